@@ -1,0 +1,4 @@
+//! The `polydem` command line.
+fn main() {
+    println!("polydem {}", env!("CARGO_PKG_VERSION"));
+}

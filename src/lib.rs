@@ -1,0 +1,15 @@
+//! polydem — a convex-polyhedral discrete element engine.
+//!
+//! The method follows Zhao, Feng et al. (2021), "Discrete Element Modelling of Dynamic Behaviour of Rockfills
+//! for Resisting High Speed Projectile Penetration" (CMES, DOI 10.32604/cmes.2021.015913): contact between
+//! convex polyhedra is detected by GJK and measured by EPA as the *Minkowski overlap* (depth δ_M, normal n_M,
+//! contact points c1, c2 and c_M = (c1 + c2)/2), which makes an elastic normal law energy-conserving.
+//!
+//! Modules, one concept each:
+//! - [`math`]: the f64 linear-algebra aliases every other module uses.
+//! - [`shape`]: convex polyhedra (hull, adjacency, principal frame, mass properties), spheres, planes.
+//! - [`contact`]: support mapping, GJK, EPA, the exact SAT oracle, fast paths per shape pair, dispatch.
+
+pub mod contact;
+pub mod math;
+pub mod shape;

@@ -1,0 +1,4 @@
+//! `cargo validate [--quick|--full] [CASE...]`.
+fn main() {
+    println!("polydem validation suite");
+}
