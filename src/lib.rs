@@ -9,7 +9,9 @@
 //! - [`math`]: the f64 linear-algebra aliases every other module uses.
 //! - [`shape`]: convex polyhedra (hull, adjacency, principal frame, mass properties), spheres, planes.
 //! - [`contact`]: support mapping, GJK, EPA, the exact SAT oracle, fast paths per shape pair, dispatch.
+//! - [`world`]: the many-body engine: broad phase, contact store, step pipeline.
 
 pub mod contact;
 pub mod math;
 pub mod shape;
+pub mod world;
