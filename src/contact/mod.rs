@@ -3,7 +3,29 @@
 //! The narrow phase answers one question per pair — where and how much do these two shapes overlap — and
 //! returns a [`ContactGeometry`]. It never computes forces: contact laws live elsewhere and consume the
 //! geometry.
+//!
+//! Files, one job each: [`minkowski`] (support of A ⊖ B), [`gjk`], [`epa`], [`sat`] (exact oracle and
+//! fallback), [`features`] (closest points of small features), one file per shape pair, [`counters`],
+//! [`tolerances`].
 
+pub mod contact_polyhedron_polyhedron;
+pub mod counters;
+pub mod epa;
+pub mod features;
 mod geometry;
+pub mod gjk;
+pub mod minkowski;
+pub mod sat;
+pub mod tolerances;
 
+#[cfg(test)]
+pub(crate) mod testing;
+#[cfg(test)]
+mod tests_oracle;
+
+pub use contact_polyhedron_polyhedron::{intersect_polytopes_cached, query_polytopes_cached, PairCache};
+pub use counters::QueryCounters;
+pub use epa::EpaScratch;
 pub use geometry::{ContactGeometry, ContactKind, SolverStatus};
+pub use sat::{sat_polytopes, Polytope};
+pub use tolerances::ContactTolerances;
