@@ -147,7 +147,13 @@ fn query_inner<A: Polytope + ?Sized, B: Polytope + ?Sized>(
                     )
                 }
                 EpaOutcome::MaxIterations => fallback(SolverStatus::FallbackAfterMaxIterations),
-                EpaOutcome::Degenerate => fallback(SolverStatus::FallbackAfterDegenerate),
+                EpaOutcome::Degenerate(_why) => {
+                    #[cfg(test)]
+                    if std::env::var("POLYDEM_DEBUG_FALLBACK").is_ok() {
+                        eprintln!("epa degenerate: {_why:?} after {} iterations", er.iterations);
+                    }
+                    fallback(SolverStatus::FallbackAfterDegenerate)
+                }
             }
         }
         GjkOutcome::MaxIterations | GjkOutcome::SeparatingAxis => {

@@ -88,7 +88,20 @@ pub enum EpaOutcome {
         point_b: Vector,
     },
     MaxIterations,
-    Degenerate,
+    Degenerate(Degeneracy),
+}
+
+/// Why EPA gave up (the caller falls back to the exact answer).
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+pub enum Degeneracy {
+    /// No proper tetrahedron could be formed from the start points.
+    FlatStart,
+    /// A buffer of the scratch is full.
+    BufferFull,
+    /// A new face has no usable normal.
+    FaceWithoutNormal,
+    /// The horizon is not one simple loop.
+    BrokenHorizon,
 }
 
 /// Result of one EPA run.
@@ -220,33 +233,47 @@ pub fn epa<A: SupportMap + ?Sized, B: SupportMap + ?Sized>(
     if !ok {
         scratch.verts.clear();
         scratch.verts.extend_from_slice(&simplex.pts[..simplex.len]);
-        for d in [
-            Vector::x(),
-            -Vector::x(),
-            Vector::y(),
-            -Vector::y(),
-            Vector::z(),
-            -Vector::z(),
-        ] {
-            let s = pair.support(&d);
+        // Supports along the axes of a fixed, irregular frame (coordinate axes are tie-prone for aligned
+        // shapes), then along the diagonals of that frame if the first six are not enough.
+        for d in START_DIRECTIONS[..6].iter() {
+            let s = pair.support(d);
             scratch.verts.push(s);
+        }
+        if spread_tetrahedron(&scratch.verts).is_none() {
+            for d in START_DIRECTIONS[6..].iter() {
+                let s = pair.support(d);
+                scratch.verts.push(s);
+            }
+        }
+        // Still flat (all supports so far in one plane through a face of A ⊖ B's symmetric core): the
+        // supports along the plane's two normals leave it, since A ⊖ B has volume.
+        if let Some((i0, i1, i2)) = spread_triangle(&scratch.verts) {
+            if spread_tetrahedron(&scratch.verts).is_none() {
+                let (p0, p1, p2) = (scratch.verts[i0].w, scratch.verts[i1].w, scratch.verts[i2].w);
+                let nrm = (p1 - p0).cross(&(p2 - p0));
+                let nrm = nrm / nrm.norm();
+                let up = pair.support(&nrm);
+                let down = pair.support(&-nrm);
+                scratch.verts.push(up);
+                scratch.verts.push(down);
+            }
         }
         let Some(idx) = spread_tetrahedron(&scratch.verts) else {
             return EpaResult {
-                outcome: EpaOutcome::Degenerate,
+                outcome: EpaOutcome::Degenerate(Degeneracy::FlatStart),
                 iterations: 0,
             };
         };
         if !scratch.start_tetrahedron(idx) {
             return EpaResult {
-                outcome: EpaOutcome::Degenerate,
+                outcome: EpaOutcome::Degenerate(Degeneracy::FlatStart),
                 iterations: 0,
             };
         }
     }
 
-    let degenerate = |iterations| EpaResult {
-        outcome: EpaOutcome::Degenerate,
+    let degenerate = |iterations, why| EpaResult {
+        outcome: EpaOutcome::Degenerate(why),
         iterations,
     };
     let mut iterations = 0u32;
@@ -261,7 +288,7 @@ pub fn epa<A: SupportMap + ?Sized, B: SupportMap + ?Sized>(
             }
         }
         if best == u32::MAX {
-            return degenerate(iterations);
+            return degenerate(iterations, Degeneracy::BrokenHorizon);
         }
         let face = scratch.faces[best as usize];
         let n = face.normal;
@@ -283,7 +310,7 @@ pub fn epa<A: SupportMap + ?Sized, B: SupportMap + ?Sized>(
         }
         iterations += 1;
         if scratch.verts.len() >= scratch.max_verts {
-            return degenerate(iterations);
+            return degenerate(iterations, Degeneracy::BufferFull);
         }
         scratch.verts.push(s);
         let wi = scratch.verts.len() as u32 - 1;
@@ -294,23 +321,18 @@ pub fn epa<A: SupportMap + ?Sized, B: SupportMap + ?Sized>(
             scratch.silhouette(face.adj[e], face.adj_edge[e], &s.w, vis_eps);
         }
         if scratch.horizon.len() < 3 {
-            return degenerate(iterations);
+            return degenerate(iterations, Degeneracy::BrokenHorizon);
         }
         // A fan of new faces, one per horizon edge: [end, start, w] of the (reversed) horizon edge.
         scratch.new_faces.clear();
         for h_idx in 0..scratch.horizon.len() {
             let (g, k) = scratch.horizon[h_idx];
-            let gf = scratch.faces[g as usize];
+            let gf = &scratch.faces[g as usize];
             let p = gf.v[(k as usize + 1) % 3];
             let q = gf.v[k as usize];
             let Some(nf) = scratch.push_face([p, q, wi]) else {
-                return degenerate(iterations);
+                return degenerate(iterations, Degeneracy::FaceWithoutNormal);
             };
-            // Every new face must see w on its plane and keep the origin's side consistent: a face whose
-            // plane is tilted away from its neighbour by more than 90° signals a broken silhouette.
-            if scratch.faces[nf as usize].normal.dot(&gf.normal) < -0.5 {
-                return degenerate(iterations);
-            }
             scratch.faces[nf as usize].adj[0] = g;
             scratch.faces[nf as usize].adj_edge[0] = k;
             scratch.faces[g as usize].adj[k as usize] = nf;
@@ -328,13 +350,13 @@ pub fn epa<A: SupportMap + ?Sized, B: SupportMap + ?Sized>(
                 let fi = scratch.new_faces[i];
                 if scratch.faces[fi as usize].v[0] == qj {
                     if found != u32::MAX {
-                        return degenerate(iterations);
+                        return degenerate(iterations, Degeneracy::BrokenHorizon);
                     }
                     found = fi;
                 }
             }
             if found == u32::MAX || scratch.faces[found as usize].adj[2] != u32::MAX {
-                return degenerate(iterations);
+                return degenerate(iterations, Degeneracy::BrokenHorizon);
             }
             scratch.faces[fj as usize].adj[1] = found;
             scratch.faces[fj as usize].adj_edge[1] = 2;
@@ -344,22 +366,45 @@ pub fn epa<A: SupportMap + ?Sized, B: SupportMap + ?Sized>(
     }
 }
 
-/// Picks four of `pts` with maximal spread (farthest point, farthest from the line, farthest from the
-/// plane). `None` if they span less than a proper volume.
-fn spread_tetrahedron(pts: &[SupportPoint]) -> Option<[u32; 4]> {
+/// Start directions: ±axes and the eight diagonals of the frame rotated by the Euler angles (0.3, 0.7, 1.1)
+/// rad: a fixed, irregular frame, so that aligned shapes do not produce ties between start supports.
+static START_DIRECTIONS: std::sync::LazyLock<[Vector; 14]> = std::sync::LazyLock::new(|| {
+    let r = crate::math::Rotation::from_euler_angles(0.3, 0.7, 1.1);
+    let s3 = 1.0 / (3.0 as Real).sqrt();
+    let local = [
+        Vector::x(),
+        -Vector::x(),
+        Vector::y(),
+        -Vector::y(),
+        Vector::z(),
+        -Vector::z(),
+        Vector::new(s3, s3, s3),
+        Vector::new(-s3, -s3, -s3),
+        Vector::new(s3, -s3, s3),
+        Vector::new(-s3, s3, -s3),
+        Vector::new(s3, s3, -s3),
+        Vector::new(-s3, -s3, s3),
+        Vector::new(-s3, s3, s3),
+        Vector::new(s3, -s3, -s3),
+    ];
+    local.map(|d| r * d)
+});
+
+/// Three of `pts` with maximal spread (farthest from the centroid, farthest from it, farthest from their
+/// line); `None` if all are collinear.
+fn spread_triangle(pts: &[SupportPoint]) -> Option<(usize, usize, usize)> {
     let n = pts.len();
     let c = pts.iter().fold(Vector::zeros(), |acc, p| acc + p.w) / n as Real;
-    let i0 = (0..n).max_by(|&i, &j| {
-        (pts[i].w - c)
-            .norm_squared()
-            .total_cmp(&(pts[j].w - c).norm_squared())
-    })?;
+    let far = |from: Vector| {
+        (0..n).max_by(|&i, &j| {
+            (pts[i].w - from)
+                .norm_squared()
+                .total_cmp(&(pts[j].w - from).norm_squared())
+        })
+    };
+    let i0 = far(c)?;
     let p0 = pts[i0].w;
-    let i1 = (0..n).max_by(|&i, &j| {
-        (pts[i].w - p0)
-            .norm_squared()
-            .total_cmp(&(pts[j].w - p0).norm_squared())
-    })?;
+    let i1 = far(p0)?;
     let d1 = pts[i1].w - p0;
     if d1.norm_squared() == 0.0 {
         return None;
@@ -370,14 +415,29 @@ fn spread_tetrahedron(pts: &[SupportPoint]) -> Option<[u32; 4]> {
             .total_cmp(&d1.cross(&(pts[j].w - p0)).norm_squared())
     })?;
     let nrm = d1.cross(&(pts[i2].w - p0));
-    if nrm.norm_squared() == 0.0 {
+    if !(nrm.norm_squared() > 1e-24 * d1.norm_squared() * d1.norm_squared()) {
         return None;
     }
-    let i3 = (0..n).max_by(|&i, &j| {
+    Some((i0, i1, i2))
+}
+
+/// Four of `pts` with maximal spread: [`spread_triangle`] and the point farthest from its plane. `None` if
+/// they span no proper volume (relative volume below 1e-9).
+fn spread_tetrahedron(pts: &[SupportPoint]) -> Option<[u32; 4]> {
+    let (i0, i1, i2) = spread_triangle(pts)?;
+    let p0 = pts[i0].w;
+    let e1 = pts[i1].w - p0;
+    let e2 = pts[i2].w - p0;
+    let nrm = e1.cross(&e2);
+    let i3 = (0..pts.len()).max_by(|&i, &j| {
         nrm.dot(&(pts[i].w - p0))
             .abs()
             .total_cmp(&nrm.dot(&(pts[j].w - p0)).abs())
     })?;
+    let e3 = pts[i3].w - p0;
+    if !(nrm.dot(&e3).abs() > 1e-9 * e1.norm() * e2.norm() * e3.norm()) {
+        return None;
+    }
     Some([i0 as u32, i1 as u32, i2 as u32, i3 as u32])
 }
 
@@ -458,3 +518,4 @@ fn symmetric(pa: Vector, pb: Vector, n: Vector, h: Real) -> EpaOutcome {
         point_b: mid - half,
     }
 }
+

@@ -22,6 +22,8 @@ pub mod tolerances;
 pub(crate) mod testing;
 #[cfg(test)]
 mod tests_oracle;
+#[cfg(test)]
+mod tests_degenerate;
 
 pub use contact_polyhedron_polyhedron::{intersect_polytopes_cached, query_polytopes_cached, PairCache};
 pub use counters::QueryCounters;

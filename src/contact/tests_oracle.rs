@@ -56,6 +56,9 @@ pub(crate) fn check_pair(
     stats.pairs += 1;
     if g.status != SolverStatus::Converged {
         stats.fallbacks += 1;
+        if std::env::var("POLYDEM_DEBUG_FALLBACK").is_ok() {
+            eprintln!("fallback {:?} kind {:?} {ctx}", g.status, g.kind);
+        }
     }
     if g.kind != oracle.kind {
         return Err(format!("wrong kind: {:?} vs exact {:?}\n{}", g.kind, oracle.kind, desc()));
@@ -127,45 +130,29 @@ pub(crate) fn check_pair(
     Ok(())
 }
 
-/// Exact signed overlap (SAT axes; positive = overlap) of `a` at `pos1` and `b` at `pos2`.
-fn sat_signed(pos1: &Pose, a: &TestPolytope, pos2: &Pose, b: &TestPolytope) -> Real {
-    // The best SAT value is exactly zero at first contact, so its sign locates the contact.
-    let mut best = Real::INFINITY;
+/// Translation along unit `u` (from `pos1`'s centre) at which `b` (orientation `rot2`) first touches `a`.
+///
+/// With B at `pos1.translation + t u`, the overlap along a SAT axis n is s_n(0) − t n·u, and the pair
+/// overlaps iff every axis overlaps (the SAT value's sign is exact). At t = 0 both centroids coincide, so all
+/// s_n(0) > 0, and first contact is at t* = min over axes with n·u > 0 of s_n(0) / (n·u).
+pub(crate) fn touching_offset(pos1: &Pose, a: &TestPolytope, rot2: &crate::math::Rotation, b: &TestPolytope, u: &Vector) -> Real {
+    let pos2 = Pose::from_parts(pos1.translation, *rot2);
     let mut axes: Vec<Vector> = a.normals.iter().map(|n| pos1.rotation * n).collect();
     axes.extend(b.normals.iter().map(|n| -(pos2.rotation * n)));
     for ea in &a.edges {
-        let u = pos1.rotation * (a.verts[ea[1] as usize] - a.verts[ea[0] as usize]).normalize();
+        let e1 = pos1.rotation * (a.verts[ea[1] as usize] - a.verts[ea[0] as usize]).normalize();
         for eb in &b.edges {
-            let v = pos2.rotation * (b.verts[eb[1] as usize] - b.verts[eb[0] as usize]).normalize();
-            if let Some(n) = sat::edge_edge_axis(&u, &v) {
+            let e2 = pos2.rotation * (b.verts[eb[1] as usize] - b.verts[eb[0] as usize]).normalize();
+            if let Some(n) = sat::edge_edge_axis(&e1, &e2) {
                 axes.push(n);
                 axes.push(-n);
             }
         }
     }
-    for n in &axes {
-        best = best.min(overlap_along_world(pos1, a, pos2, b, n));
-    }
-    best
-}
-
-/// Translation along unit `u` (from `pos1`'s centre) at which `b` first touches `a`, by bisection on the sign
-/// of the exact SAT value.
-fn touching_offset(pos1: &Pose, a: &TestPolytope, rot2: &crate::math::Rotation, b: &TestPolytope, u: &Vector) -> Real {
-    let at = |t: Real| Pose::from_parts((pos1.translation.vector + u * t).into(), *rot2);
-    let (mut lo, mut hi) = (0.0, 1.01 * (a.radius + b.radius));
-    for _ in 0..200 {
-        let mid = 0.5 * (lo + hi);
-        if mid <= lo || mid >= hi {
-            break;
-        }
-        if sat_signed(pos1, a, &at(mid), b) > 0.0 {
-            lo = mid;
-        } else {
-            hi = mid;
-        }
-    }
-    0.5 * (lo + hi)
+    axes.iter()
+        .filter(|n| n.dot(u) > 1e-9)
+        .map(|n| overlap_along_world(pos1, a, &pos2, b, n) / n.dot(u))
+        .fold(Real::INFINITY, Real::min)
 }
 
 pub(crate) fn random_tetrahedron(rng: &mut impl Rng, size: Real) -> TestPolytope {
@@ -298,5 +285,16 @@ fn debug_pair() {
 
             }
         }
+    }
+}
+
+/// Large sweep for manual runs: `POLYDEM_SWEEP=100000 cargo test --release -- --ignored sweep`.
+#[test]
+#[ignore]
+fn sweep() {
+    let n: usize = std::env::var("POLYDEM_SWEEP").ok().and_then(|s| s.parse().ok()).unwrap_or(10_000);
+    for (seed, size) in [(11u64, 1.0), (12, 1e-3), (13, 1e3)] {
+        let s = random_pairs(seed, n, size, &CLASSES);
+        println!("{size:e}: {s:?}");
     }
 }
