@@ -1,0 +1,433 @@
+//! Broad phase: candidate pairs from bounding spheres in a uniform grid, with a Verlet skin.
+//!
+//! Every body is enclosed by a sphere about its centre of mass (rotation-invariant, so only translation can
+//! invalidate the list). Two bodies are a candidate pair when their spheres, each inflated by half the skin,
+//! overlap: `|x_i − x_j| < r_i + r_j + skin`. The list stays valid — it contains every pair that can touch —
+//! until some body has moved more than `skin / 2` from where it was at the last rebuild, so the grid is rebuilt
+//! only then ([`BroadPhase::needs_rebuild`]).
+//!
+//! The grid's cell size is the median inflated diameter, so a typical body covers one to eight cells; a body
+//! much larger than its neighbours (a 0.8 m projectile among 0.1 m rocks) is simply entered in every cell
+//! its box covers. A pair is reported once, from the first cell (lowest x, y, z) of the overlap of the two
+//! bodies' cell ranges, which makes the result exactly the set the O(N²) definition gives — no duplicates
+//! and no misses — and [`brute_force_pairs`] is that definition, kept as the test oracle.
+//!
+//! Output: pairs `(i, j)` with `i < j`, sorted, so every later stage sees the same order on every run and
+//! for any thread count.
+
+use crate::math::{Point, Real};
+
+/// A candidate pair of body indices, `i < j`.
+pub type Pair = (u32, u32);
+
+/// The broad-phase state kept between steps.
+#[derive(Clone, Debug, Default)]
+pub struct BroadPhase {
+    /// Extra margin (m) added to the sum of the radii; the list is valid while no body moved `skin / 2`.
+    skin: Real,
+    /// Body centres at the last rebuild.
+    centres_at_build: Vec<Point>,
+    /// The candidate pairs, sorted.
+    pairs: Vec<Pair>,
+    /// How many times the grid has been rebuilt.
+    rebuilds: u64,
+    // Scratch, reused between rebuilds.
+    cell_start: Vec<u32>,
+    cell_bodies: Vec<u32>,
+    body_cells: Vec<CellRange>,
+}
+
+/// The inclusive range of grid cells a body's inflated box covers.
+#[derive(Copy, Clone, Debug, Default, PartialEq, Eq)]
+struct CellRange {
+    lo: [u32; 3],
+    hi: [u32; 3],
+}
+
+/// The grid geometry of one rebuild.
+struct Grid {
+    origin: [Real; 3],
+    cell_size: Real,
+    dims: [u32; 3],
+}
+
+impl Grid {
+    /// The cell coordinate of `x` along `axis`, clamped into the grid.
+    fn coord(&self, x: Real, axis: usize) -> u32 {
+        let c = ((x - self.origin[axis]) / self.cell_size).floor();
+        c.clamp(0.0, (self.dims[axis] - 1) as Real) as u32
+    }
+
+    fn linear(&self, c: [u32; 3]) -> usize {
+        (c[0] as usize)
+            + (self.dims[0] as usize)
+                * ((c[1] as usize) + (self.dims[1] as usize) * (c[2] as usize))
+    }
+}
+
+/// The largest number of cells the grid may have; beyond it the cell size grows (a sparse, spread-out scene
+/// must not allocate a huge empty grid).
+const MAX_CELLS: usize = 1 << 22;
+
+impl BroadPhase {
+    /// A broad phase with the given skin (m). A skin of zero is allowed: the list is then rebuilt whenever
+    /// any body moves at all.
+    pub fn new(skin: Real) -> Self {
+        Self {
+            skin: skin.max(0.0),
+            ..Self::default()
+        }
+    }
+
+    pub fn skin(&self) -> Real {
+        self.skin
+    }
+
+    /// The candidate pairs of the last rebuild, sorted, `i < j`.
+    pub fn pairs(&self) -> &[Pair] {
+        &self.pairs
+    }
+
+    /// How many times the grid has been rebuilt.
+    pub fn rebuilds(&self) -> u64 {
+        self.rebuilds
+    }
+
+    /// Whether the pair list may have become incomplete: the body count changed, or some body moved more than
+    /// half the skin since the last rebuild.
+    pub fn needs_rebuild(&self, centres: &[Point]) -> bool {
+        if centres.len() != self.centres_at_build.len() || self.rebuilds == 0 {
+            return true;
+        }
+        let limit_sq = 0.25 * self.skin * self.skin;
+        centres
+            .iter()
+            .zip(&self.centres_at_build)
+            .any(|(now, then)| (now - then).norm_squared() >= limit_sq)
+    }
+
+    /// Rebuilds the pair list if [`needs_rebuild`](Self::needs_rebuild); returns whether it did.
+    pub fn update(&mut self, centres: &[Point], radii: &[Real]) -> bool {
+        if self.needs_rebuild(centres) {
+            self.rebuild(centres, radii);
+            true
+        } else {
+            false
+        }
+    }
+
+    /// Recomputes the candidate pairs from scratch.
+    ///
+    /// `centres` and `radii` are the bounding spheres of the bodies (world frame, m), one per body; the radii
+    /// must be finite and non-negative (the world checks bodies before they get here).
+    pub fn rebuild(&mut self, centres: &[Point], radii: &[Real]) {
+        assert_eq!(
+            centres.len(),
+            radii.len(),
+            "broad phase: one radius per centre"
+        );
+        self.rebuilds += 1;
+        self.centres_at_build.clear();
+        self.centres_at_build.extend_from_slice(centres);
+        self.pairs.clear();
+        if centres.len() < 2 {
+            return;
+        }
+        let half_skin = 0.5 * self.skin;
+        let grid = self.grid_for(centres, radii);
+
+        // Cell ranges of every body's inflated box.
+        self.body_cells.clear();
+        self.body_cells
+            .extend(centres.iter().zip(radii).map(|(c, &r)| {
+                // Widened by a relative 1e-9 so that rounding can never drop a pair the sphere test would keep:
+                // extra cells only cost a test, a missing cell would lose a contact.
+                let reach = (r + half_skin) * (1.0 + 1e-9);
+                let mut range = CellRange::default();
+                for axis in 0..3 {
+                    range.lo[axis] = grid.coord(c[axis] - reach, axis);
+                    range.hi[axis] = grid.coord(c[axis] + reach, axis);
+                }
+                range
+            }));
+
+        // Counting sort of (cell, body) entries into CSR form: cell_bodies[cell_start[k]..cell_start[k+1]].
+        let num_cells = (grid.dims[0] * grid.dims[1] * grid.dims[2]) as usize;
+        self.cell_start.clear();
+        self.cell_start.resize(num_cells + 1, 0);
+        for range in &self.body_cells {
+            for_each_cell(range, |c| self.cell_start[grid.linear(c) + 1] += 1);
+        }
+        for k in 0..num_cells {
+            self.cell_start[k + 1] += self.cell_start[k];
+        }
+        self.cell_bodies.clear();
+        self.cell_bodies
+            .resize(self.cell_start[num_cells] as usize, 0);
+        let mut fill = self.cell_start.clone();
+        for (body, range) in self.body_cells.iter().enumerate() {
+            for_each_cell(range, |c| {
+                let k = grid.linear(c);
+                self.cell_bodies[fill[k] as usize] = body as u32;
+                fill[k] += 1;
+            });
+        }
+
+        // Each pair is examined in the first cell of the overlap of both ranges only.
+        for (i, range_i) in self.body_cells.iter().enumerate() {
+            for_each_cell(range_i, |c| {
+                let k = grid.linear(c);
+                for &j in
+                    &self.cell_bodies[self.cell_start[k] as usize..self.cell_start[k + 1] as usize]
+                {
+                    let j_usize = j as usize;
+                    if j_usize <= i {
+                        continue;
+                    }
+                    let range_j = &self.body_cells[j_usize];
+                    let first_common = [
+                        range_i.lo[0].max(range_j.lo[0]),
+                        range_i.lo[1].max(range_j.lo[1]),
+                        range_i.lo[2].max(range_j.lo[2]),
+                    ];
+                    if first_common != c {
+                        continue;
+                    }
+                    if spheres_within(
+                        centres[i],
+                        radii[i],
+                        centres[j_usize],
+                        radii[j_usize],
+                        self.skin,
+                    ) {
+                        self.pairs.push((i as u32, j));
+                    }
+                }
+            });
+        }
+        self.pairs.sort_unstable();
+    }
+
+    /// A grid over the inflated boxes of all bodies, with the median inflated diameter as cell size.
+    fn grid_for(&self, centres: &[Point], radii: &[Real]) -> Grid {
+        let half_skin = 0.5 * self.skin;
+        let mut lo = [Real::INFINITY; 3];
+        let mut hi = [Real::NEG_INFINITY; 3];
+        for (c, &r) in centres.iter().zip(radii) {
+            for axis in 0..3 {
+                lo[axis] = lo[axis].min(c[axis] - r - half_skin);
+                hi[axis] = hi[axis].max(c[axis] + r + half_skin);
+            }
+        }
+        let mut diameters: Vec<Real> = radii.iter().map(|&r| 2.0 * (r + half_skin)).collect();
+        let mid = diameters.len() / 2;
+        let (_, median, _) = diameters.select_nth_unstable_by(mid, |a, b| a.total_cmp(b));
+        let extent = [hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]];
+        let largest_extent = extent.iter().cloned().fold(0.0, Real::max);
+        // A zero median (point bodies, no skin) would make a degenerate grid: fall back to the scene size.
+        let mut cell_size = if *median > 0.0 {
+            *median
+        } else {
+            largest_extent.max(1.0)
+        };
+        let dims_for =
+            |size: Real| extent.map(|e| ((e / size).floor() as u64 + 1).min(u32::MAX as u64));
+        loop {
+            let dims = dims_for(cell_size);
+            if (dims[0] as u128) * (dims[1] as u128) * (dims[2] as u128) <= MAX_CELLS as u128 {
+                return Grid {
+                    origin: lo,
+                    cell_size,
+                    dims: dims.map(|d| d as u32),
+                };
+            }
+            cell_size *= 2.0;
+        }
+    }
+}
+
+/// Calls `f` with every cell of an inclusive range.
+fn for_each_cell(range: &CellRange, mut f: impl FnMut([u32; 3])) {
+    for z in range.lo[2]..=range.hi[2] {
+        for y in range.lo[1]..=range.hi[1] {
+            for x in range.lo[0]..=range.hi[0] {
+                f([x, y, z]);
+            }
+        }
+    }
+}
+
+/// The pair criterion: spheres closer than the sum of their radii plus the skin.
+fn spheres_within(c1: Point, r1: Real, c2: Point, r2: Real, skin: Real) -> bool {
+    let reach = r1 + r2 + skin;
+    (c2 - c1).norm_squared() < reach * reach
+}
+
+/// The O(N²) definition of the candidate pairs: the oracle the grid must match exactly.
+pub fn brute_force_pairs(centres: &[Point], radii: &[Real], skin: Real) -> Vec<Pair> {
+    let mut pairs = Vec::new();
+    for i in 0..centres.len() {
+        for j in i + 1..centres.len() {
+            if spheres_within(centres[i], radii[i], centres[j], radii[j], skin) {
+                pairs.push((i as u32, j as u32));
+            }
+        }
+    }
+    pairs
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A small deterministic generator (SplitMix64), so these tests need no extra crate.
+    struct SplitMix(u64);
+    impl SplitMix {
+        fn next_f64(&mut self) -> f64 {
+            self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+            let mut z = self.0;
+            z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+            z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+            ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
+        }
+        fn uniform(&mut self, lo: f64, hi: f64) -> f64 {
+            lo + (hi - lo) * self.next_f64()
+        }
+    }
+
+    fn random_scene(
+        seed: u64,
+        n: usize,
+        box_size: f64,
+        r_min: f64,
+        r_max: f64,
+    ) -> (Vec<Point>, Vec<Real>) {
+        let mut rng = SplitMix(seed);
+        let centres = (0..n)
+            .map(|_| {
+                Point::new(
+                    rng.uniform(0.0, box_size),
+                    rng.uniform(0.0, box_size),
+                    rng.uniform(0.0, box_size),
+                )
+            })
+            .collect();
+        let radii = (0..n).map(|_| rng.uniform(r_min, r_max)).collect();
+        (centres, radii)
+    }
+
+    fn assert_matches_oracle(label: &str, centres: &[Point], radii: &[Real], skin: Real) {
+        let mut broad = BroadPhase::new(skin);
+        broad.rebuild(centres, radii);
+        let expected = brute_force_pairs(centres, radii, skin);
+        let missing: Vec<_> = expected
+            .iter()
+            .filter(|p| broad.pairs().binary_search(p).is_err())
+            .take(5)
+            .collect();
+        let extra: Vec<_> = broad
+            .pairs()
+            .iter()
+            .filter(|p| expected.binary_search(p).is_err())
+            .take(5)
+            .collect();
+        assert!(
+            broad.pairs() == expected.as_slice(),
+            "{label}: grid found {} pairs, O(N²) oracle {} (n = {}, skin = {skin}); first missing {missing:?}, \
+             first extra {extra:?}",
+            broad.pairs().len(),
+            expected.len(),
+            centres.len(),
+        );
+    }
+
+    #[test]
+    fn grid_pairs_equal_brute_force_for_uniform_sizes() {
+        for seed in 0..5 {
+            let (centres, radii) = random_scene(seed, 800, 2.0, 0.045, 0.055);
+            assert_matches_oracle(&format!("uniform seed {seed}"), &centres, &radii, 0.01);
+        }
+    }
+
+    #[test]
+    fn grid_pairs_equal_brute_force_with_a_projectile_among_small_rocks() {
+        // A 0.8 m body among 0.1 m ones: the large body covers many cells.
+        let (mut centres, mut radii) = random_scene(7, 1500, 3.0, 0.04, 0.06);
+        centres.push(Point::new(1.5, 1.5, 1.5));
+        radii.push(0.4);
+        centres.push(Point::new(0.1, 2.9, 1.0));
+        radii.push(0.45);
+        assert_matches_oracle("projectile among rocks", &centres, &radii, 0.005);
+    }
+
+    #[test]
+    fn grid_pairs_equal_brute_force_for_sizes_spanning_four_decades() {
+        let mut rng = SplitMix(11);
+        let n = 600;
+        let centres: Vec<Point> = (0..n)
+            .map(|_| {
+                Point::new(
+                    rng.uniform(0.0, 5.0),
+                    rng.uniform(0.0, 5.0),
+                    rng.uniform(0.0, 5.0),
+                )
+            })
+            .collect();
+        let radii: Vec<Real> = (0..n).map(|_| 10f64.powf(rng.uniform(-3.0, 0.0))).collect();
+        assert_matches_oracle("log-uniform radii 1e-3..1", &centres, &radii, 0.0);
+        assert_matches_oracle("log-uniform radii 1e-3..1, skin", &centres, &radii, 0.02);
+    }
+
+    #[test]
+    fn spheres_exactly_at_the_reach_are_not_a_pair_and_just_inside_are() {
+        let radii = [0.5, 0.5];
+        let apart = [Point::origin(), Point::new(1.1, 0.0, 0.0)];
+        assert_matches_oracle("at the reach", &apart, &radii, 0.1);
+        let inside = [Point::origin(), Point::new(1.1 * (1.0 - 1e-15), 0.0, 0.0)];
+        assert_matches_oracle("just inside the reach", &inside, &radii, 0.1);
+        assert_eq!(brute_force_pairs(&inside, &radii, 0.1), vec![(0, 1)]);
+    }
+
+    #[test]
+    fn degenerate_scenes_give_the_oracle_pairs() {
+        // All bodies at one point, a flat layer, and a spread-out sparse scene that would need a huge grid.
+        let same = vec![Point::new(1.0, 1.0, 1.0); 20];
+        assert_matches_oracle("coincident centres", &same, &[0.1; 20], 0.0);
+        let flat: Vec<Point> = (0..400)
+            .map(|k| Point::new((k % 20) as f64 * 0.09, (k / 20) as f64 * 0.09, 0.0))
+            .collect();
+        assert_matches_oracle("flat layer", &flat, &[0.05; 400], 0.0);
+        let sparse: Vec<Point> = (0..50)
+            .map(|k| Point::new(k as f64 * 1e4, 0.0, (k % 3) as f64))
+            .collect();
+        assert_matches_oracle("sparse huge extent", &sparse, &[0.6; 50], 0.0);
+        assert_matches_oracle("no bodies", &[], &[], 0.1);
+        assert_matches_oracle("one body", &[Point::origin()], &[1.0], 0.1);
+    }
+
+    #[test]
+    fn list_is_rebuilt_only_after_a_body_moves_half_the_skin() {
+        let (mut centres, radii) = random_scene(3, 200, 1.0, 0.04, 0.06);
+        let skin = 0.02;
+        let mut broad = BroadPhase::new(skin);
+        assert!(broad.update(&centres, &radii), "first update must build");
+        centres[17].x += 0.49 * skin;
+        assert!(
+            !broad.update(&centres, &radii),
+            "a move of 0.49 skin must not trigger a rebuild"
+        );
+        // Every pair that can touch (sum of radii, no skin) is still in the stale list.
+        for (i, j) in brute_force_pairs(&centres, &radii, 0.0) {
+            assert!(
+                broad.pairs().binary_search(&(i, j)).is_ok(),
+                "stale list lost touching pair ({i}, {j})"
+            );
+        }
+        centres[17].x += 0.02 * skin;
+        assert!(
+            broad.update(&centres, &radii),
+            "a move of 0.51 skin must trigger a rebuild"
+        );
+        assert_eq!(broad.rebuilds(), 2);
+    }
+}

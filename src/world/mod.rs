@@ -1,0 +1,3 @@
+//! The many-body world: broad phase, contact store and the step pipeline.
+
+pub mod broad_phase;
