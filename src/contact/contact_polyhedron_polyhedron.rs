@@ -7,7 +7,7 @@
 //! 3. on an iteration cap or a degeneracy of either solver, the exact SAT answer
 //!    ([`sat`](super::sat)) with the status saying why, counted in [`QueryCounters`].
 //!
-//! Classification uses the touching band `touching · L` (L = larger bounding radius): Overlap when
+//! Classification uses the touching band `touching · L` (L = the larger `length_scale()` of the two): Overlap when
 //! δ_M > band, Separated when the gap > band, Touching otherwise (depth and distance then reported as 0).
 //!
 //! [`intersect_polytopes_cached`] is the boolean variant for rejection tests: bounding spheres, one support
@@ -21,6 +21,7 @@ use super::sat::{sat_polytopes, Polytope};
 use super::tolerances::ContactTolerances;
 use super::{ContactGeometry, ContactKind, SolverStatus};
 use crate::math::{Point, Pose, Real, Vector};
+use crate::shape::ConvexPolyhedron;
 
 /// What the narrow phase remembers about a pair between queries (frame-1 quantities; tiny, `Copy`).
 #[derive(Copy, Clone, Debug, Default, PartialEq)]
@@ -88,7 +89,7 @@ fn query_inner<A: Polytope + ?Sized, B: Polytope + ?Sized>(
     counters: &mut QueryCounters,
 ) -> ContactGeometry {
     let pos12 = pos1.inv_mul(pos2);
-    let scale = a.bounding_radius().max(b.bounding_radius());
+    let scale = a.length_scale().max(b.length_scale());
     let touch = tol.touching * scale;
     let mut pair = MinkowskiPair::new(a, b, &pos12, cache.hint_a, cache.hint_b);
     let v0 = if cache.dir != Vector::zeros() {
@@ -179,7 +180,7 @@ pub fn intersect_polytopes_cached<A: Polytope + ?Sized, B: Polytope + ?Sized>(
 ) -> bool {
     let pos12 = pos1.inv_mul(pos2);
     let (ra, rb) = (a.bounding_radius(), b.bounding_radius());
-    let scale = ra.max(rb);
+    let scale = a.length_scale().max(b.length_scale());
     let touch = tol.touching * scale;
     let t12 = pos12.translation.vector;
     if t12.norm_squared() > (ra + rb + touch) * (ra + rb + touch) {
@@ -220,4 +221,73 @@ pub fn intersect_polytopes_cached<A: Polytope + ?Sized, B: Polytope + ?Sized>(
             g.kind != ContactKind::Separated
         }
     }
+}
+
+/// Contact query between two convex polyhedra with a fresh cache, fresh scratch, default tolerances and no
+/// counters: the convenience form (CLI, tests). The answer is the same as the hot path's.
+pub fn query_polyhedra(pos1: &Pose, a: &ConvexPolyhedron, pos2: &Pose, b: &ConvexPolyhedron) -> ContactGeometry {
+    let mut cache = PairCache::default();
+    let mut counters = QueryCounters::default();
+    EPA_SCRATCH.with(|s| {
+        query_polytopes_cached(
+            pos1,
+            a,
+            pos2,
+            b,
+            &ContactTolerances::default(),
+            &mut cache,
+            &mut s.borrow_mut(),
+            &mut counters,
+        )
+    })
+}
+
+thread_local! {
+    static EPA_SCRATCH: std::cell::RefCell<EpaScratch> = std::cell::RefCell::new(EpaScratch::default());
+}
+
+/// Hot-path contact query between two convex polyhedra with the default tolerances: the caller keeps one
+/// [`PairCache`] per pair, one [`EpaScratch`] per thread and one [`QueryCounters`] per thread.
+pub fn query_polyhedra_cached(
+    pos1: &Pose,
+    a: &ConvexPolyhedron,
+    pos2: &Pose,
+    b: &ConvexPolyhedron,
+    cache: &mut PairCache,
+    scratch: &mut EpaScratch,
+    counters: &mut QueryCounters,
+) -> ContactGeometry {
+    query_polytopes_cached(pos1, a, pos2, b, &ContactTolerances::default(), cache, scratch, counters)
+}
+
+/// [`query_polyhedra_cached`] with explicit tolerances (for tolerance sweeps).
+#[allow(clippy::too_many_arguments)]
+pub fn query_polyhedra_with(
+    pos1: &Pose,
+    a: &ConvexPolyhedron,
+    pos2: &Pose,
+    b: &ConvexPolyhedron,
+    tol: &ContactTolerances,
+    cache: &mut PairCache,
+    scratch: &mut EpaScratch,
+    counters: &mut QueryCounters,
+) -> ContactGeometry {
+    query_polytopes_cached(pos1, a, pos2, b, tol, cache, scratch, counters)
+}
+
+/// Whether two convex polyhedra overlap or touch, without measuring (rejection test; default tolerances).
+pub fn intersect_polyhedra_cached(
+    pos1: &Pose,
+    a: &ConvexPolyhedron,
+    pos2: &Pose,
+    b: &ConvexPolyhedron,
+    cache: &mut PairCache,
+    counters: &mut QueryCounters,
+) -> bool {
+    intersect_polytopes_cached(pos1, a, pos2, b, &ContactTolerances::default(), cache, counters)
+}
+
+/// The exact SAT answer for two convex polyhedra (the oracle; status `Exact`). Slow: O(E_A E_B V).
+pub fn sat_polyhedra(pos1: &Pose, a: &ConvexPolyhedron, pos2: &Pose, b: &ConvexPolyhedron) -> ContactGeometry {
+    sat_polytopes(pos1, a, pos2, b, &ContactTolerances::default(), SolverStatus::Exact)
 }

@@ -25,7 +25,10 @@ mod tests_oracle;
 #[cfg(test)]
 mod tests_degenerate;
 
-pub use contact_polyhedron_polyhedron::{intersect_polytopes_cached, query_polytopes_cached, PairCache};
+pub use contact_polyhedron_polyhedron::{
+    intersect_polyhedra_cached, intersect_polytopes_cached, query_polyhedra, query_polyhedra_cached,
+    query_polyhedra_with, query_polytopes_cached, sat_polyhedra, PairCache,
+};
 pub use counters::QueryCounters;
 pub use epa::EpaScratch;
 pub use geometry::{ContactGeometry, ContactKind, SolverStatus};

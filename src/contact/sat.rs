@@ -44,6 +44,32 @@ pub trait Polytope: SupportMap {
     fn edges(&self) -> &[[u32; 2]];
     /// Radius of a sphere about the local origin that contains the shape.
     fn bounding_radius(&self) -> Real;
+    /// The length all contact tolerances are scaled by (the particle size).
+    fn length_scale(&self) -> Real;
+}
+
+impl Polytope for crate::shape::ConvexPolyhedron {
+    fn vertices(&self) -> &[Point] {
+        crate::shape::ConvexPolyhedron::vertices(self)
+    }
+    fn num_faces(&self) -> usize {
+        crate::shape::ConvexPolyhedron::num_faces(self)
+    }
+    fn face_normal(&self, i: usize) -> Vector {
+        *crate::shape::ConvexPolyhedron::face_normal(self, i)
+    }
+    fn face_vertices(&self, i: usize) -> &[u32] {
+        crate::shape::ConvexPolyhedron::face_vertices(self, i)
+    }
+    fn edges(&self) -> &[[u32; 2]] {
+        crate::shape::ConvexPolyhedron::edges(self)
+    }
+    fn bounding_radius(&self) -> Real {
+        crate::shape::ConvexPolyhedron::bounding_radius(self)
+    }
+    fn length_scale(&self) -> Real {
+        crate::shape::ConvexPolyhedron::length_scale(self)
+    }
 }
 
 fn max_dot(pts: &[Vector], n: &Vector) -> Real {
@@ -186,7 +212,7 @@ pub fn sat_polytopes<A: Polytope + ?Sized, B: Polytope + ?Sized>(
     let pos12 = pos1.inv_mul(pos2);
     let va: Vec<Vector> = a.vertices().iter().map(|p| p.coords).collect();
     let vb: Vec<Vector> = b.vertices().iter().map(|p| (pos12 * p).coords).collect();
-    let scale = a.bounding_radius().max(b.bounding_radius());
+    let scale = a.length_scale().max(b.length_scale());
     let touch = tol.touching * scale;
     let (s, n) = best_axis(a, b, &va, &vb, &pos12.rotation);
     let to_world = |n1: Vector, c1: Vector, c2: Vector, kind, depth, distance| {

@@ -158,6 +158,9 @@ impl Polytope for TestPolytope {
     fn bounding_radius(&self) -> Real {
         self.radius
     }
+    fn length_scale(&self) -> Real {
+        2.0 * self.radius
+    }
 }
 
 /// A uniformly random rotation (Shoemake's method).
