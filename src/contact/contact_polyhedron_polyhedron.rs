@@ -151,7 +151,10 @@ fn query_inner<A: Polytope + ?Sized, B: Polytope + ?Sized>(
                 EpaOutcome::Degenerate(_why) => {
                     #[cfg(test)]
                     if std::env::var("POLYDEM_DEBUG_FALLBACK").is_ok() {
-                        eprintln!("epa degenerate: {_why:?} after {} iterations", er.iterations);
+                        eprintln!(
+                            "epa degenerate: {_why:?} after {} iterations",
+                            er.iterations
+                        );
                     }
                     fallback(SolverStatus::FallbackAfterDegenerate)
                 }
@@ -217,7 +220,14 @@ pub fn intersect_polytopes_cached<A: Polytope + ?Sized, B: Polytope + ?Sized>(
         GjkOutcome::Contact => true,
         GjkOutcome::MaxIterations => {
             counters.fallback_max_iterations += 1;
-            let g = sat_polytopes(pos1, a, pos2, b, tol, SolverStatus::FallbackAfterMaxIterations);
+            let g = sat_polytopes(
+                pos1,
+                a,
+                pos2,
+                b,
+                tol,
+                SolverStatus::FallbackAfterMaxIterations,
+            );
             g.kind != ContactKind::Separated
         }
     }
@@ -225,7 +235,12 @@ pub fn intersect_polytopes_cached<A: Polytope + ?Sized, B: Polytope + ?Sized>(
 
 /// Contact query between two convex polyhedra with a fresh cache, fresh scratch, default tolerances and no
 /// counters: the convenience form (CLI, tests). The answer is the same as the hot path's.
-pub fn query_polyhedra(pos1: &Pose, a: &ConvexPolyhedron, pos2: &Pose, b: &ConvexPolyhedron) -> ContactGeometry {
+pub fn query_polyhedra(
+    pos1: &Pose,
+    a: &ConvexPolyhedron,
+    pos2: &Pose,
+    b: &ConvexPolyhedron,
+) -> ContactGeometry {
     let mut cache = PairCache::default();
     let mut counters = QueryCounters::default();
     EPA_SCRATCH.with(|s| {
@@ -257,7 +272,16 @@ pub fn query_polyhedra_cached(
     scratch: &mut EpaScratch,
     counters: &mut QueryCounters,
 ) -> ContactGeometry {
-    query_polytopes_cached(pos1, a, pos2, b, &ContactTolerances::default(), cache, scratch, counters)
+    query_polytopes_cached(
+        pos1,
+        a,
+        pos2,
+        b,
+        &ContactTolerances::default(),
+        cache,
+        scratch,
+        counters,
+    )
 }
 
 /// [`query_polyhedra_cached`] with explicit tolerances (for tolerance sweeps).
@@ -284,10 +308,30 @@ pub fn intersect_polyhedra_cached(
     cache: &mut PairCache,
     counters: &mut QueryCounters,
 ) -> bool {
-    intersect_polytopes_cached(pos1, a, pos2, b, &ContactTolerances::default(), cache, counters)
+    intersect_polytopes_cached(
+        pos1,
+        a,
+        pos2,
+        b,
+        &ContactTolerances::default(),
+        cache,
+        counters,
+    )
 }
 
 /// The exact SAT answer for two convex polyhedra (the oracle; status `Exact`). Slow: O(E_A E_B V).
-pub fn sat_polyhedra(pos1: &Pose, a: &ConvexPolyhedron, pos2: &Pose, b: &ConvexPolyhedron) -> ContactGeometry {
-    sat_polytopes(pos1, a, pos2, b, &ContactTolerances::default(), SolverStatus::Exact)
+pub fn sat_polyhedra(
+    pos1: &Pose,
+    a: &ConvexPolyhedron,
+    pos2: &Pose,
+    b: &ConvexPolyhedron,
+) -> ContactGeometry {
+    sat_polytopes(
+        pos1,
+        a,
+        pos2,
+        b,
+        &ContactTolerances::default(),
+        SolverStatus::Exact,
+    )
 }

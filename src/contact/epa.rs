@@ -192,7 +192,9 @@ impl EpaScratch {
                 }
             }
         }
-        self.faces.iter().all(|f| f.adj.iter().all(|&a| a != u32::MAX))
+        self.faces
+            .iter()
+            .all(|f| f.adj.iter().all(|&a| a != u32::MAX))
     }
 
     fn silhouette(&mut self, f: u32, edge: u8, w: &Vector, vis_eps: Real) {
@@ -249,7 +251,11 @@ pub fn epa<A: SupportMap + ?Sized, B: SupportMap + ?Sized>(
         // supports along the plane's two normals leave it, since A ⊖ B has volume.
         if let Some((i0, i1, i2)) = spread_triangle(&scratch.verts) {
             if spread_tetrahedron(&scratch.verts).is_none() {
-                let (p0, p1, p2) = (scratch.verts[i0].w, scratch.verts[i1].w, scratch.verts[i2].w);
+                let (p0, p1, p2) = (
+                    scratch.verts[i0].w,
+                    scratch.verts[i1].w,
+                    scratch.verts[i2].w,
+                );
                 let nrm = (p1 - p0).cross(&(p2 - p0));
                 let nrm = nrm / nrm.norm();
                 let up = pair.support(&nrm);
@@ -518,4 +524,3 @@ fn symmetric(pa: Vector, pb: Vector, n: Vector, h: Real) -> EpaOutcome {
         point_b: mid - half,
     }
 }
-

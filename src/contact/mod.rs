@@ -8,7 +8,11 @@
 //! fallback), [`features`] (closest points of small features), one file per shape pair, [`counters`],
 //! [`tolerances`].
 
+pub mod contact_polyhedron_plane;
 pub mod contact_polyhedron_polyhedron;
+pub mod contact_sphere_plane;
+pub mod contact_sphere_polyhedron;
+pub mod contact_sphere_sphere;
 pub mod counters;
 pub mod epa;
 pub mod features;
@@ -21,14 +25,18 @@ pub mod tolerances;
 #[cfg(test)]
 pub(crate) mod testing;
 #[cfg(test)]
-mod tests_oracle;
-#[cfg(test)]
 mod tests_degenerate;
+#[cfg(test)]
+mod tests_oracle;
 
+pub use contact_polyhedron_plane::contact_plane_polytope;
 pub use contact_polyhedron_polyhedron::{
-    intersect_polyhedra_cached, intersect_polytopes_cached, query_polyhedra, query_polyhedra_cached,
-    query_polyhedra_with, query_polytopes_cached, sat_polyhedra, PairCache,
+    intersect_polyhedra_cached, intersect_polytopes_cached, query_polyhedra,
+    query_polyhedra_cached, query_polyhedra_with, query_polytopes_cached, sat_polyhedra, PairCache,
 };
+pub use contact_sphere_plane::contact_plane_sphere;
+pub use contact_sphere_polyhedron::contact_polytope_sphere;
+pub use contact_sphere_sphere::contact_sphere_sphere;
 pub use counters::QueryCounters;
 pub use epa::EpaScratch;
 pub use geometry::{ContactGeometry, ContactKind, SolverStatus};

@@ -26,7 +26,7 @@
 //! Cost: O(F + E_A E_B) support evaluations of O(V) each, plus O(V T + E²) for the distance: fine as an oracle
 //! and as a rare fallback, not a hot path. It allocates.
 
-use super::features::{closest_point_sets, closest_on_triangle, closest_segments};
+use super::features::{closest_on_triangle, closest_point_sets, closest_segments};
 use super::tolerances::ContactTolerances;
 use super::{ContactGeometry, ContactKind, SolverStatus};
 use crate::math::{Point, Pose, Real, Vector};
@@ -38,6 +38,8 @@ pub trait Polytope: SupportMap {
     fn num_faces(&self) -> usize;
     /// Outward unit normal of face `i`.
     fn face_normal(&self, i: usize) -> Vector;
+    /// Plane offset of face `i`: the face lies in {x : normal·x = offset}.
+    fn face_offset(&self, i: usize) -> Real;
     /// Vertex indices of face `i`, in order around the face (a convex polygon).
     fn face_vertices(&self, i: usize) -> &[u32];
     /// Each edge once, as a pair of vertex indices.
@@ -57,6 +59,9 @@ impl Polytope for crate::shape::ConvexPolyhedron {
     }
     fn face_normal(&self, i: usize) -> Vector {
         *crate::shape::ConvexPolyhedron::face_normal(self, i)
+    }
+    fn face_offset(&self, i: usize) -> Real {
+        crate::shape::ConvexPolyhedron::face_offset(self, i)
     }
     fn face_vertices(&self, i: usize) -> &[u32] {
         crate::shape::ConvexPolyhedron::face_vertices(self, i)
@@ -154,7 +159,11 @@ fn exact_distance<A: Polytope + ?Sized, B: Polytope + ?Sized>(
     for fi in 0..b.num_faces() {
         let fv = b.face_vertices(fi);
         for k in 1..fv.len().saturating_sub(1) {
-            let (t0, t1, t2) = (vb[fv[0] as usize], vb[fv[k] as usize], vb[fv[k + 1] as usize]);
+            let (t0, t1, t2) = (
+                vb[fv[0] as usize],
+                vb[fv[k] as usize],
+                vb[fv[k + 1] as usize],
+            );
             for x in va {
                 consider(*x, closest_on_triangle(x, &t0, &t1, &t2));
             }
@@ -163,7 +172,11 @@ fn exact_distance<A: Polytope + ?Sized, B: Polytope + ?Sized>(
     for fi in 0..a.num_faces() {
         let fv = a.face_vertices(fi);
         for k in 1..fv.len().saturating_sub(1) {
-            let (t0, t1, t2) = (va[fv[0] as usize], va[fv[k] as usize], va[fv[k + 1] as usize]);
+            let (t0, t1, t2) = (
+                va[fv[0] as usize],
+                va[fv[k] as usize],
+                va[fv[k + 1] as usize],
+            );
             for y in vb {
                 consider(closest_on_triangle(y, &t0, &t1, &t2), *y);
             }
@@ -184,11 +197,21 @@ fn exact_distance<A: Polytope + ?Sized, B: Polytope + ?Sized>(
 }
 
 /// Contact points along the axis `n` with overlap `s` (frame 1): c1 on A, c2 on B, c1 − c2 = s n.
-fn points_along(va: &[Vector], vb: &[Vector], n: &Vector, s: Real, scale: Real) -> (Vector, Vector) {
+fn points_along(
+    va: &[Vector],
+    vb: &[Vector],
+    n: &Vector,
+    s: Real,
+    scale: Real,
+) -> (Vector, Vector) {
     let eps = 1e-12 * scale;
     let ha = max_dot(va, n);
     let hb = max_dot(vb, &-n);
-    let fa: Vec<Vector> = va.iter().filter(|p| n.dot(p) >= ha - eps).copied().collect();
+    let fa: Vec<Vector> = va
+        .iter()
+        .filter(|p| n.dot(p) >= ha - eps)
+        .copied()
+        .collect();
     let fb: Vec<Vector> = vb
         .iter()
         .filter(|p| -n.dot(p) >= hb - eps)
@@ -238,7 +261,11 @@ pub fn sat_polytopes<A: Polytope + ?Sized, B: Polytope + ?Sized>(
         // The best axis is exact when it realises the distance (facet or edge–edge closest features); it is
         // then better conditioned than the witness difference.
         let n_w = (y - x) / d;
-        let n1 = if (-s - d).abs() <= 1e-12 * scale { n } else { n_w };
+        let n1 = if (-s - d).abs() <= 1e-12 * scale {
+            n
+        } else {
+            n_w
+        };
         let mid = (x + y) * 0.5;
         let half = n1 * (0.5 * d);
         return to_world(n1, mid - half, mid + half, ContactKind::Separated, 0.0, d);

@@ -18,7 +18,8 @@ pub struct TestPolytope {
 
 impl TestPolytope {
     pub fn from_faces(verts: Vec<Point>, faces: Vec<Vec<u32>>) -> Self {
-        let centroid = verts.iter().fold(Vector::zeros(), |a, p| a + p.coords) / verts.len() as Real;
+        let centroid =
+            verts.iter().fold(Vector::zeros(), |a, p| a + p.coords) / verts.len() as Real;
         let mut normals = Vec::new();
         let mut faces_out = Vec::new();
         for f in faces {
@@ -80,47 +81,6 @@ impl TestPolytope {
             vec![vec![0, 1, 2], vec![0, 1, 3], vec![0, 2, 3], vec![1, 2, 3]],
         )
     }
-
-    /// Brute-force hull of points in general position (triangular faces), centred at the vertex mean.
-    pub fn hull(points: &[Point]) -> Self {
-        let c = points.iter().fold(Vector::zeros(), |a, p| a + p.coords) / points.len() as Real;
-        let pts: Vec<Vector> = points.iter().map(|p| p.coords - c).collect();
-        let n = pts.len();
-        let mut faces = Vec::new();
-        for i in 0..n {
-            for j in i + 1..n {
-                for k in j + 1..n {
-                    let nrm = (pts[j] - pts[i]).cross(&(pts[k] - pts[i]));
-                    let o = nrm.dot(&pts[i]);
-                    let (mut pos, mut neg) = (false, false);
-                    for (l, p) in pts.iter().enumerate() {
-                        if l == i || l == j || l == k {
-                            continue;
-                        }
-                        let s = nrm.dot(p) - o;
-                        pos |= s > 0.0;
-                        neg |= s < 0.0;
-                    }
-                    if !(pos && neg) {
-                        faces.push(vec![i as u32, j as u32, k as u32]);
-                    }
-                }
-            }
-        }
-        // Keep only vertices that appear in faces.
-        let mut used = vec![u32::MAX; n];
-        let mut verts = Vec::new();
-        for f in &mut faces {
-            for v in f.iter_mut() {
-                if used[*v as usize] == u32::MAX {
-                    used[*v as usize] = verts.len() as u32;
-                    verts.push(Point::from(pts[*v as usize]));
-                }
-                *v = used[*v as usize];
-            }
-        }
-        Self::from_faces(verts, faces)
-    }
 }
 
 impl SupportMap for TestPolytope {
@@ -148,6 +108,9 @@ impl Polytope for TestPolytope {
     }
     fn face_normal(&self, i: usize) -> Vector {
         self.normals[i]
+    }
+    fn face_offset(&self, i: usize) -> Real {
+        self.normals[i].dot(&self.verts[self.faces[i][0] as usize].coords)
     }
     fn face_vertices(&self, i: usize) -> &[u32] {
         &self.faces[i]

@@ -38,22 +38,60 @@ fn cases(size: Real, g: &Pose, tag: &str) -> Vec<Case> {
     for &d in &overlaps {
         for (sx, sy) in [(0.0, 0.0), (0.3, 0.1), (1.0, 0.0), (1.0, 1.0), (2.0, 0.0)] {
             let p2 = at(sx * h.x, sy * h.y, 2.0 * h.z - d * size);
-            out.push(place(format!("{tag} stacked boxes d={d} shift=({sx},{sy})"), &bx, id, &bx, p2, g));
+            out.push(place(
+                format!("{tag} stacked boxes d={d} shift=({sx},{sy})"),
+                &bx,
+                id,
+                &bx,
+                p2,
+                g,
+            ));
         }
     }
     // A cube on a cube: ties between the face normal and other directions.
     let cube = TestPolytope::cuboid(Vector::repeat(size));
     for &d in &overlaps {
-        out.push(place(format!("{tag} stacked cubes d={d}"), &cube, id, &cube, at(0.0, 0.0, (2.0 - d) * size), g));
+        out.push(place(
+            format!("{tag} stacked cubes d={d}"),
+            &cube,
+            id,
+            &cube,
+            at(0.0, 0.0, (2.0 - d) * size),
+            g,
+        ));
     }
     // 2. Concentric shapes: identical cubes (six tied optimal axes), identical boxes, nested boxes,
     // identical and rotated tetrahedra.
-    out.push(place(format!("{tag} concentric cubes"), &cube, id, &cube, id, g));
-    out.push(place(format!("{tag} concentric boxes"), &bx, id, &bx, id, g));
+    out.push(place(
+        format!("{tag} concentric cubes"),
+        &cube,
+        id,
+        &cube,
+        id,
+        g,
+    ));
+    out.push(place(
+        format!("{tag} concentric boxes"),
+        &bx,
+        id,
+        &bx,
+        id,
+        g,
+    ));
     let small = TestPolytope::cuboid(Vector::new(0.2, 0.3, 0.1) * size);
     out.push(place(format!("{tag} nested boxes"), &bx, id, &small, id, g));
-    let rot = Pose::from_parts(Vector::zeros().into(), Rotation::from_euler_angles(0.3, 0.2, 0.1));
-    out.push(place(format!("{tag} concentric rotated boxes"), &bx, id, &bx, rot, g));
+    let rot = Pose::from_parts(
+        Vector::zeros().into(),
+        Rotation::from_euler_angles(0.3, 0.2, 0.1),
+    );
+    out.push(place(
+        format!("{tag} concentric rotated boxes"),
+        &bx,
+        id,
+        &bx,
+        rot,
+        g,
+    ));
     let mut rng = ChaCha8Rng::seed_from_u64(7);
     let reg = TestPolytope::tetrahedron([
         Point::new(1.0, 1.0, 1.0) * size,
@@ -61,17 +99,55 @@ fn cases(size: Real, g: &Pose, tag: &str) -> Vec<Case> {
         Point::new(-1.0, 1.0, -1.0) * size,
         Point::new(-1.0, -1.0, 1.0) * size,
     ]);
-    out.push(place(format!("{tag} concentric regular tetrahedra"), &reg, id, &reg, id, g));
-    let flip = Pose::from_parts(Vector::zeros().into(), Rotation::from_euler_angles(0.0, 0.0, std::f64::consts::FRAC_PI_2));
-    out.push(place(format!("{tag} concentric dual tetrahedra"), &reg, id, &reg, flip, g));
+    out.push(place(
+        format!("{tag} concentric regular tetrahedra"),
+        &reg,
+        id,
+        &reg,
+        id,
+        g,
+    ));
+    let flip = Pose::from_parts(
+        Vector::zeros().into(),
+        Rotation::from_euler_angles(0.0, 0.0, std::f64::consts::FRAC_PI_2),
+    );
+    out.push(place(
+        format!("{tag} concentric dual tetrahedra"),
+        &reg,
+        id,
+        &reg,
+        flip,
+        g,
+    ));
     for k in 0..4 {
         let t = random_tetrahedron(&mut rng, size);
-        out.push(place(format!("{tag} concentric tetrahedra {k}"), &t, id, &t, id, g));
+        out.push(place(
+            format!("{tag} concentric tetrahedra {k}"),
+            &t,
+            id,
+            &t,
+            id,
+            g,
+        ));
         // 3. Same-orientation tetrahedra, translated along a face normal, an edge and a vertex direction.
-        for (j, dir) in [Vector::x(), Vector::new(1.0, 1.0, 0.0), Vector::new(1.0, 1.0, 1.0)].iter().enumerate() {
+        for (j, dir) in [
+            Vector::x(),
+            Vector::new(1.0, 1.0, 0.0),
+            Vector::new(1.0, 1.0, 1.0),
+        ]
+        .iter()
+        .enumerate()
+        {
             for &f in &[0.0, 0.5, 1.0] {
                 let off = dir.normalize() * f * size;
-                out.push(place(format!("{tag} same-orientation tetrahedra {k} dir {j} f={f}"), &t, id, &t, at(off.x, off.y, off.z), g));
+                out.push(place(
+                    format!("{tag} same-orientation tetrahedra {k} dir {j} f={f}"),
+                    &t,
+                    id,
+                    &t,
+                    at(off.x, off.y, off.z),
+                    g,
+                ));
             }
         }
     }
@@ -84,16 +160,35 @@ fn cases(size: Real, g: &Pose, tag: &str) -> Vec<Case> {
         for sx in [0.0, 0.5, 2.0] {
             let p1 = Pose::from_parts(Vector::zeros().into(), r45);
             let p2 = Pose::from_parts(Vector::new(sx * h.x, 0.0, 2.0 * top - d * size).into(), r45);
-            out.push(place(format!("{tag} parallel edges d={d} sx={sx}"), &bx, p1, &bx, p2, g));
+            out.push(place(
+                format!("{tag} parallel edges d={d} sx={sx}"),
+                &bx,
+                p1,
+                &bx,
+                p2,
+                g,
+            ));
         }
     }
     // 5. Vertex on vertex: cube diagonals along z, apex to apex.
-    let diag = Rotation::rotation_between(&Vector::new(1.0, 1.0, 1.0), &Vector::z()).expect("non-opposite");
-    let diag_down = Rotation::rotation_between(&Vector::new(1.0, 1.0, 1.0), &-Vector::z()).expect("non-opposite");
+    let diag = Rotation::rotation_between(&Vector::new(1.0, 1.0, 1.0), &Vector::z())
+        .expect("non-opposite");
+    let diag_down = Rotation::rotation_between(&Vector::new(1.0, 1.0, 1.0), &-Vector::z())
+        .expect("non-opposite");
     for &d in &overlaps {
         let p1 = Pose::from_parts(Vector::zeros().into(), diag);
-        let p2 = Pose::from_parts(Vector::new(0.0, 0.0, (2.0 * 3f64.sqrt() - d) * size).into(), diag_down);
-        out.push(place(format!("{tag} vertex on vertex d={d}"), &cube, p1, &cube, p2, g));
+        let p2 = Pose::from_parts(
+            Vector::new(0.0, 0.0, (2.0 * 3f64.sqrt() - d) * size).into(),
+            diag_down,
+        );
+        out.push(place(
+            format!("{tag} vertex on vertex d={d}"),
+            &cube,
+            p1,
+            &cube,
+            p2,
+            g,
+        ));
     }
     // 6. A face resting exactly on a face: a tetrahedron with a face in z = 0 on a box's top face.
     let base = TestPolytope::tetrahedron([
@@ -102,11 +197,22 @@ fn cases(size: Real, g: &Pose, tag: &str) -> Vec<Case> {
         Point::new(0.0, size, 0.0),
         Point::new(0.2 * size, 0.3 * size, 0.8 * size),
     ]);
-    let zmin = base.verts.iter().map(|p| p.z).fold(Real::INFINITY, Real::min);
+    let zmin = base
+        .verts
+        .iter()
+        .map(|p| p.z)
+        .fold(Real::INFINITY, Real::min);
     for &d in &overlaps {
         for sx in [0.0, 0.4, 0.9] {
             let p2 = at(sx * h.x, 0.1 * h.y, h.z - zmin - d * size);
-            out.push(place(format!("{tag} face on face d={d} sx={sx}"), &bx, id, &base, p2, g));
+            out.push(place(
+                format!("{tag} face on face d={d} sx={sx}"),
+                &bx,
+                id,
+                &base,
+                p2,
+                g,
+            ));
         }
     }
     out
@@ -121,7 +227,10 @@ fn degenerate_set_matches_sat() {
         let mut globals = vec![("aligned".to_string(), Pose::identity())];
         for k in 0..3 {
             let t = Vector::new(0.3, -1.2, 2.5) * size * (k as Real);
-            globals.push((format!("rotated{k}"), Pose::from_parts(t.into(), random_rotation(&mut rng))));
+            globals.push((
+                format!("rotated{k}"),
+                Pose::from_parts(t.into(), random_rotation(&mut rng)),
+            ));
         }
         for (tag, g) in &globals {
             for c in cases(size, g, &format!("size {size:e} {tag}")) {
@@ -137,6 +246,11 @@ fn degenerate_set_matches_sat() {
         "{} of {} degenerate pairs failed; first ones:\n{}",
         failures.len(),
         stats.pairs,
-        failures.iter().take(4).cloned().collect::<Vec<_>>().join("\n\n")
+        failures
+            .iter()
+            .take(4)
+            .cloned()
+            .collect::<Vec<_>>()
+            .join("\n\n")
     );
 }

@@ -5,9 +5,9 @@
 //! c1 and c2 on the surfaces of A and B within the same tolerance; c1 − c2 = δ n (c2 − c1 = d n when apart).
 
 use super::testing::{random_pose, random_rotation, random_unit, TestPolytope};
-use crate::shape::ConvexPolyhedron;
 use super::*;
 use crate::math::{Point, Pose, Real, Vector};
+use crate::shape::ConvexPolyhedron;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
@@ -24,9 +24,23 @@ pub(crate) struct Stats {
     pub max_surface_err: Real,
 }
 
-fn overlap_along_world<A: Polytope, B: Polytope>(pos1: &Pose, a: &A, pos2: &Pose, b: &B, n: &Vector) -> Real {
-    let ha = a.vertices().iter().map(|p| n.dot(&(pos1 * p).coords)).fold(Real::NEG_INFINITY, Real::max);
-    let hb = b.vertices().iter().map(|p| -n.dot(&(pos2 * p).coords)).fold(Real::NEG_INFINITY, Real::max);
+fn overlap_along_world<A: Polytope, B: Polytope>(
+    pos1: &Pose,
+    a: &A,
+    pos2: &Pose,
+    b: &B,
+    n: &Vector,
+) -> Real {
+    let ha = a
+        .vertices()
+        .iter()
+        .map(|p| n.dot(&(pos1 * p).coords))
+        .fold(Real::NEG_INFINITY, Real::max);
+    let hb = b
+        .vertices()
+        .iter()
+        .map(|p| -n.dot(&(pos2 * p).coords))
+        .fold(Real::NEG_INFINITY, Real::max);
     ha + hb
 }
 
@@ -34,7 +48,10 @@ fn overlap_along_world<A: Polytope, B: Polytope>(pos1: &Pose, a: &A, pos2: &Pose
 fn surface_distance<P: Polytope>(pos: &Pose, p: &P, x: &Point) -> Real {
     let y = pos.inverse_transform_point(x).coords;
     (0..p.num_faces())
-        .map(|i| p.face_normal(i).dot(&(y - p.vertices()[p.face_vertices(i)[0] as usize].coords)))
+        .map(|i| {
+            p.face_normal(i)
+                .dot(&(y - p.vertices()[p.face_vertices(i)[0] as usize].coords))
+        })
         .fold(Real::NEG_INFINITY, Real::max)
 }
 
@@ -51,9 +68,19 @@ pub(crate) fn check_pair<A: Polytope, B: Polytope>(
     let mut cache = PairCache::default();
     let mut scratch = EpaScratch::default();
     let mut counters = QueryCounters::default();
-    let g = query_polytopes_cached(pos1, a, pos2, b, &tol, &mut cache, &mut scratch, &mut counters);
+    let g = query_polytopes_cached(
+        pos1,
+        a,
+        pos2,
+        b,
+        &tol,
+        &mut cache,
+        &mut scratch,
+        &mut counters,
+    );
     let scale = a.bounding_radius().max(b.bounding_radius());
-    let desc = || format!("{ctx}: pos1 = {pos1:?}, pos2 = {pos2:?}\n ours = {g:?}\n sat = {oracle:?}");
+    let desc =
+        || format!("{ctx}: pos1 = {pos1:?}, pos2 = {pos2:?}\n ours = {g:?}\n sat = {oracle:?}");
     stats.pairs += 1;
     if g.status != SolverStatus::Converged {
         stats.fallbacks += 1;
@@ -62,7 +89,12 @@ pub(crate) fn check_pair<A: Polytope, B: Polytope>(
         }
     }
     if g.kind != oracle.kind {
-        return Err(format!("wrong kind: {:?} vs exact {:?}\n{}", g.kind, oracle.kind, desc()));
+        return Err(format!(
+            "wrong kind: {:?} vs exact {:?}\n{}",
+            g.kind,
+            oracle.kind,
+            desc()
+        ));
     }
     let (value, exact, signed_exact) = match g.kind {
         ContactKind::Overlap => {
@@ -88,13 +120,22 @@ pub(crate) fn check_pair<A: Polytope, B: Polytope>(
         ));
     }
     if (g.normal.norm() - 1.0).abs() > 1e-12 {
-        return Err(format!("normal not unit: |n| = {}\n{}", g.normal.norm(), desc()));
+        return Err(format!(
+            "normal not unit: |n| = {}\n{}",
+            g.normal.norm(),
+            desc()
+        ));
     }
     let along = overlap_along_world(pos1, a, pos2, b, &g.normal);
     let nerr = (along - signed_exact).abs();
     stats.max_normal_err = stats.max_normal_err.max(nerr / scale);
     let touch_allow = tol.touching * a.length_scale().max(b.length_scale());
-    let allowed_n = allowed + if g.kind == ContactKind::Touching { touch_allow } else { 0.0 };
+    let allowed_n = allowed
+        + if g.kind == ContactKind::Touching {
+            touch_allow
+        } else {
+            0.0
+        };
     if nerr > allowed_n {
         return Err(format!(
             "normal not optimal: overlap along it {along:e}, exact {signed_exact:e}, error {nerr:e} > {allowed_n:e}\n{}",
@@ -144,7 +185,9 @@ pub(crate) fn touching_offset<A: Polytope, B: Polytope>(
     u: &Vector,
 ) -> Real {
     let pos2 = Pose::from_parts(pos1.translation, *rot2);
-    let mut axes: Vec<Vector> = (0..a.num_faces()).map(|i| pos1.rotation * a.face_normal(i)).collect();
+    let mut axes: Vec<Vector> = (0..a.num_faces())
+        .map(|i| pos1.rotation * a.face_normal(i))
+        .collect();
     axes.extend((0..b.num_faces()).map(|i| -(pos2.rotation * b.face_normal(i))));
     let (va, vb) = (a.vertices(), b.vertices());
     for ea in a.edges() {
@@ -165,8 +208,13 @@ pub(crate) fn touching_offset<A: Polytope, B: Polytope>(
 
 pub(crate) fn random_tetrahedron(rng: &mut impl Rng, size: Real) -> TestPolytope {
     loop {
-        let p: [Point; 4] = std::array::from_fn(|_| Point::from(random_unit(rng) * size * rng.random_range(0.5..1.0)));
-        let vol = (p[1] - p[0]).dot(&(p[2] - p[0]).cross(&(p[3] - p[0]))).abs() / 6.0;
+        let p: [Point; 4] = std::array::from_fn(|_| {
+            Point::from(random_unit(rng) * size * rng.random_range(0.5..1.0))
+        });
+        let vol = (p[1] - p[0])
+            .dot(&(p[2] - p[0]).cross(&(p[3] - p[0])))
+            .abs()
+            / 6.0;
         if vol > 0.02 * size * size * size {
             return TestPolytope::tetrahedron(p);
         }
@@ -175,8 +223,14 @@ pub(crate) fn random_tetrahedron(rng: &mut impl Rng, size: Real) -> TestPolytope
 
 /// Points on an ellipsoid with semi-axes up to 3:1.
 fn ellipsoid_points(rng: &mut impl Rng, size: Real, n: usize) -> Vec<Point> {
-    let axes = Vector::new(1.0, rng.random_range(1.0 / 3.0..1.0), rng.random_range(1.0 / 3.0..1.0)) * size;
-    (0..n).map(|_| Point::from(random_unit(rng).component_mul(&axes))).collect()
+    let axes = Vector::new(
+        1.0,
+        rng.random_range(1.0 / 3.0..1.0),
+        rng.random_range(1.0 / 3.0..1.0),
+    ) * size;
+    (0..n)
+        .map(|_| Point::from(random_unit(rng).component_mul(&axes)))
+        .collect()
 }
 
 /// Vertices of a Voronoi-like cell: the cell of the origin among random neighbours at distances
@@ -188,7 +242,14 @@ pub(crate) fn voronoi_cell_points(rng: &mut impl Rng, size: Real, neighbours: us
             (p.normalize(), 0.5 * p.norm())
         })
         .collect();
-    for d in [Vector::x(), -Vector::x(), Vector::y(), -Vector::y(), Vector::z(), -Vector::z()] {
+    for d in [
+        Vector::x(),
+        -Vector::x(),
+        Vector::y(),
+        -Vector::y(),
+        Vector::z(),
+        -Vector::z(),
+    ] {
         planes.push((d, 1.5 * size));
     }
     let mut pts = Vec::new();
@@ -201,7 +262,9 @@ pub(crate) fn voronoi_cell_points(rng: &mut impl Rng, size: Real, neighbours: us
                     planes[j].0.transpose(),
                     planes[k].0.transpose(),
                 ]);
-                let Some(inv) = mat.try_inverse() else { continue };
+                let Some(inv) = mat.try_inverse() else {
+                    continue;
+                };
                 if mat.determinant().abs() < 1e-6 {
                     continue;
                 }
@@ -216,7 +279,16 @@ pub(crate) fn voronoi_cell_points(rng: &mut impl Rng, size: Real, neighbours: us
 }
 
 /// Shape classes of the random sets, all built by the production constructor.
-pub(crate) const CLASS_NAMES: [&str; 8] = ["tetrahedron", "box", "hull8", "hull16", "hull32", "hull64", "voronoi", "box-exact"];
+pub(crate) const CLASS_NAMES: [&str; 8] = [
+    "tetrahedron",
+    "box",
+    "hull8",
+    "hull16",
+    "hull32",
+    "hull64",
+    "voronoi",
+    "box-exact",
+];
 
 pub(crate) fn random_polyhedron(rng: &mut impl Rng, size: Real, class: usize) -> ConvexPolyhedron {
     let pts: Vec<Point> = match class {
@@ -228,7 +300,9 @@ pub(crate) fn random_polyhedron(rng: &mut impl Rng, size: Real, class: usize) ->
         5 => ellipsoid_points(rng, size, 64),
         _ => voronoi_cell_points(rng, size, 24),
     };
-    ConvexPolyhedron::from_points(&pts).expect("valid random shape").0
+    ConvexPolyhedron::from_points(&pts)
+        .expect("valid random shape")
+        .0
 }
 
 pub(crate) fn random_box(rng: &mut impl Rng, size: Real) -> TestPolytope {
@@ -261,7 +335,10 @@ fn random_pairs(seed: u64, count: usize, size: Real, classes: &[(usize, usize)])
             _ => t0 - x,
         };
         let pos2 = Pose::from_parts((pos1.translation.vector + u * t).into(), rot2);
-        let ctx = format!("seed {seed} pair {i} classes ({},{})", CLASS_NAMES[ca], CLASS_NAMES[cb]);
+        let ctx = format!(
+            "seed {seed} pair {i} classes ({},{})",
+            CLASS_NAMES[ca], CLASS_NAMES[cb]
+        );
         let ctx = format!("{ctx} size {size:e} mode {mode} offset {x:e}");
         if let Err(e) = check_pair(&ctx, &pos1, &a, &pos2, &b, &mut stats) {
             failures.push(e);
@@ -272,7 +349,12 @@ fn random_pairs(seed: u64, count: usize, size: Real, classes: &[(usize, usize)])
         "{} of {} pairs failed; first ones:\n{}",
         failures.len(),
         count,
-        failures.iter().take(3).cloned().collect::<Vec<_>>().join("\n\n")
+        failures
+            .iter()
+            .take(3)
+            .cloned()
+            .collect::<Vec<_>>()
+            .join("\n\n")
     );
     stats
 }
@@ -318,7 +400,10 @@ fn random_pairs_match_sat_at_kilometre_size() {
 #[test]
 #[ignore]
 fn sweep() {
-    let n: usize = std::env::var("POLYDEM_SWEEP").ok().and_then(|s| s.parse().ok()).unwrap_or(10_000);
+    let n: usize = std::env::var("POLYDEM_SWEEP")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(10_000);
     for (seed, size) in [(11u64, 1.0), (12, 1e-3), (13, 1e3)] {
         let s = random_pairs(seed, n, size, &CLASSES);
         println!("{size:e}: {s:?}");
