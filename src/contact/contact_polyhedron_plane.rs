@@ -92,7 +92,7 @@ mod tests {
         let bx = TestPolytope::cuboid(h);
         for scale in [1e-3, 1.0, 1e3] {
             let bxs = TestPolytope::cuboid(h * scale);
-            let pos2 = Pose::translation(2.0 * scale, -1.0 * scale, (0.25 - 1e-7) * scale);
+            let pos2 = Pose::translation(2.0 * scale, -scale, (0.25 - 1e-7) * scale);
             let g = contact_plane_polytope(&Pose::identity(), &Vector::z(), 0.0, &pos2, &bxs, &tol);
             assert_eq!(g.kind, ContactKind::Overlap, "{g:?}");
             assert!(
@@ -100,7 +100,7 @@ mod tests {
                 "depth {} scale {scale}",
                 g.depth
             );
-            let want = Point::new(2.0 * scale, -1.0 * scale, 0.0);
+            let want = Point::new(2.0 * scale, -scale, 0.0);
             assert!(
                 (g.point_a - want).norm() <= 1e-14 * scale,
                 "c1 {:?} want {want:?}",

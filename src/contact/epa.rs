@@ -128,7 +128,7 @@ fn face_plane(verts: &[SupportPoint], v: [u32; 3]) -> Option<(Vector, Real)> {
         ab.cross(&bc)
     };
     let nn = n.norm();
-    if !(nn > 0.0) || !nn.is_finite() {
+    if !nn.is_finite() || nn <= 0.0 {
         return None;
     }
     let n = n / nn;
@@ -161,7 +161,7 @@ impl EpaScratch {
         let e3 = w(idx[3]) - w(idx[0]);
         let vol = e1.dot(&e2.cross(&e3));
         let ref_vol = e1.norm() * e2.norm() * e3.norm();
-        if !(vol.abs() > 1e-9 * ref_vol) {
+        if vol.is_nan() || vol.abs() <= 1e-9 * ref_vol {
             return false;
         }
         let [p0, mut p1, mut p2, p3] = idx;
@@ -421,7 +421,8 @@ fn spread_triangle(pts: &[SupportPoint]) -> Option<(usize, usize, usize)> {
             .total_cmp(&d1.cross(&(pts[j].w - p0)).norm_squared())
     })?;
     let nrm = d1.cross(&(pts[i2].w - p0));
-    if !(nrm.norm_squared() > 1e-24 * d1.norm_squared() * d1.norm_squared()) {
+    let nn = nrm.norm_squared();
+    if nn.is_nan() || nn <= 1e-24 * d1.norm_squared() * d1.norm_squared() {
         return None;
     }
     Some((i0, i1, i2))
@@ -441,7 +442,8 @@ fn spread_tetrahedron(pts: &[SupportPoint]) -> Option<[u32; 4]> {
             .total_cmp(&nrm.dot(&(pts[j].w - p0)).abs())
     })?;
     let e3 = pts[i3].w - p0;
-    if !(nrm.dot(&e3).abs() > 1e-9 * e1.norm() * e2.norm() * e3.norm()) {
+    let vol = nrm.dot(&e3);
+    if vol.is_nan() || vol.abs() <= 1e-9 * e1.norm() * e2.norm() * e3.norm() {
         return None;
     }
     Some([i0 as u32, i1 as u32, i2 as u32, i3 as u32])

@@ -90,7 +90,7 @@ fn overlap_along(va: &[Vector], vb: &[Vector], n: &Vector) -> Real {
 pub(crate) fn edge_edge_axis(u: &Vector, v: &Vector) -> Option<Vector> {
     let w = v - u * u.dot(v);
     let s = w.norm();
-    if !(s > 1e-12) {
+    if s.is_nan() || s <= 1e-12 {
         return None;
     }
     let w = w / s;

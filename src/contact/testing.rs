@@ -75,7 +75,7 @@ impl TestPolytope {
     /// Tetrahedron with its centroid moved to the origin.
     pub fn tetrahedron(p: [Point; 4]) -> Self {
         let c = (p[0].coords + p[1].coords + p[2].coords + p[3].coords) / 4.0;
-        let verts = p.iter().map(|q| q - c).map(Point::from).collect();
+        let verts = p.iter().map(|q| q - c).collect();
         Self::from_faces(
             verts,
             vec![vec![0, 1, 2], vec![0, 1, 3], vec![0, 2, 3], vec![1, 2, 3]],
