@@ -15,6 +15,7 @@
 
 pub mod contact;
 pub mod dynamics;
+pub mod io;
 pub mod math;
 pub mod shape;
 pub mod special_functions;
