@@ -2,7 +2,8 @@
 """Turn LIGGGHTS' fix print file and log into out/<variant>.csv with a provenance header.
 
 The contact force is the total force on the projectile minus its weight (LIGGGHTS' fix
-gravity adds m g to f before fix print reads it). Numbers are otherwise copied as printed.
+gravity adds m g to f before fix print reads it). Numbers are rounded to 9 significant
+digits (as in the YADE output); nothing else is changed.
 Usage: post.py VARIANT PRINTFILE LOGFILE MASS Z0 PROVENANCE_FILE OUT.csv
 """
 import os
@@ -54,11 +55,12 @@ def main(variant, printfile, logfile, mass, z0, prov, out):
         for h in header:
             f.write("# " + h + "\n")
         f.write("t,step,x,y,z,vx,vy,vz,fx,fy,fz,contacts\n")
-        f.write("0,0,%s,%s,%s,0,0,%r,0,0,0,0\n" % (repr(0.5 * sc["bed"]["box_x"]), repr(0.5 * sc["bed"]["box_y"]), z0, -var["speed"]))
+        f.write("0,0,%.9g,%.9g,%.9g,0,0,%.9g,0,0,0,0\n" % (0.5 * sc["bed"]["box_x"], 0.5 * sc["bed"]["box_y"], float(z0), -var["speed"]))
         for r in rows:
             t, st, x, y, z, vx, vy, vz, fx, fy, fz, nc = r
-            f.write("%s,%s,%s,%s,%s,%s,%s,%s,%s,%s,%.9g,%d\n" % (
-                t, st, x, y, z, vx, vy, vz, fx, fy, float(fz) + mass * g, round(float(nc))))
+            f.write("%.9g,%d,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%d\n" % (
+                float(t), int(st), float(x), float(y), float(z), float(vx), float(vy), float(vz),
+                float(fx), float(fy), float(fz) + mass * g, round(float(nc))))
     print("LIGGGHTS %s: %d steps in %.2f s wall, %.4g particle-steps/s, final z %s vz %s" % (
         variant, steps, wall, nparticles * steps / wall, rows[-1][4], rows[-1][7]))
 

@@ -19,10 +19,11 @@ for V in $VARIANTS; do
   LAW=$(python3 -c "import json;print(json.load(open('$BED/scene.json'))['variants']['$V']['law'])")
   CMD="liggghts -in in.penetration $VARS -var lawfile in.law_$LAW -var datafile bed.data -var pid $PID -var outfile print.txt"
   START=$(date -u +%Y-%m-%dT%H:%M:%SZ)
+  LOAD=$(cut -d' ' -f1-3 /proc/loadavg)
   # shellcheck disable=SC2086
   (cd "$HERE" && nice -n 10 liggghts -in in.penetration $VARS -var lawfile "in.law_$LAW" \
       -var datafile "$WORK/bed.data" -var pid "$PID" -var outfile "$WORK/print.txt" \
-      -log "$WORK/log.liggghts" -echo none -screen none)
+      -log "$WORK/log.liggghts" -echo none -screen none) || { tail -5 "$WORK/log.liggghts"; exit 1; }
   {
     echo "sphere-bed penetration, variant $V (reference/sphere_bed/README.md)"
     echo "code: LIGGGHTS-PUBLIC $(dpkg-query -W -f='${Version}' liggghts) (Debian package liggghts), serial, 1 process"
@@ -32,7 +33,7 @@ for V in $VARIANTS; do
     echo "bed: bed_quick.csv, $((PID - 1)) spheres, velocities set to zero; walls of the bed material"
     echo "projectile: atom $PID, mass $MASS kg, start centre z0 = $Z0 m (= max(z+r) + gap + radius)"
     echo "date: $START"
-    echo "machine: $(nproc) cores, $CPU"
+    echo "machine: $(nproc) cores, $CPU; load average at start $LOAD (shared machine)"
     echo "particles: $PID"
   } > "$WORK/prov.txt"
   python3 "$HERE/post.py" "$V" "$WORK/print.txt" "$WORK/log.liggghts" "$MASS" "$Z0" "$WORK/prov.txt" "$HERE/out/$V.csv"

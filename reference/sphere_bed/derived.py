@@ -50,6 +50,33 @@ def hertz_damping_ratio(e):
     return math.sqrt(5.0 / 6.0) * log_beta(e)
 
 
+def hertz_restitution(b, steps=200000):
+    """Restitution actually produced by the Hertz law with damping ratio b.
+
+    Non-dimensional head-on impact (m* = 1, k = 1, impact speed 1; the result does not
+    depend on the speed): x'' = -x^1.5 - 2 b sqrt(1.5) x^0.25 x', force clamped at zero
+    (no attraction, as in both codes). RK4; the contact ends when the force vanishes.
+    """
+    def acc(x, v):
+        if x <= 0.0:
+            return 0.0
+        f = x ** 1.5 + 2.0 * b * math.sqrt(1.5) * x ** 0.25 * v
+        return -max(f, 0.0)
+
+    x, v = 0.0, 1.0
+    h = 4.0 / steps
+    for _ in range(steps):
+        k1x, k1v = v, acc(x, v)
+        k2x, k2v = v + 0.5 * h * k1v, acc(x + 0.5 * h * k1x, v + 0.5 * h * k1v)
+        k3x, k3v = v + 0.5 * h * k2v, acc(x + 0.5 * h * k2x, v + 0.5 * h * k2v)
+        k4x, k4v = v + h * k3v, acc(x + h * k3x, v + h * k3v)
+        x += h / 6.0 * (k1x + 2 * k2x + 2 * k3x + k4x)
+        v += h / 6.0 * (k1v + 2 * k2v + 2 * k3v + k4v)
+        if v < 0.0 and (x <= 0.0 or acc(x, v) == 0.0):
+            return -v
+    raise RuntimeError("contact did not end")
+
+
 def rayleigh_time(radius, mat):
     g = mat["young"] / (2 * (1 + mat["poisson"]))
     return math.pi * radius * math.sqrt(mat["density"] / g) / (0.1631 * mat["poisson"] + 0.8766)
@@ -135,6 +162,10 @@ def table(scene):
                  hertz_damping_ratio(scene["pairs"]["bed_bed"]["restitution"]), "-"))
     rows.append(("Hertz damping ratio b (bed-steel, e=%.2f)" % scene["pairs"]["bed_steel"]["restitution"],
                  hertz_damping_ratio(scene["pairs"]["bed_steel"]["restitution"]), "-"))
+    for key in ("bed_bed", "bed_steel"):
+        e = scene["pairs"][key]["restitution"]
+        rows.append(("restitution actually produced by the Hertz law for input e=%.2f" % e,
+                     hertz_restitution(hertz_damping_ratio(e)), "-"))
     rows.append(("linear k_n (all pairs)", lin["kn"], "N/m"))
     rows.append(("linear k_t (all pairs)", lin["kt"], "N/m"))
     rows.append(("linear c_n bed-bed and bed-wall", lin["cn_bb"], "N s/m"))

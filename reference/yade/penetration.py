@@ -99,6 +99,8 @@ O.dt = var["dt"]
 s0 = O.bodies[pid].state
 samples.append((0.0, 0, s0.pos[0], s0.pos[1], s0.pos[2], s0.vel[0], s0.vel[1], s0.vel[2], 0.0, 0.0, 0.0, 0))
 start = time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime())
+with open("/proc/loadavg") as f:
+    loadavg = " ".join(f.read().split()[:3])
 t0 = time.time()
 O.run(var["steps"], True)
 wall = time.time() - t0
@@ -127,7 +129,8 @@ header = [
     "projectile: radius %g m, mass %.9g kg, start centre z0 = %.9g m (= max(z+r) + gap + radius), vz0 = %g m/s" % (
         proj["radius"], m_proj, z0, -var["speed"]),
     "date: %s" % start,
-    "machine: %d cores, %s; python %s" % (os.cpu_count(), cpu, platform.python_version()),
+    "machine: %d cores, %s; python %s; load average at start %s (shared machine)" % (
+        os.cpu_count(), cpu, platform.python_version(), loadavg),
     "sampling: after every %d-th step; position and force at the end of the step, velocity at the half step (YADE leapfrog)" % var["sample_every"],
     "force: resultant contact force on the projectile (gravity excluded)",
     "particles: %d" % (n_bed + 1),
