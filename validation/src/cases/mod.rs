@@ -1,0 +1,9 @@
+//! The registry of cases. Adding a case: a module here implementing [`Case`], its data file
+//! `validation/cases/<name>.toml`, and one line in [`registry`].
+
+use crate::case::Case;
+
+/// Every case of the suite, in the order they run.
+pub fn registry() -> Vec<&'static dyn Case> {
+    vec![]
+}
