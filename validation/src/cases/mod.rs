@@ -3,7 +3,9 @@
 
 use crate::case::Case;
 
+pub mod precession;
+
 /// Every case of the suite, in the order they run.
 pub fn registry() -> Vec<&'static dyn Case> {
-    vec![]
+    vec![&precession::Precession]
 }

@@ -1,0 +1,7 @@
+//! Peer codes the suite compares against, behind adapters that speak polydem's types.
+//!
+//! - [`rapier`]: rapier3d-f64 0.36's rigid-body integrator on a single free body (precession case).
+//! - [`convert`]: every nalgebra ↔ glam conversion of the harness (one file, project rule).
+
+pub mod convert;
+pub mod rapier;
