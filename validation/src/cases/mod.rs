@@ -4,8 +4,12 @@
 use crate::case::Case;
 
 pub mod precession;
+pub mod single_contact_energy;
 
 /// Every case of the suite, in the order they run.
 pub fn registry() -> Vec<&'static dyn Case> {
-    vec![&precession::Precession]
+    vec![
+        &precession::Precession,
+        &single_contact_energy::SingleContactEnergy,
+    ]
 }
