@@ -1,0 +1,51 @@
+//! Every conversion between polydem's nalgebra types and the glam types of parry3d-f64 0.31 used by the
+//! harness, in one place.
+
+use parry3d_f64::math::{Pose as GlamPose, Rot3 as GlamRot, Vector as GlamVec};
+use polydem::math::{Point, Pose, Vector};
+
+/// nalgebra point → glam vector.
+pub fn point_to_glam(p: &Point) -> GlamVec {
+    GlamVec::new(p.x, p.y, p.z)
+}
+
+/// nalgebra vector → glam vector.
+pub fn vector_to_glam(v: &Vector) -> GlamVec {
+    GlamVec::new(v.x, v.y, v.z)
+}
+
+/// glam vector → nalgebra point.
+pub fn glam_to_point(v: GlamVec) -> Point {
+    Point::new(v.x, v.y, v.z)
+}
+
+/// glam vector → nalgebra vector.
+pub fn glam_to_vector(v: GlamVec) -> Vector {
+    Vector::new(v.x, v.y, v.z)
+}
+
+/// nalgebra isometry (unit quaternion + translation) → glam pose. Exact: the quaternion components and the
+/// translation are copied, no re-normalisation.
+pub fn pose_to_glam(p: &Pose) -> GlamPose {
+    let q = p.rotation.quaternion();
+    let rot = GlamRot::from_xyzw(q.i, q.j, q.k, q.w);
+    GlamPose::from_parts(vector_to_glam(&p.translation.vector), rot)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use polydem::math::Rotation;
+
+    #[test]
+    fn pose_conversion_maps_points_identically() {
+        let pose = Pose::from_parts(
+            nalgebra::Translation3::new(1.0, -2.0, 0.5),
+            Rotation::from_scaled_axis(Vector::new(0.3, -0.7, 1.1)),
+        );
+        let p = Point::new(0.25, 4.0, -3.0);
+        let a = pose * p;
+        let b = glam_to_point(pose_to_glam(&pose).transform_point(point_to_glam(&p)));
+        assert!((a - b).norm() < 1e-14, "nalgebra {a} vs glam {b}");
+    }
+}

@@ -1,0 +1,7 @@
+//! Peer codes the suite compares against, behind adapters that speak polydem's types.
+//!
+//! - [`parry`]: parry3d-f64 0.31 (GJK/EPA contact, intersection test, distance) on convex polyhedra.
+//! - [`convert`]: every nalgebra ↔ glam conversion of the harness (one file, project rule).
+
+pub mod convert;
+pub mod parry;
