@@ -3,7 +3,10 @@
 
 use crate::case::Case;
 
+pub mod contact;
+pub mod perf;
+
 /// Every case of the suite, in the order they run.
 pub fn registry() -> Vec<&'static dyn Case> {
-    vec![]
+    vec![&contact::Contact, &perf::Perf]
 }
