@@ -256,6 +256,10 @@ mod tests {
                 label: "ours".into(),
                 style: SeriesStyle::Points,
                 points: vec![(1e-9, 1e-17), (1e-3, 2e-16), (0.0, 1.0)],
+            }, Series {
+                label: "parry3d-f64".into(),
+                style: SeriesStyle::LinePoints,
+                points: vec![(1e-8, 1e-12), (1e-2, 3e-3)],
             }],
             caption: String::new(),
         };
@@ -271,5 +275,8 @@ mod tests {
             assert!(svg.contains(needle), "SVG lacks `{needle}`");
         }
         assert_eq!(plot.hidden_points(), vec![("ours".to_string(), 1)]);
+        // Left in the temp directory for a look: `rsvg-convert` it to PNG.
+        let path = std::env::temp_dir().join("polydem_plot_test.svg");
+        plot.write_svg(&path).unwrap();
     }
 }
