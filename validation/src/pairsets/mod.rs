@@ -109,12 +109,18 @@ pub fn random_pair(
             + poly_b.bounding_radius()
             + (pos1.translation.vector - pos2_base.translation.vector).norm()
             + size;
-        let coarse = |t: f64| {
-            let c = peer.contact(&pos1, &pos2_at(t), 4.0 * t_max).ok()??;
-            Some((c.signed_gap, c.normal))
+        // parry drives the bisections; where it gives no answer (it does near touching for large
+        // particles), and for the touching refinement, the exact oracle answers.
+        let gap = |t: f64, want_exact: bool| {
+            let pos2 = pos2_at(t);
+            if !want_exact {
+                if let Ok(Some(c)) = peer.contact(&pos1, &pos2, 4.0 * t_max) {
+                    return Some((c.signed_gap, c.normal));
+                }
+            }
+            exact(&pos1, &poly_a, &pos2, &poly_b)
         };
-        let refine = |t: f64| exact(&pos1, &poly_a, &pos2_at(t), &poly_b);
-        if let Some(t) = placement::place(coarse, refine, &u, t_max, intent) {
+        if let Some(t) = placement::place(gap, &u, t_max, intent) {
             let b = b_base.iter().map(|p| p + u * t).collect();
             return Ok(Pair { id: format!("{class}/s{si}/{index:05}"), class: class.clone(), size, intent, a, b });
         }

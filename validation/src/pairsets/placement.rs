@@ -35,16 +35,17 @@ impl Intent {
     }
 }
 
-/// Finds the translation t along `u` at which the pair realises `intent`. `coarse(t)` and `refine(t)`
-/// return the signed gap and the unit normal (A → B) at translation t; `t_max` separates the bounding
-/// spheres. Returns `None` when the draw cannot realise the intent (reject and redraw).
+/// Finds the translation t along `u` at which the pair realises `intent`. `gap(t, exact)` returns the signed
+/// gap and the unit normal (A → B) at translation t, from the coarse solver (`exact == false`) or the exact
+/// oracle (`exact == true`); `t_max` separates the bounding spheres. Returns `None` when the draw cannot
+/// realise the intent (reject and redraw).
 pub fn place(
-    mut coarse: impl FnMut(f64) -> Option<(f64, Vector)>,
-    mut refine: impl FnMut(f64) -> Option<(f64, Vector)>,
+    mut gap: impl FnMut(f64, bool) -> Option<(f64, Vector)>,
     u: &Vector,
     t_max: f64,
     intent: Intent,
 ) -> Option<f64> {
+    let mut coarse = |t: f64| gap(t, false);
     let g0 = coarse(0.0)?.0;
     if g0 >= 0.0 || coarse(t_max)?.0 <= 0.0 {
         return None;
@@ -72,7 +73,7 @@ pub fn place(
         Intent::Touching => {
             let mut t = t0;
             for _ in 0..6 {
-                let (g, n) = refine(t)?;
+                let (g, n) = gap(t, true)?;
                 let slope = n.dot(u);
                 if g == 0.0 || slope < 0.05 {
                     break;
@@ -109,14 +110,14 @@ mod tests {
     /// Two unit cubes (half-width 0.5), axis-aligned, B moved along x: g(t) = t − 1 exactly.
     #[test]
     fn places_cubes_at_the_intended_gap() {
-        let gap = |t: f64| Some((t - 1.0, Vector::x()));
+        let gap = |t: f64, _exact: bool| Some((t - 1.0, Vector::x()));
         let u = Vector::x();
-        let t = place(gap, gap, &u, 3.0, Intent::Touching).unwrap();
+        let t = place(gap, &u, 3.0, Intent::Touching).unwrap();
         assert!((t - 1.0).abs() < 1e-15, "touching at t = {t}, expected 1");
-        let t = place(gap, gap, &u, 3.0, Intent::Overlap(0.25)).unwrap();
+        let t = place(gap, &u, 3.0, Intent::Overlap(0.25)).unwrap();
         assert!((t - 0.75).abs() <= 0.25e-3, "overlap 0.25 at t = {t}, expected 0.75 ± 2.5e-4");
-        let t = place(gap, gap, &u, 3.0, Intent::Separated(1e-6)).unwrap();
+        let t = place(gap, &u, 3.0, Intent::Separated(1e-6)).unwrap();
         assert!((t - 1.0 - 1e-6).abs() <= 1e-9, "gap 1e-6 at t = {t}, expected 1 + 1e-6 ± 1e-9");
-        assert!(place(gap, gap, &u, 3.0, Intent::Overlap(1.5)).is_none(), "overlap deeper than g(0) must be rejected");
+        assert!(place(gap, &u, 3.0, Intent::Overlap(1.5)).is_none(), "overlap deeper than g(0) must be rejected");
     }
 }
