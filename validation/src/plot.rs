@@ -32,6 +32,16 @@ pub struct Series {
     pub points: Vec<(f64, f64)>,
 }
 
+/// Where the legend box goes.
+#[derive(Copy, Clone, Debug, PartialEq, Eq, Default)]
+pub enum Legend {
+    #[default]
+    UpperLeft,
+    UpperRight,
+    LowerLeft,
+    LowerRight,
+}
+
 /// A plot: title, axis labels (with units), axis scales and series.
 #[derive(Clone, Debug)]
 pub struct Plot {
@@ -45,6 +55,7 @@ pub struct Plot {
     pub series: Vec<Series>,
     /// Markdown text shown under the plot.
     pub caption: String,
+    pub legend: Legend,
 }
 
 const COLORS: [RGBColor; 8] = [
@@ -230,7 +241,12 @@ impl Plot {
                 .background_style(WHITE.mix(0.85))
                 .border_style(BLACK)
                 .label_font(("sans-serif", 14))
-                .position(SeriesLabelPosition::UpperLeft)
+                .position(match self.legend {
+                    Legend::UpperLeft => SeriesLabelPosition::UpperLeft,
+                    Legend::UpperRight => SeriesLabelPosition::UpperRight,
+                    Legend::LowerLeft => SeriesLabelPosition::LowerLeft,
+                    Legend::LowerRight => SeriesLabelPosition::LowerRight,
+                })
                 .draw()
                 .map_err(|e| e.to_string())?;
             root.present().map_err(|e| e.to_string())?;
@@ -262,6 +278,7 @@ mod tests {
                 points: vec![(1e-8, 1e-12), (1e-2, 3e-3)],
             }],
             caption: String::new(),
+            legend: Legend::UpperLeft,
         };
         let mut svg = String::new();
         plot.render(&mut svg).unwrap();

@@ -13,7 +13,7 @@ use crate::cases::contact::{random_set, timing};
 use crate::context::CaseContext;
 use crate::error::SuiteError;
 use crate::pairsets::{Intent, RandomSetSpec};
-use crate::plot::{Plot, Series, SeriesStyle};
+use crate::plot::{Legend, Plot, Series, SeriesStyle};
 use crate::provenance::Provenance;
 
 /// The case (registered in [`crate::cases::registry`]).
@@ -175,6 +175,7 @@ impl Case for Perf {
             y_log: true,
             series,
             caption: "One point per `cargo validate perf` run.".into(),
+            legend: Legend::UpperRight,
         })?;
         Ok(())
     }

@@ -20,7 +20,7 @@ use crate::case::{Case, CaseData, Profile, Target};
 use crate::context::CaseContext;
 use crate::error::SuiteError;
 use crate::pairsets::{self, degenerate::degenerate_set, Pair, RandomSetSpec};
-use crate::plot::{Plot, Series, SeriesStyle};
+use crate::plot::{Legend, Plot, Series, SeriesStyle};
 use eval::{build, evaluate, Built, Errors, Eval};
 use ours::{sat, Ours};
 
@@ -52,6 +52,8 @@ pub struct Params {
 const NAME: &str = "contact";
 /// Errors below this (relative to size) are drawn at this value on log axes.
 const PLOT_FLOOR: f64 = 1e-18;
+/// Ranks drawn per CDF line.
+const CDF_POINTS: usize = 400;
 
 fn case_err(msg: impl Into<String>) -> SuiteError {
     SuiteError::Case { case: NAME.into(), msg: msg.into() }
@@ -358,7 +360,7 @@ impl Case for Contact {
             .collect();
         ctx.table(
             Some("parry_failures"),
-            &["pair", "exact kind", "exact overlap /size", "parry kind", "parry gap err /size", "parry normal err /size", "ours kind", "ours gap err /size", "ours normal err /size"],
+            &["pair", "exact kind", "exact overlap /size (< 0: gap)", "parry kind", "parry gap err /size", "parry normal err /size", "ours kind", "ours gap err /size", "ours normal err /size"],
             &fail_rows,
         )?;
 
@@ -381,7 +383,7 @@ impl Case for Contact {
             .collect();
         ctx.table(
             Some("degenerate"),
-            &["pair", "exact kind", "exact overlap /size", "ours kind", "ours gap err /size", "ours worst err/tol", "parry kind", "parry gap err /size", "parry worst err/tol"],
+            &["pair", "exact kind", "exact overlap /size (< 0: gap)", "ours kind", "ours gap err /size", "ours worst err/tol", "parry kind", "parry gap err /size", "parry worst err/tol"],
             &deg_rows,
         )?;
 
@@ -427,17 +429,21 @@ impl Case for Contact {
             y_log: true,
             series: vec![scatter("ours (GJK/EPA)", &|e| e.ours.gap), scatter("parry3d-f64", &|e| e.parry.gap), tol_line],
             caption: format!("All sizes pooled. Errors below {PLOT_FLOOR:e} × size (including exact zeros) are drawn at {PLOT_FLOOR:e}."),
+            legend: Legend::UpperLeft,
         })?;
 
         ctx.section("Error distribution");
         let cdf = |label: &str, pick: &dyn Fn(&Eval) -> f64| {
             let s = sorted(evals.iter().map(|e| (pick(e) / e.size).max(PLOT_FLOOR)).collect());
-            let n = s.len() as f64;
-            Series {
-                label: label.into(),
-                style: SeriesStyle::Line,
-                points: s.iter().enumerate().map(|(i, v)| (*v, (i + 1) as f64 / n)).collect(),
-            }
+            let n = s.len();
+            let step = n.div_ceil(CDF_POINTS).max(1);
+            let points = s
+                .iter()
+                .enumerate()
+                .filter(|(i, _)| i % step == 0 || *i + 1 == n)
+                .map(|(i, v)| (*v, (i + 1) as f64 / n as f64))
+                .collect();
+            Series { label: label.into(), style: SeriesStyle::Line, points }
         };
         ctx.plot(&Plot {
             name: "error_cdf".into(),
@@ -447,7 +453,11 @@ impl Case for Contact {
             x_log: true,
             y_log: false,
             series: vec![cdf("ours (GJK/EPA)", &|e| e.ours.gap), cdf("parry3d-f64", &|e| e.parry.gap)],
-            caption: format!("Errors below {PLOT_FLOOR:e} × size are drawn at {PLOT_FLOOR:e}."),
+            caption: format!(
+                "Errors below {PLOT_FLOOR:e} × size are drawn at {PLOT_FLOOR:e}. Lines drawn through at most \
+                 {CDF_POINTS} ranks per method (the CSV has the same points)."
+            ),
+            legend: Legend::LowerRight,
         })?;
 
         // ---- timing and work-precision ------------------------------------------------------------
@@ -555,6 +565,7 @@ impl Case for Contact {
                  answer would count as an infinite error.",
                 pooled_overlap.len()
             ),
+            legend: Legend::UpperRight,
         })?;
         ctx.table(Some("work_precision_table"), &["method", "ns per query", "max depth err / size"], &wp_rows)?;
         Ok(())
