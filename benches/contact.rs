@@ -18,7 +18,9 @@ use polydem_validation::cases::contact::random_set;
 use polydem_validation::pairsets::{Intent, RandomSetSpec};
 use polydem_validation::peers::parry::ParryPair;
 
-const CLASSES: [&str; 7] = ["tet", "box", "hull8", "hull16", "hull32", "hull64", "voronoi"];
+const CLASSES: [&str; 7] = [
+    "tet", "box", "hull8", "hull16", "hull32", "hull64", "voronoi",
+];
 const PAIRS_PER_KIND: usize = 64;
 
 fn pools() -> Vec<(&'static str, Vec<Built>, Vec<Built>)> {
@@ -43,7 +45,11 @@ fn pools() -> Vec<(&'static str, Vec<Built>, Vec<Built>)> {
                     .map(|p| build(p).expect("hull of a generated pair"))
                     .collect()
             };
-            (*class, of(|i| matches!(i, Intent::Overlap(_))), of(|i| matches!(i, Intent::Separated(_))))
+            (
+                *class,
+                of(|i| matches!(i, Intent::Overlap(_))),
+                of(|i| matches!(i, Intent::Separated(_))),
+            )
         })
         .collect()
 }
@@ -63,7 +69,10 @@ fn contact(c: &mut Criterion) {
         g.bench_function("parry", |b| {
             b.iter(|| {
                 for p in &overlap {
-                    let peer = ParryPair { a: &p.parry_a, b: &p.parry_b };
+                    let peer = ParryPair {
+                        a: &p.parry_a,
+                        b: &p.parry_b,
+                    };
                     let _ = black_box(peer.contact(&p.pos1, &p.pos2, 0.0));
                 }
             })
@@ -82,7 +91,10 @@ fn contact(c: &mut Criterion) {
         g.bench_function("parry", |b| {
             b.iter(|| {
                 for p in &separated {
-                    let peer = ParryPair { a: &p.parry_a, b: &p.parry_b };
+                    let peer = ParryPair {
+                        a: &p.parry_a,
+                        b: &p.parry_b,
+                    };
                     black_box(peer.intersects(&p.pos1, &p.pos2));
                 }
             })

@@ -6,14 +6,27 @@ use polydem_validation::{run_case_in_memory, Profile};
 
 #[test]
 fn contact_case_quick_profile_passes_every_check() {
-    let report = run_case_in_memory("contact", Profile::Quick).expect("the contact case's data file must load");
-    assert!(report.error.is_none(), "contact case did not complete: {:?}", report.error);
+    let report = run_case_in_memory("contact", Profile::Quick)
+        .expect("the contact case's data file must load");
+    assert!(
+        report.error.is_none(),
+        "contact case did not complete: {:?}",
+        report.error
+    );
     assert!(!report.checks.is_empty(), "contact case produced no checks");
     let failed: Vec<String> = report
         .checks
         .iter()
         .filter(|c| !c.pass)
-        .map(|c| format!("{}: measured {:e} {}, target {}", c.metric, c.value, c.unit, c.target.render()))
+        .map(|c| {
+            format!(
+                "{}: measured {:e} {}, target {}",
+                c.metric,
+                c.value,
+                c.unit,
+                c.target.render()
+            )
+        })
         .collect();
     assert!(
         failed.is_empty(),

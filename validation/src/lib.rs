@@ -8,10 +8,10 @@
 
 pub mod case;
 pub mod cases;
-pub mod peers;
 pub mod context;
 pub mod error;
 pub mod pairsets;
+pub mod peers;
 pub mod plot;
 pub mod progress;
 pub mod provenance;

@@ -268,15 +268,18 @@ mod tests {
             y_label: "depth error / size".into(),
             x_log: true,
             y_log: true,
-            series: vec![Series {
-                label: "ours".into(),
-                style: SeriesStyle::Points,
-                points: vec![(1e-9, 1e-17), (1e-3, 2e-16), (0.0, 1.0)],
-            }, Series {
-                label: "parry3d-f64".into(),
-                style: SeriesStyle::LinePoints,
-                points: vec![(1e-8, 1e-12), (1e-2, 3e-3)],
-            }],
+            series: vec![
+                Series {
+                    label: "ours".into(),
+                    style: SeriesStyle::Points,
+                    points: vec![(1e-9, 1e-17), (1e-3, 2e-16), (0.0, 1.0)],
+                },
+                Series {
+                    label: "parry3d-f64".into(),
+                    style: SeriesStyle::LinePoints,
+                    points: vec![(1e-8, 1e-12), (1e-2, 3e-3)],
+                },
+            ],
             caption: String::new(),
             legend: Legend::UpperLeft,
         };

@@ -30,10 +30,22 @@ struct Params {
 
 const NAME: &str = "perf";
 const HISTORY: &str = "history.csv";
-const HEADER: [&str; 8] = ["commit", "date", "machine", "figure", "value", "unit", "peer_value", "ratio"];
+const HEADER: [&str; 8] = [
+    "commit",
+    "date",
+    "machine",
+    "figure",
+    "value",
+    "unit",
+    "peer_value",
+    "ratio",
+];
 
 fn case_err(msg: impl Into<String>) -> SuiteError {
-    SuiteError::Case { case: NAME.into(), msg: msg.into() }
+    SuiteError::Case {
+        case: NAME.into(),
+        msg: msg.into(),
+    }
 }
 
 fn read_history(path: &Path) -> Result<Vec<Vec<String>>, SuiteError> {
@@ -67,7 +79,12 @@ impl Case for Perf {
         &[HISTORY]
     }
 
-    fn run(&self, data: &CaseData, profile: Profile, ctx: &mut CaseContext) -> Result<(), SuiteError> {
+    fn run(
+        &self,
+        data: &CaseData,
+        profile: Profile,
+        ctx: &mut CaseContext,
+    ) -> Result<(), SuiteError> {
         let p: Params = data.params(NAME, profile)?;
         let threshold = data.tolerance(NAME, "ratio_regression")?.value;
         let spec = RandomSetSpec {
@@ -80,14 +97,21 @@ impl Case for Perf {
             overlap_min_rel: 1e-6,
             overlap_max_rel: 0.3,
         };
-        ctx.progress().stage("generating pairs", (p.classes.len() * spec.pairs_per_class_and_size) as u64);
+        ctx.progress().stage(
+            "generating pairs",
+            (p.classes.len() * spec.pairs_per_class_and_size) as u64,
+        );
         let pairs = random_set(&spec, || ctx.progress().inc(1))?;
         ctx.progress().stage("timing", p.classes.len() as u64);
         // (figure, ours ns, parry ns)
         let mut figures: Vec<(String, f64, f64)> = Vec::new();
         for class in &p.classes {
             let of = |want: fn(&Intent) -> bool| -> Result<Vec<Built>, SuiteError> {
-                pairs.iter().filter(|q| &q.class == class && want(&q.intent)).map(|q| build(q).map_err(case_err)).collect()
+                pairs
+                    .iter()
+                    .filter(|q| &q.class == class && want(&q.intent))
+                    .map(|q| build(q).map_err(case_err))
+                    .collect()
             };
             let ov = of(|i| matches!(i, Intent::Overlap(_)))?;
             let sep = of(|i| matches!(i, Intent::Separated(_)))?;
@@ -125,10 +149,27 @@ impl Case for Perf {
             let ratio = ours / parry;
             match baseline(fig) {
                 Some(base) => {
-                    ctx.check(&format!("{fig}_ratio_vs_baseline"), ratio / base, Target::at_most(threshold), "1");
-                    rows.push(vec![fig.clone(), format!("{ours:.0}"), format!("{parry:.0}"), format!("{ratio:.3}"), format!("{base:.3}")]);
+                    ctx.check(
+                        &format!("{fig}_ratio_vs_baseline"),
+                        ratio / base,
+                        Target::at_most(threshold),
+                        "1",
+                    );
+                    rows.push(vec![
+                        fig.clone(),
+                        format!("{ours:.0}"),
+                        format!("{parry:.0}"),
+                        format!("{ratio:.3}"),
+                        format!("{base:.3}"),
+                    ]);
                 }
-                None => rows.push(vec![fig.clone(), format!("{ours:.0}"), format!("{parry:.0}"), format!("{ratio:.3}"), "none (first run on this machine)".into()]),
+                None => rows.push(vec![
+                    fig.clone(),
+                    format!("{ours:.0}"),
+                    format!("{parry:.0}"),
+                    format!("{ratio:.3}"),
+                    "none (first run on this machine)".into(),
+                ]),
             }
             new_rows.push(vec![
                 prov.commit.clone(),
@@ -155,7 +196,11 @@ impl Case for Perf {
              × the last ratio recorded for the same figure on the same machine. History: [perf/{HISTORY}](perf/{HISTORY}).",
             p.repeats, p.pairs_per_class
         ));
-        ctx.table(None, &["figure", "ours ns", "parry ns", "ratio", "baseline ratio"], &rows)?;
+        ctx.table(
+            None,
+            &["figure", "ours ns", "parry ns", "ratio", "baseline ratio"],
+            &rows,
+        )?;
         let mut series = Vec::new();
         for (fig, _, _) in &figures {
             let pts: Vec<(f64, f64)> = history
@@ -164,7 +209,11 @@ impl Case for Perf {
                 .enumerate()
                 .filter_map(|(i, r)| Some(((i + 1) as f64, r[7].parse::<f64>().ok()?)))
                 .collect();
-            series.push(Series { label: fig.clone(), style: SeriesStyle::LinePoints, points: pts });
+            series.push(Series {
+                label: fig.clone(),
+                style: SeriesStyle::LinePoints,
+                points: pts,
+            });
         }
         ctx.plot(&Plot {
             name: "history".into(),

@@ -28,10 +28,15 @@ fn moved(pts: &[Point], rot: &Rotation, t: Vector) -> Vec<Point> {
 }
 
 fn regular_tet(h: f64) -> Vec<Point> {
-    [(1.0, 1.0, 1.0), (1.0, -1.0, -1.0), (-1.0, 1.0, -1.0), (-1.0, -1.0, 1.0)]
-        .iter()
-        .map(|&(x, y, z)| Point::new(x * h, y * h, z * h))
-        .collect()
+    [
+        (1.0, 1.0, 1.0),
+        (1.0, -1.0, -1.0),
+        (-1.0, 1.0, -1.0),
+        (-1.0, -1.0, 1.0),
+    ]
+    .iter()
+    .map(|&(x, y, z)| Point::new(x * h, y * h, z * h))
+    .collect()
 }
 
 /// The degenerate set at particle sizes `sizes`.
@@ -52,7 +57,12 @@ pub fn degenerate_set(sizes: &[f64]) -> Vec<Pair> {
             });
         };
         let c = cube(h);
-        push("stacked_cubes_touching", Intent::Touching, c.clone(), moved(&c, &id, z * (2.0 * h)));
+        push(
+            "stacked_cubes_touching",
+            Intent::Touching,
+            c.clone(),
+            moved(&c, &id, z * (2.0 * h)),
+        );
         for (tag, d) in [("1e-9", 1e-9), ("1e-6", 1e-6), ("0.1", 0.1)] {
             push(
                 &format!("stacked_cubes_overlap_{tag}"),
@@ -67,14 +77,39 @@ pub fn degenerate_set(sizes: &[f64]) -> Vec<Pair> {
             c.clone(),
             moved(&c, &id, Vector::new(0.25 * h, 0.5 * h, 2.0 * h)),
         );
-        push("concentric_cubes_identical", Intent::Overlap(s), c.clone(), c.clone());
-        push("concentric_cubes_nested", Intent::Overlap(0.75 * s), c.clone(), cube(0.5 * h));
+        push(
+            "concentric_cubes_identical",
+            Intent::Overlap(s),
+            c.clone(),
+            c.clone(),
+        );
+        push(
+            "concentric_cubes_nested",
+            Intent::Overlap(0.75 * s),
+            c.clone(),
+            cube(0.5 * h),
+        );
         let rz45 = Rotation::from_axis_angle(&Vector::z_axis(), std::f64::consts::FRAC_PI_4);
-        push("concentric_cubes_rotated45", Intent::Overlap(s), c.clone(), moved(&c, &rz45, Vector::zeros()));
+        push(
+            "concentric_cubes_rotated45",
+            Intent::Overlap(s),
+            c.clone(),
+            moved(&c, &rz45, Vector::zeros()),
+        );
         let t = regular_tet(h);
-        push("concentric_tets_identical", Intent::Overlap(s), t.clone(), t.clone());
+        push(
+            "concentric_tets_identical",
+            Intent::Overlap(s),
+            t.clone(),
+            t.clone(),
+        );
         let reflected: Vec<Point> = t.iter().map(|p| Point::from(-p.coords)).collect();
-        push("concentric_tets_reflected", Intent::Overlap(s), t.clone(), reflected);
+        push(
+            "concentric_tets_reflected",
+            Intent::Overlap(s),
+            t.clone(),
+            reflected,
+        );
         push(
             "same_orientation_tets_offset",
             Intent::Overlap(0.5 * s),
@@ -83,10 +118,18 @@ pub fn degenerate_set(sizes: &[f64]) -> Vec<Pair> {
         );
         let rx45 = Rotation::from_axis_angle(&Vector::x_axis(), std::f64::consts::FRAC_PI_4);
         let edge_up = moved(&c, &rx45, Vector::zeros());
-        let top = edge_up.iter().map(|p| p.z).fold(f64::NEG_INFINITY, f64::max);
+        let top = edge_up
+            .iter()
+            .map(|p| p.z)
+            .fold(f64::NEG_INFINITY, f64::max);
         let bottom = edge_up.iter().map(|p| p.z).fold(f64::INFINITY, f64::min);
         let stack = top - bottom;
-        push("parallel_edges_touching", Intent::Touching, edge_up.clone(), moved(&edge_up, &id, z * stack));
+        push(
+            "parallel_edges_touching",
+            Intent::Touching,
+            edge_up.clone(),
+            moved(&edge_up, &id, z * stack),
+        );
         push(
             "parallel_edges_overlap_1e-3",
             Intent::Overlap(1e-3 * s),
@@ -101,7 +144,10 @@ pub fn degenerate_set(sizes: &[f64]) -> Vec<Pair> {
         );
         let diag = Rotation::rotation_between(&Vector::new(1.0, 1.0, 1.0), &z).unwrap_or(id);
         let vertex_up = moved(&c, &diag, Vector::zeros());
-        let vtop = vertex_up.iter().map(|p| p.z).fold(f64::NEG_INFINITY, f64::max);
+        let vtop = vertex_up
+            .iter()
+            .map(|p| p.z)
+            .fold(f64::NEG_INFINITY, f64::max);
         let vbottom = vertex_up.iter().map(|p| p.z).fold(f64::INFINITY, f64::min);
         push(
             "vertex_on_vertex_touching",
@@ -121,9 +167,22 @@ pub fn degenerate_set(sizes: &[f64]) -> Vec<Pair> {
             Point::new(0.0, 0.5 * h, h),
             Point::new(0.0, 0.0, 2.0 * h),
         ];
-        push("face_on_face_tet_on_cube", Intent::Touching, c.clone(), tet_on_face);
-        let small: Vec<Point> = cube(0.25 * h).iter().map(|p| p + Vector::new(0.0, 0.0, 1.25 * h)).collect();
-        push("face_on_face_small_cube_on_cube", Intent::Touching, c.clone(), small);
+        push(
+            "face_on_face_tet_on_cube",
+            Intent::Touching,
+            c.clone(),
+            tet_on_face,
+        );
+        let small: Vec<Point> = cube(0.25 * h)
+            .iter()
+            .map(|p| p + Vector::new(0.0, 0.0, 1.25 * h))
+            .collect();
+        push(
+            "face_on_face_small_cube_on_cube",
+            Intent::Touching,
+            c.clone(),
+            small,
+        );
     }
     pairs
 }

@@ -51,7 +51,8 @@ pub struct RandomSetSpec {
 }
 
 /// The exact signed gap and normal of a pair at given poses (provided by the caller: the SAT oracle).
-pub type ExactGap<'a> = dyn FnMut(&Pose, &ConvexPolyhedron, &Pose, &ConvexPolyhedron) -> Option<(f64, Vector)> + 'a;
+pub type ExactGap<'a> =
+    dyn FnMut(&Pose, &ConvexPolyhedron, &Pose, &ConvexPolyhedron) -> Option<(f64, Vector)> + 'a;
 
 /// SplitMix64 of the set seed and the pair's coordinates: each pair has its own stream, so changing the
 /// number of pairs of one class does not change the others.
@@ -93,13 +94,29 @@ pub fn random_pair(
     };
     let intent = draw_intent(&mut rng);
     for _attempt in 0..50 {
-        let scale = |pts: Vec<Point>, c: Vector| pts.into_iter().map(|p| Point::from(p.coords * size + c)).collect::<Vec<_>>();
-        let center = Vector::new(rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0)) * size;
-        let a = scale(shapes::random_shape(class, &mut rng).ok_or_else(|| fail("unknown class".into()))?, center);
-        let b_base = scale(shapes::random_shape(class, &mut rng).ok_or_else(|| fail("unknown class".into()))?, center);
+        let scale = |pts: Vec<Point>, c: Vector| {
+            pts.into_iter()
+                .map(|p| Point::from(p.coords * size + c))
+                .collect::<Vec<_>>()
+        };
+        let center = Vector::new(
+            rng.random_range(-1.0..1.0),
+            rng.random_range(-1.0..1.0),
+            rng.random_range(-1.0..1.0),
+        ) * size;
+        let a = scale(
+            shapes::random_shape(class, &mut rng).ok_or_else(|| fail("unknown class".into()))?,
+            center,
+        );
+        let b_base = scale(
+            shapes::random_shape(class, &mut rng).ok_or_else(|| fail("unknown class".into()))?,
+            center,
+        );
         let u = shapes::random_unit(&mut rng);
-        let (poly_a, pos1) = ConvexPolyhedron::from_points(&a).map_err(|e| fail(format!("hull of A: {e}")))?;
-        let (poly_b, pos2_base) = ConvexPolyhedron::from_points(&b_base).map_err(|e| fail(format!("hull of B: {e}")))?;
+        let (poly_a, pos1) =
+            ConvexPolyhedron::from_points(&a).map_err(|e| fail(format!("hull of A: {e}")))?;
+        let (poly_b, pos2_base) =
+            ConvexPolyhedron::from_points(&b_base).map_err(|e| fail(format!("hull of B: {e}")))?;
         let (Some(pa), Some(pb)) = (ParryShape::new(&poly_a), ParryShape::new(&poly_b)) else {
             return Err(fail("parry could not build the hull".into()));
         };
@@ -122,7 +139,14 @@ pub fn random_pair(
         };
         if let Some(t) = placement::place(gap, &u, t_max, intent) {
             let b = b_base.iter().map(|p| p + u * t).collect();
-            return Ok(Pair { id: format!("{class}/s{si}/{index:05}"), class: class.clone(), size, intent, a, b });
+            return Ok(Pair {
+                id: format!("{class}/s{si}/{index:05}"),
+                class: class.clone(),
+                size,
+                intent,
+                a,
+                b,
+            });
         }
     }
     Err(fail(format!("no draw realised {intent:?} in 50 attempts")))

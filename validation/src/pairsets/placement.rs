@@ -50,7 +50,11 @@ pub fn place(
     if g0 >= 0.0 || coarse(t_max)?.0 <= 0.0 {
         return None;
     }
-    let bisect = |f: &mut dyn FnMut(f64) -> Option<(f64, Vector)>, mut lo: f64, mut hi: f64, target: f64, rel: f64| {
+    let bisect = |f: &mut dyn FnMut(f64) -> Option<(f64, Vector)>,
+                  mut lo: f64,
+                  mut hi: f64,
+                  target: f64,
+                  rel: f64| {
         for _ in 0..200 {
             let mid = 0.5 * (lo + hi);
             if mid <= lo || mid >= hi {
@@ -115,9 +119,18 @@ mod tests {
         let t = place(gap, &u, 3.0, Intent::Touching).unwrap();
         assert!((t - 1.0).abs() < 1e-15, "touching at t = {t}, expected 1");
         let t = place(gap, &u, 3.0, Intent::Overlap(0.25)).unwrap();
-        assert!((t - 0.75).abs() <= 0.25e-3, "overlap 0.25 at t = {t}, expected 0.75 ± 2.5e-4");
+        assert!(
+            (t - 0.75).abs() <= 0.25e-3,
+            "overlap 0.25 at t = {t}, expected 0.75 ± 2.5e-4"
+        );
         let t = place(gap, &u, 3.0, Intent::Separated(1e-6)).unwrap();
-        assert!((t - 1.0 - 1e-6).abs() <= 1e-9, "gap 1e-6 at t = {t}, expected 1 + 1e-6 ± 1e-9");
-        assert!(place(gap, &u, 3.0, Intent::Overlap(1.5)).is_none(), "overlap deeper than g(0) must be rejected");
+        assert!(
+            (t - 1.0 - 1e-6).abs() <= 1e-9,
+            "gap 1e-6 at t = {t}, expected 1 + 1e-6 ± 1e-9"
+        );
+        assert!(
+            place(gap, &u, 3.0, Intent::Overlap(1.5)).is_none(),
+            "overlap deeper than g(0) must be rejected"
+        );
     }
 }

@@ -16,7 +16,9 @@ use polydem::math::{Point, Rotation, Vector};
 use rand::Rng;
 
 /// The shape classes of the random pair sets, in report order.
-pub const CLASSES: [&str; 7] = ["tet", "box", "hull8", "hull16", "hull32", "hull64", "voronoi"];
+pub const CLASSES: [&str; 7] = [
+    "tet", "box", "hull8", "hull16", "hull32", "hull64", "voronoi",
+];
 
 /// A uniformly distributed unit vector.
 pub fn random_unit(rng: &mut impl Rng) -> Vector {
@@ -31,14 +33,22 @@ pub fn random_rotation(rng: &mut impl Rng) -> Rotation {
     let (u1, u2, u3): (f64, f64, f64) = (rng.random(), rng.random(), rng.random());
     let tau = std::f64::consts::TAU;
     let (a, b) = ((1.0 - u1).sqrt(), u1.sqrt());
-    let q = nalgebra::Quaternion::new(b * (tau * u3).cos(), a * (tau * u2).sin(), a * (tau * u2).cos(), b * (tau * u3).sin());
+    let q = nalgebra::Quaternion::new(
+        b * (tau * u3).cos(),
+        a * (tau * u2).sin(),
+        a * (tau * u2).cos(),
+        b * (tau * u3).sin(),
+    );
     Rotation::from_quaternion(q)
 }
 
 fn normalise_size(mut pts: Vec<Point>) -> Vec<Point> {
     let n = pts.len() as f64;
     let mean = pts.iter().fold(Vector::zeros(), |s, p| s + p.coords) / n;
-    let r = pts.iter().map(|p| (p.coords - mean).norm()).fold(0.0, f64::max);
+    let r = pts
+        .iter()
+        .map(|p| (p.coords - mean).norm())
+        .fold(0.0, f64::max);
     for p in &mut pts {
         *p = Point::from((p.coords - mean) * (0.5 / r));
     }
@@ -50,7 +60,11 @@ fn tetrahedron(rng: &mut impl Rng) -> Vec<Point> {
     let regular = 8.0 / (9.0 * 3f64.sqrt());
     loop {
         let p: Vec<Vector> = (0..4).map(|_| random_unit(rng)).collect();
-        let vol = (p[1] - p[0]).cross(&(p[2] - p[0])).dot(&(p[3] - p[0])).abs() / 6.0;
+        let vol = (p[1] - p[0])
+            .cross(&(p[2] - p[0]))
+            .dot(&(p[3] - p[0]))
+            .abs()
+            / 6.0;
         if vol >= 0.05 * regular {
             return normalise_size(p.into_iter().map(Point::from).collect());
         }
@@ -58,7 +72,11 @@ fn tetrahedron(rng: &mut impl Rng) -> Vec<Point> {
 }
 
 fn cuboid(rng: &mut impl Rng) -> Vec<Point> {
-    let h = Vector::new(1.0, rng.random_range(1.0 / 3.0..1.0), rng.random_range(1.0 / 3.0..1.0));
+    let h = Vector::new(
+        1.0,
+        rng.random_range(1.0 / 3.0..1.0),
+        rng.random_range(1.0 / 3.0..1.0),
+    );
     let mut pts = Vec::with_capacity(8);
     for i in 0..8 {
         let s = |bit: usize| if i & bit == 0 { -1.0 } else { 1.0 };
@@ -68,8 +86,16 @@ fn cuboid(rng: &mut impl Rng) -> Vec<Point> {
 }
 
 fn ellipsoid_hull(rng: &mut impl Rng, n: usize) -> Vec<Point> {
-    let axes = Vector::new(1.0, rng.random_range(1.0 / 3.0..1.0), rng.random_range(1.0 / 3.0..1.0));
-    normalise_size((0..n).map(|_| Point::from(random_unit(rng).component_mul(&axes))).collect())
+    let axes = Vector::new(
+        1.0,
+        rng.random_range(1.0 / 3.0..1.0),
+        rng.random_range(1.0 / 3.0..1.0),
+    );
+    normalise_size(
+        (0..n)
+            .map(|_| Point::from(random_unit(rng).component_mul(&axes)))
+            .collect(),
+    )
 }
 
 fn voronoi_cell(rng: &mut impl Rng) -> Vec<Point> {
@@ -95,13 +121,21 @@ fn voronoi_cell(rng: &mut impl Rng) -> Vec<Point> {
             for j in i + 1..m {
                 for k in j + 1..m {
                     let (a, b, c) = (&planes[i], &planes[j], &planes[k]);
-                    let mat = nalgebra::Matrix3::from_rows(&[a.0.transpose(), b.0.transpose(), c.0.transpose()]);
-                    let Some(inv) = mat.try_inverse() else { continue };
+                    let mat = nalgebra::Matrix3::from_rows(&[
+                        a.0.transpose(),
+                        b.0.transpose(),
+                        c.0.transpose(),
+                    ]);
+                    let Some(inv) = mat.try_inverse() else {
+                        continue;
+                    };
                     if mat.determinant().abs() < 1e-9 * a.0.norm() * b.0.norm() * c.0.norm() {
                         continue;
                     }
                     let x = inv * Vector::new(a.1, b.1, c.1);
-                    let inside = planes.iter().all(|(n, d)| n.dot(&x) <= d + 1e-12 * n.norm());
+                    let inside = planes
+                        .iter()
+                        .all(|(n, d)| n.dot(&x) <= d + 1e-12 * n.norm());
                     if inside && !verts.iter().any(|v| (v.coords - x).norm() < 1e-9) {
                         verts.push(Point::from(x));
                     }
@@ -141,8 +175,14 @@ mod tests {
         for class in CLASSES {
             let pts = random_shape(class, &mut rng).unwrap();
             let mean = pts.iter().fold(Vector::zeros(), |s, p| s + p.coords) / pts.len() as f64;
-            let r = pts.iter().map(|p| (p.coords - mean).norm()).fold(0.0, f64::max);
-            assert!((r - 0.5).abs() < 1e-12, "class {class}: bounding radius {r}, expected 0.5");
+            let r = pts
+                .iter()
+                .map(|p| (p.coords - mean).norm())
+                .fold(0.0, f64::max);
+            assert!(
+                (r - 0.5).abs() < 1e-12,
+                "class {class}: bounding radius {r}, expected 0.5"
+            );
             let expected = match class {
                 "tet" => 4..=4,
                 "box" => 8..=8,
@@ -152,7 +192,11 @@ mod tests {
                 "hull64" => 64..=64,
                 _ => 20..=40,
             };
-            assert!(expected.contains(&pts.len()), "class {class}: {} points, expected {expected:?}", pts.len());
+            assert!(
+                expected.contains(&pts.len()),
+                "class {class}: {} points, expected {expected:?}",
+                pts.len()
+            );
         }
     }
 }

@@ -2,10 +2,10 @@
 //!
 //! parry's `ConvexPolyhedron` is built from the vertices of our polyhedron in its principal frame, so both
 //! codes see the same solid at the same pose. Queries:
-//! - [`ParryPair::contact`]: `parry3d_f64::query::contact` with a prediction large enough to also return
-//!   the gap of separated pairs (contact points then are the closest points);
-//! - [`ParryPair::intersects`]: `query::intersection_test` (the boolean rejection test);
-//! - [`ParryPair::distance`]: `query::distance`.
+//! - `parry3d_f64::query::contact` in [`ParryPair::contact`], with a prediction large enough to also
+//!   return the gap of separated pairs (contact points then are the closest points);
+//! - `query::intersection_test` in [`ParryPair::intersects`] (the boolean rejection test);
+//! - `query::distance` in [`ParryPair::distance`].
 //!
 //! A panic inside parry is caught and reported as `None`, never as "no contact".
 
@@ -51,7 +51,12 @@ impl ParryPair<'_> {
     /// parry's contact with `prediction` (m): `Ok(None)` when parry reports no contact within the prediction,
     /// `Err(())` when parry panicked or reported the pair unsupported.
     #[allow(clippy::result_unit_err)]
-    pub fn contact(&self, pos1: &Pose, pos2: &Pose, prediction: f64) -> Result<Option<ParryContact>, ()> {
+    pub fn contact(
+        &self,
+        pos1: &Pose,
+        pos2: &Pose,
+        prediction: f64,
+    ) -> Result<Option<ParryContact>, ()> {
         let (p1, p2) = (pose_to_glam(pos1), pose_to_glam(pos2));
         let r = catch_unwind(AssertUnwindSafe(|| {
             query::contact(&p1, &self.a.shape, &p2, &self.b.shape, prediction)
@@ -71,18 +76,22 @@ impl ParryPair<'_> {
     /// parry's boolean intersection test (`None` when parry panicked or reported the pair unsupported).
     pub fn intersects(&self, pos1: &Pose, pos2: &Pose) -> Option<bool> {
         let (p1, p2) = (pose_to_glam(pos1), pose_to_glam(pos2));
-        catch_unwind(AssertUnwindSafe(|| query::intersection_test(&p1, &self.a.shape, &p2, &self.b.shape)))
-            .ok()?
-            .ok()
-            .map(|r| r.intersecting)
+        catch_unwind(AssertUnwindSafe(|| {
+            query::intersection_test(&p1, &self.a.shape, &p2, &self.b.shape)
+        }))
+        .ok()?
+        .ok()
+        .map(|r| r.intersecting)
     }
 
     /// parry's distance (0 when intersecting; `None` on panic or unsupported).
     pub fn distance(&self, pos1: &Pose, pos2: &Pose) -> Option<f64> {
         let (p1, p2) = (pose_to_glam(pos1), pose_to_glam(pos2));
-        catch_unwind(AssertUnwindSafe(|| query::distance(&p1, &self.a.shape, &p2, &self.b.shape)))
-            .ok()?
-            .ok()
-            .map(|r| r.distance)
+        catch_unwind(AssertUnwindSafe(|| {
+            query::distance(&p1, &self.a.shape, &p2, &self.b.shape)
+        }))
+        .ok()?
+        .ok()
+        .map(|r| r.distance)
     }
 }

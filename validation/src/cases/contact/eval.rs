@@ -35,7 +35,13 @@ pub struct Answer {
 
 impl Answer {
     pub fn from_geometry(g: &ContactGeometry) -> Self {
-        Answer { kind: g.kind, signed_gap: g.distance - g.depth, normal: g.normal, point_a: g.point_a, point_b: g.point_b }
+        Answer {
+            kind: g.kind,
+            signed_gap: g.distance - g.depth,
+            normal: g.normal,
+            point_a: g.point_a,
+            point_b: g.point_b,
+        }
     }
 }
 
@@ -90,17 +96,34 @@ pub struct Built {
 
 /// Builds the polyhedra of a pair (ours and parry's).
 pub fn build(pair: &Pair) -> Result<Built, String> {
-    let (a, pos1) = ConvexPolyhedron::from_points(&pair.a).map_err(|e| format!("{}: hull of A: {e}", pair.id))?;
-    let (b, pos2) = ConvexPolyhedron::from_points(&pair.b).map_err(|e| format!("{}: hull of B: {e}", pair.id))?;
-    let parry_a = ParryShape::new(&a).ok_or_else(|| format!("{}: parry hull of A failed", pair.id))?;
-    let parry_b = ParryShape::new(&b).ok_or_else(|| format!("{}: parry hull of B failed", pair.id))?;
-    Ok(Built { a, pos1, b, pos2, parry_a, parry_b })
+    let (a, pos1) = ConvexPolyhedron::from_points(&pair.a)
+        .map_err(|e| format!("{}: hull of A: {e}", pair.id))?;
+    let (b, pos2) = ConvexPolyhedron::from_points(&pair.b)
+        .map_err(|e| format!("{}: hull of B: {e}", pair.id))?;
+    let parry_a =
+        ParryShape::new(&a).ok_or_else(|| format!("{}: parry hull of A failed", pair.id))?;
+    let parry_b =
+        ParryShape::new(&b).ok_or_else(|| format!("{}: parry hull of B failed", pair.id))?;
+    Ok(Built {
+        a,
+        pos1,
+        b,
+        pos2,
+        parry_a,
+        parry_b,
+    })
 }
 
 /// Overlap of the point clouds along unit `n`: max_a n·a − min_b n·b (brute force).
 fn overlap_along(a: &[Point], b: &[Point], n: &Vector) -> f64 {
-    let ha = a.iter().map(|p| n.dot(&p.coords)).fold(f64::NEG_INFINITY, f64::max);
-    let lb = b.iter().map(|p| n.dot(&p.coords)).fold(f64::INFINITY, f64::min);
+    let ha = a
+        .iter()
+        .map(|p| n.dot(&p.coords))
+        .fold(f64::NEG_INFINITY, f64::max);
+    let lb = b
+        .iter()
+        .map(|p| n.dot(&p.coords))
+        .fold(f64::INFINITY, f64::min);
     ha - lb
 }
 
@@ -112,9 +135,22 @@ fn plane_distance(poly: &ConvexPolyhedron, pose: &Pose, p: &Point) -> f64 {
         .fold(f64::NEG_INFINITY, f64::max)
 }
 
-fn errors(pair: &Pair, built: &Built, ans: &Answer, reference: &Answer, band: f64, tol: f64) -> Errors {
+fn errors(
+    pair: &Pair,
+    built: &Built,
+    ans: &Answer,
+    reference: &Answer,
+    band: f64,
+    tol: f64,
+) -> Errors {
     let n_norm = ans.normal.norm();
-    let finite = ans.signed_gap.is_finite() && ans.point_a.coords.iter().chain(ans.point_b.coords.iter()).all(|x| x.is_finite());
+    let finite = ans.signed_gap.is_finite()
+        && ans
+            .point_a
+            .coords
+            .iter()
+            .chain(ans.point_b.coords.iter())
+            .all(|x| x.is_finite());
     let normal = if (n_norm - 1.0).abs() <= 1e-9 && finite {
         let n = ans.normal / n_norm;
         (-overlap_along(&pair.a, &pair.b, &n) - reference.signed_gap).abs()
@@ -155,7 +191,9 @@ pub fn evaluate(
     depth_rel: f64,
 ) -> Result<Eval, String> {
     let built = build(pair)?;
-    let Built { a, pos1, b, pos2, .. } = &built;
+    let Built {
+        a, pos1, b, pos2, ..
+    } = &built;
     let size = a.length_scale().max(b.length_scale());
     let band = ContactTolerances::default().touching * a.bounding_radius().max(b.bounding_radius());
     let reference = Answer::from_geometry(&sat(pos1, a, pos2, b));
@@ -163,7 +201,10 @@ pub fn evaluate(
     let g = ours.query(pos1, a, pos2, b);
     let ours_answer = Answer::from_geometry(&g);
     let ours_errors = errors(pair, &built, &ours_answer, &reference, band, tol);
-    let peer = ParryPair { a: &built.parry_a, b: &built.parry_b };
+    let peer = ParryPair {
+        a: &built.parry_a,
+        b: &built.parry_b,
+    };
     let parry_answer = match peer.contact(pos1, pos2, size) {
         Ok(Some(c)) => Some(Answer {
             kind: classify(c.signed_gap, band),
@@ -184,7 +225,16 @@ pub fn evaluate(
     };
     let (parry_errors, parry_kind) = match &parry_answer {
         Some(p) => (errors(pair, &built, p, &reference, band, tol), Some(p.kind)),
-        None => (Errors { failed: true, wrong_status: true, gap: f64::INFINITY, normal: f64::INFINITY, point: f64::INFINITY }, None),
+        None => (
+            Errors {
+                failed: true,
+                wrong_status: true,
+                gap: f64::INFINITY,
+                normal: f64::INFINITY,
+                point: f64::INFINITY,
+            },
+            None,
+        ),
     };
     Ok(Eval {
         id: pair.id.clone(),

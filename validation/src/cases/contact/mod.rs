@@ -56,7 +56,10 @@ const PLOT_FLOOR: f64 = 1e-18;
 const CDF_POINTS: usize = 400;
 
 fn case_err(msg: impl Into<String>) -> SuiteError {
-    SuiteError::Case { case: NAME.into(), msg: msg.into() }
+    SuiteError::Case {
+        case: NAME.into(),
+        msg: msg.into(),
+    }
 }
 
 impl Params {
@@ -191,8 +194,14 @@ fn group(evals: &[&Eval], pick: impl Fn(&Eval) -> Errors) -> Group {
     let maxf = |f: &dyn Fn(&Eval) -> f64| evals.iter().map(|e| f(e)).fold(0.0, f64::max);
     Group {
         n: evals.len(),
-        wrong: evals.iter().filter(|e| pick(e).wrong_status || pick(e).failed).count(),
-        over_tol: evals.iter().filter(|e| pick(e).worst_ratio(e.tol) > 1.0).count(),
+        wrong: evals
+            .iter()
+            .filter(|e| pick(e).wrong_status || pick(e).failed)
+            .count(),
+        over_tol: evals
+            .iter()
+            .filter(|e| pick(e).worst_ratio(e.tol) > 1.0)
+            .count(),
         gap_max: s.last().copied().unwrap_or(f64::NAN),
         gap_p99: quantile(&s, 0.99),
         gap_median: quantile(&s, 0.5),
@@ -214,30 +223,43 @@ impl Case for Contact {
         include_str!("../../../cases/contact.toml")
     }
 
-    fn run(&self, data: &CaseData, profile: Profile, ctx: &mut CaseContext) -> Result<(), SuiteError> {
+    fn run(
+        &self,
+        data: &CaseData,
+        profile: Profile,
+        ctx: &mut CaseContext,
+    ) -> Result<(), SuiteError> {
         let p: Params = data.params(NAME, profile)?;
         let depth_abs = data.tolerance(NAME, "depth_abs")?.value;
         let depth_rel = data.tolerance(NAME, "depth_rel")?.value;
         let spec = p.spec(p.pairs_per_class_and_size);
 
         let n_random = p.classes.len() * p.sizes.len() * p.pairs_per_class_and_size;
-        ctx.progress().stage("generating random pairs", n_random as u64);
+        ctx.progress()
+            .stage("generating random pairs", n_random as u64);
         let random = random_set(&spec, || ctx.progress().inc(1))?;
         let degenerate = degenerate_set(&p.sizes);
 
-        ctx.progress().stage("evaluating pairs", (random.len() + degenerate.len()) as u64);
+        ctx.progress()
+            .stage("evaluating pairs", (random.len() + degenerate.len()) as u64);
         let mut ours = Ours::new(ContactTolerances::default());
         let size_index = |pair: &Pair| p.sizes.iter().position(|s| *s == pair.size).unwrap_or(0);
         let mut evals = Vec::with_capacity(random.len());
         for pair in &random {
-            evals.push(evaluate(pair, size_index(pair), &mut ours, depth_abs, depth_rel).map_err(case_err)?);
+            evals.push(
+                evaluate(pair, size_index(pair), &mut ours, depth_abs, depth_rel)
+                    .map_err(case_err)?,
+            );
             ctx.progress().inc(1);
         }
         let random_counters = ours.counters;
         let mut ours_deg = Ours::new(ContactTolerances::default());
         let mut deg_evals = Vec::with_capacity(degenerate.len());
         for pair in &degenerate {
-            deg_evals.push(evaluate(pair, size_index(pair), &mut ours_deg, depth_abs, depth_rel).map_err(case_err)?);
+            deg_evals.push(
+                evaluate(pair, size_index(pair), &mut ours_deg, depth_abs, depth_rel)
+                    .map_err(case_err)?,
+            );
             ctx.progress().inc(1);
         }
 
@@ -252,15 +274,55 @@ impl Case for Contact {
             .map(|e| -e.reference.signed_gap / e.size)
             .collect();
         let count = |k: ContactKind| evals.iter().filter(|e| e.reference.kind == k).count() as f64;
-        ctx.check("random_pairs_overlap_min_rel", overlaps.iter().copied().fold(f64::INFINITY, f64::min), Target::at_most(1e-8), "1");
-        ctx.check("random_pairs_overlap_max_rel", overlaps.iter().copied().fold(0.0, f64::max), Target::at_least(0.1), "1");
-        ctx.check("random_pairs_touching", count(ContactKind::Touching), Target::at_least(1.0), "pairs");
-        ctx.check("random_pairs_separated", count(ContactKind::Separated), Target::at_least(1.0), "pairs");
+        ctx.check(
+            "random_pairs_overlap_min_rel",
+            overlaps.iter().copied().fold(f64::INFINITY, f64::min),
+            Target::at_most(1e-8),
+            "1",
+        );
+        ctx.check(
+            "random_pairs_overlap_max_rel",
+            overlaps.iter().copied().fold(0.0, f64::max),
+            Target::at_least(0.1),
+            "1",
+        );
+        ctx.check(
+            "random_pairs_touching",
+            count(ContactKind::Touching),
+            Target::at_least(1.0),
+            "pairs",
+        );
+        ctx.check(
+            "random_pairs_separated",
+            count(ContactKind::Separated),
+            Target::at_least(1.0),
+            "pairs",
+        );
         for (tag, g) in [("random", &ours_all), ("degenerate", &ours_deg_g)] {
-            ctx.check(&format!("ours_{tag}_wrong_status"), g.wrong as f64, Target::equal(0.0), "pairs");
-            ctx.check(&format!("ours_{tag}_gap_error_over_tol_max"), g.gap_ratio_max, Target::at_most(1.0), "1");
-            ctx.check(&format!("ours_{tag}_normal_error_over_tol_max"), g.normal_ratio_max, Target::at_most(1.0), "1");
-            ctx.check(&format!("ours_{tag}_point_error_over_tol_max"), g.point_ratio_max, Target::at_most(1.0), "1");
+            ctx.check(
+                &format!("ours_{tag}_wrong_status"),
+                g.wrong as f64,
+                Target::equal(0.0),
+                "pairs",
+            );
+            ctx.check(
+                &format!("ours_{tag}_gap_error_over_tol_max"),
+                g.gap_ratio_max,
+                Target::at_most(1.0),
+                "1",
+            );
+            ctx.check(
+                &format!("ours_{tag}_normal_error_over_tol_max"),
+                g.normal_ratio_max,
+                Target::at_most(1.0),
+                "1",
+            );
+            ctx.check(
+                &format!("ours_{tag}_point_error_over_tol_max"),
+                g.point_ratio_max,
+                Target::at_most(1.0),
+                "1",
+            );
         }
 
         // ---- page ---------------------------------------------------------------------------------
@@ -296,7 +358,19 @@ impl Case for Contact {
         };
         ctx.table(
             Some("overview"),
-            &["set", "method", "pairs", "wrong status", "pairs over tol", "gap err max /size", "p99", "median", "normal err max /size", "point err max /size", "worst err/tol"],
+            &[
+                "set",
+                "method",
+                "pairs",
+                "wrong status",
+                "pairs over tol",
+                "gap err max /size",
+                "p99",
+                "median",
+                "normal err max /size",
+                "point err max /size",
+                "worst err/tol",
+            ],
             &[
                 row("random", "ours", &ours_all),
                 row("random", "parry", &parry_all),
@@ -309,7 +383,10 @@ impl Case for Contact {
         let mut rows = Vec::new();
         for class in &p.classes {
             for (si, size) in p.sizes.iter().enumerate() {
-                let g: Vec<&Eval> = evals.iter().filter(|e| &e.class == class && e.size_index == si).collect();
+                let g: Vec<&Eval> = evals
+                    .iter()
+                    .filter(|e| &e.class == class && e.size_index == si)
+                    .collect();
                 let (o, q) = (group(&g, |e| e.ours), group(&g, |e| e.parry));
                 rows.push(vec![
                     class.clone(),
@@ -328,13 +405,33 @@ impl Case for Contact {
         ctx.text("Each cell: ours / parry. Errors relative to the particle size.");
         ctx.table(
             Some("by_class"),
-            &["class", "size (m)", "pairs", "wrong status", "over tol", "gap err max", "gap err p99", "gap err median", "normal err max", "point err max"],
+            &[
+                "class",
+                "size (m)",
+                "pairs",
+                "wrong status",
+                "over tol",
+                "gap err max",
+                "gap err p99",
+                "gap err median",
+                "normal err max",
+                "point err max",
+            ],
             &rows,
         )?;
 
         ctx.section("Where parry fails");
-        let mut worst: Vec<&Eval> = evals.iter().chain(deg_evals.iter()).filter(|e| e.parry.worst_ratio(e.tol) > 1.0).collect();
-        worst.sort_by(|a, b| b.parry.worst_ratio(b.tol).total_cmp(&a.parry.worst_ratio(a.tol)).then(a.id.cmp(&b.id)));
+        let mut worst: Vec<&Eval> = evals
+            .iter()
+            .chain(deg_evals.iter())
+            .filter(|e| e.parry.worst_ratio(e.tol) > 1.0)
+            .collect();
+        worst.sort_by(|a, b| {
+            b.parry
+                .worst_ratio(b.tol)
+                .total_cmp(&a.parry.worst_ratio(a.tol))
+                .then(a.id.cmp(&b.id))
+        });
         let n_fail = worst.len();
         worst.truncate(25);
         ctx.text(&format!(
@@ -360,7 +457,17 @@ impl Case for Contact {
             .collect();
         ctx.table(
             Some("parry_failures"),
-            &["pair", "exact kind", "exact overlap /size (< 0: gap)", "parry kind", "parry gap err /size", "parry normal err /size", "ours kind", "ours gap err /size", "ours normal err /size"],
+            &[
+                "pair",
+                "exact kind",
+                "exact overlap /size (< 0: gap)",
+                "parry kind",
+                "parry gap err /size",
+                "parry normal err /size",
+                "ours kind",
+                "ours gap err /size",
+                "ours normal err /size",
+            ],
             &fail_rows,
         )?;
 
@@ -383,7 +490,17 @@ impl Case for Contact {
             .collect();
         ctx.table(
             Some("degenerate"),
-            &["pair", "exact kind", "exact overlap /size (< 0: gap)", "ours kind", "ours gap err /size", "ours worst err/tol", "parry kind", "parry gap err /size", "parry worst err/tol"],
+            &[
+                "pair",
+                "exact kind",
+                "exact overlap /size (< 0: gap)",
+                "ours kind",
+                "ours gap err /size",
+                "ours worst err/tol",
+                "parry kind",
+                "parry gap err /size",
+                "parry worst err/tol",
+            ],
             &deg_rows,
         )?;
 
@@ -392,7 +509,15 @@ impl Case for Contact {
         let per = |n: u64, d: u64| if d == 0 { 0.0 } else { n as f64 / d as f64 };
         ctx.table(
             Some("counters"),
-            &["queries", "GJK runs", "GJK iterations/run", "EPA runs", "EPA iterations/run", "SAT fallbacks (max iterations)", "SAT fallbacks (degenerate)"],
+            &[
+                "queries",
+                "GJK runs",
+                "GJK iterations/run",
+                "EPA runs",
+                "EPA iterations/run",
+                "SAT fallbacks (max iterations)",
+                "SAT fallbacks (degenerate)",
+            ],
             &[vec![
                 c.polyhedron_polyhedron.to_string(),
                 c.gjk_runs.to_string(),
@@ -406,11 +531,22 @@ impl Case for Contact {
 
         // ---- plots --------------------------------------------------------------------------------
         ctx.section("Depth error against overlap");
-        let over: Vec<&Eval> = evals.iter().filter(|e| e.reference.kind == ContactKind::Overlap).collect();
+        let over: Vec<&Eval> = evals
+            .iter()
+            .filter(|e| e.reference.kind == ContactKind::Overlap)
+            .collect();
         let scatter = |label: &str, pick: &dyn Fn(&Eval) -> f64| Series {
             label: label.into(),
             style: SeriesStyle::Points,
-            points: over.iter().map(|e| (-e.reference.signed_gap / e.size, (pick(e) / e.size).max(PLOT_FLOOR))).collect(),
+            points: over
+                .iter()
+                .map(|e| {
+                    (
+                        -e.reference.signed_gap / e.size,
+                        (pick(e) / e.size).max(PLOT_FLOOR),
+                    )
+                })
+                .collect(),
         };
         let tol_line = Series {
             label: format!("tolerance {depth_abs:e} + {depth_rel:e}·overlap"),
@@ -434,7 +570,12 @@ impl Case for Contact {
 
         ctx.section("Error distribution");
         let cdf = |label: &str, pick: &dyn Fn(&Eval) -> f64| {
-            let s = sorted(evals.iter().map(|e| (pick(e) / e.size).max(PLOT_FLOOR)).collect());
+            let s = sorted(
+                evals
+                    .iter()
+                    .map(|e| (pick(e) / e.size).max(PLOT_FLOOR))
+                    .collect(),
+            );
             let n = s.len();
             let step = n.div_ceil(CDF_POINTS).max(1);
             let points = s
@@ -443,7 +584,11 @@ impl Case for Contact {
                 .filter(|(i, _)| i % step == 0 || *i + 1 == n)
                 .map(|(i, v)| (*v, (i + 1) as f64 / n as f64))
                 .collect();
-            Series { label: label.into(), style: SeriesStyle::Line, points }
+            Series {
+                label: label.into(),
+                style: SeriesStyle::Line,
+                points,
+            }
         };
         ctx.plot(&Plot {
             name: "error_cdf".into(),
@@ -470,18 +615,22 @@ impl Case for Contact {
             random
                 .iter()
                 .zip(&evals)
-                .filter(|(pair, e)| pair.class == class && e.size_index == timing_size && e.reference.kind == kind)
+                .filter(|(pair, e)| {
+                    pair.class == class && e.size_index == timing_size && e.reference.kind == kind
+                })
                 .take(p.timing_pairs_per_class)
                 .map(|(pair, _)| build(pair).map_err(case_err))
                 .collect()
         };
-        ctx.progress().stage("timing", (p.classes.len() + p.epa_gaps.len()) as u64);
+        ctx.progress()
+            .stage("timing", (p.classes.len() + p.epa_gaps.len()) as u64);
         let mut timing_rows = Vec::new();
         let mut pooled_overlap: Vec<Built> = Vec::new();
         for class in &p.classes {
             let ov = pick(class, ContactKind::Overlap)?;
             let sep = pick(class, ContactKind::Separated)?;
-            let ours_ns = timing::ours_query_ns(&ov, ContactTolerances::default(), p.timing_repeats);
+            let ours_ns =
+                timing::ours_query_ns(&ov, ContactTolerances::default(), p.timing_repeats);
             let parry_ns = timing::parry_query_ns(&ov, p.timing_repeats);
             let ours_sep = timing::ours_intersects_ns(&sep, p.timing_repeats);
             let parry_sep = timing::parry_intersects_ns(&sep, p.timing_repeats);
@@ -509,32 +658,66 @@ impl Case for Contact {
         );
         ctx.table(
             Some("timing"),
-            &["class", "overlapping pairs", "ours ns", "parry ns", "ratio", "separated pairs", "ours ns", "parry ns", "ratio"],
+            &[
+                "class",
+                "overlapping pairs",
+                "ours ns",
+                "parry ns",
+                "ratio",
+                "separated pairs",
+                "ours ns",
+                "parry ns",
+                "ratio",
+            ],
             &timing_rows,
         )?;
 
         // Work-precision: error over the pooled overlapping timing pairs, against ns per query.
-        let exact: Vec<f64> = pooled_overlap.iter().map(|b| sat(&b.pos1, &b.a, &b.pos2, &b.b).depth).collect();
-        let sizes: Vec<f64> = pooled_overlap.iter().map(|b| b.a.length_scale().max(b.b.length_scale())).collect();
+        let exact: Vec<f64> = pooled_overlap
+            .iter()
+            .map(|b| sat(&b.pos1, &b.a, &b.pos2, &b.b).depth)
+            .collect();
+        let sizes: Vec<f64> = pooled_overlap
+            .iter()
+            .map(|b| b.a.length_scale().max(b.b.length_scale()))
+            .collect();
         let max_err = |depths: &[f64]| {
-            depths.iter().zip(&exact).zip(&sizes).map(|((d, x), s)| ((d - x).abs() / s).max(PLOT_FLOOR)).fold(PLOT_FLOOR, f64::max)
+            depths
+                .iter()
+                .zip(&exact)
+                .zip(&sizes)
+                .map(|((d, x), s)| ((d - x).abs() / s).max(PLOT_FLOOR))
+                .fold(PLOT_FLOOR, f64::max)
         };
         let mut ours_pts = Vec::new();
         let mut wp_rows = Vec::new();
         for gap in &p.epa_gaps {
-            let tol = ContactTolerances { epa_gap: *gap, ..ContactTolerances::default() };
+            let tol = ContactTolerances {
+                epa_gap: *gap,
+                ..ContactTolerances::default()
+            };
             let mut o = Ours::new(tol);
-            let depths: Vec<f64> = pooled_overlap.iter().map(|b| o.query(&b.pos1, &b.a, &b.pos2, &b.b).depth).collect();
+            let depths: Vec<f64> = pooled_overlap
+                .iter()
+                .map(|b| o.query(&b.pos1, &b.a, &b.pos2, &b.b).depth)
+                .collect();
             let ns = timing::ours_query_ns(&pooled_overlap, tol, p.timing_repeats);
             let err = max_err(&depths);
             ours_pts.push((ns, err));
-            wp_rows.push(vec![format!("ours, epa_gap = {gap:e}"), format!("{ns:.0}"), e2(err)]);
+            wp_rows.push(vec![
+                format!("ours, epa_gap = {gap:e}"),
+                format!("{ns:.0}"),
+                e2(err),
+            ]);
             ctx.progress().inc(1);
         }
         let parry_depths: Vec<f64> = pooled_overlap
             .iter()
             .map(|b| {
-                let peer = crate::peers::parry::ParryPair { a: &b.parry_a, b: &b.parry_b };
+                let peer = crate::peers::parry::ParryPair {
+                    a: &b.parry_a,
+                    b: &b.parry_b,
+                };
                 match peer.contact(&b.pos1, &b.pos2, 0.0) {
                     Ok(Some(c)) => -c.signed_gap,
                     _ => f64::NAN,
@@ -544,8 +727,16 @@ impl Case for Contact {
         let parry_ns = timing::parry_query_ns(&pooled_overlap, p.timing_repeats);
         let parry_err = max_err(&parry_depths);
         let sat_ns = timing::sat_query_ns(&pooled_overlap, p.sat_timing_repeats);
-        wp_rows.push(vec!["parry3d-f64".into(), format!("{parry_ns:.0}"), e2(parry_err)]);
-        wp_rows.push(vec!["SAT oracle (the reference)".into(), format!("{sat_ns:.0}"), e2(PLOT_FLOOR)]);
+        wp_rows.push(vec![
+            "parry3d-f64".into(),
+            format!("{parry_ns:.0}"),
+            e2(parry_err),
+        ]);
+        wp_rows.push(vec![
+            "SAT oracle (the reference)".into(),
+            format!("{sat_ns:.0}"),
+            e2(PLOT_FLOOR),
+        ]);
         ctx.section("Work-precision: depth error against time per query");
         ctx.plot(&Plot {
             name: "work_precision".into(),
@@ -567,7 +758,11 @@ impl Case for Contact {
             ),
             legend: Legend::UpperRight,
         })?;
-        ctx.table(Some("work_precision_table"), &["method", "ns per query", "max depth err / size"], &wp_rows)?;
+        ctx.table(
+            Some("work_precision_table"),
+            &["method", "ns per query", "max depth err / size"],
+            &wp_rows,
+        )?;
         Ok(())
     }
 }

@@ -38,7 +38,10 @@ pub fn ours_query_ns(pairs: &[Built], tol: ContactTolerances, repeats: usize) ->
 pub fn parry_query_ns(pairs: &[Built], repeats: usize) -> f64 {
     ns_per_item(pairs.len(), repeats, |i| {
         let p = &pairs[i];
-        let peer = ParryPair { a: &p.parry_a, b: &p.parry_b };
+        let peer = ParryPair {
+            a: &p.parry_a,
+            b: &p.parry_b,
+        };
         let _ = black_box(peer.contact(&p.pos1, &p.pos2, 0.0));
     })
 }
@@ -64,7 +67,10 @@ pub fn ours_intersects_ns(pairs: &[Built], repeats: usize) -> f64 {
 pub fn parry_intersects_ns(pairs: &[Built], repeats: usize) -> f64 {
     ns_per_item(pairs.len(), repeats, |i| {
         let p = &pairs[i];
-        let peer = ParryPair { a: &p.parry_a, b: &p.parry_b };
+        let peer = ParryPair {
+            a: &p.parry_a,
+            b: &p.parry_b,
+        };
         black_box(peer.intersects(&p.pos1, &p.pos2));
     })
 }
