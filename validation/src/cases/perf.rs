@@ -216,7 +216,7 @@ impl Case for Perf {
             });
         }
         ctx.plot(&Plot {
-            name: "history".into(),
+            name: "ratio_history".into(),
             title: "Speed ratio ours / parry3d-f64 per figure, this machine".into(),
             x_label: "run number on this machine".into(),
             y_label: "time ratio ours / parry (lower is faster)".into(),
