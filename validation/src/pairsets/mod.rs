@@ -155,10 +155,24 @@ pub fn random_pair(
 /// Writes pairs as JSONL in the `polydem contact` input format: `{"id": ..., "a": [[x,y,z],...], "b": [...]}`.
 pub fn write_jsonl(path: &Path, pairs: &[Pair]) -> Result<(), SuiteError> {
     let mut f = std::io::BufWriter::new(std::fs::File::create(path).map_err(SuiteError::io(path))?);
+    #[derive(serde::Serialize)]
+    struct Line<'a> {
+        id: &'a str,
+        a: Vec<[f64; 3]>,
+        b: Vec<[f64; 3]>,
+    }
+    let pts = |v: &[Point]| v.iter().map(|q| [q.x, q.y, q.z]).collect::<Vec<_>>();
     for p in pairs {
-        let pts = |v: &[Point]| v.iter().map(|q| [q.x, q.y, q.z]).collect::<Vec<_>>();
-        let line = serde_json::json!({ "id": p.id, "a": pts(&p.a), "b": pts(&p.b) });
-        writeln!(f, "{line}").map_err(SuiteError::io(path))?;
+        let line = Line {
+            id: &p.id,
+            a: pts(&p.a),
+            b: pts(&p.b),
+        };
+        let text = serde_json::to_string(&line).map_err(|e| SuiteError::Case {
+            case: "pairsets".into(),
+            msg: format!("{}: {e}", p.id),
+        })?;
+        writeln!(f, "{text}").map_err(SuiteError::io(path))?;
     }
     f.flush().map_err(SuiteError::io(path))
 }

@@ -122,7 +122,7 @@ pub fn export_reference(dir: &Path, profile: Profile) -> Result<(), SuiteError> 
          | `random.jsonl` | {} | classes {}; particle sizes {:?} m; {} pairs per class and size; seed {}; overlaps and gaps log-uniform in [{:e}, {}] × size; {}% touching, {}% separated. These are the first pairs of the suite's own sets (each pair has its own seeded stream). |\n\
          | `degenerate.jsonl` | {} | the degenerate set (`validation/src/pairsets/degenerate.rs`) at the same sizes |\n\n\
          Ids are `class/s<size index>/<pair index>`. The exact answers come from the SAT oracle\n\
-         (`polydem::contact::sat`); no answers are stored here, so the files stay valid when the oracle's output\n\
+         of `polydem::contact`; no answers are stored here, so the files stay valid when the oracle's output\n\
          format changes.\n",
         profile.name(),
         random.len(),
