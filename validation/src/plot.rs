@@ -86,7 +86,7 @@ fn axis_label(v: f64, log: bool) -> String {
         if (v - v.round()).abs() < 1e-9 {
             format!("1e{}", v.round() as i64)
         } else {
-            format!("{p:.0e}")
+            format!("{p:.1e}")
         }
     } else if v != 0.0 && (v.abs() >= 1e4 || v.abs() < 1e-2) {
         format!("{v:.1e}")

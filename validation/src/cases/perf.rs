@@ -201,31 +201,36 @@ impl Case for Perf {
             &["figure", "ours ns", "parry ns", "ratio", "baseline ratio"],
             &rows,
         )?;
-        let mut series = Vec::new();
-        for (fig, _, _) in &figures {
-            let pts: Vec<(f64, f64)> = history
-                .iter()
-                .filter(|r| r.len() == HEADER.len() && r[2] == machine && &r[3] == fig)
-                .enumerate()
-                .filter_map(|(i, r)| Some(((i + 1) as f64, r[7].parse::<f64>().ok()?)))
-                .collect();
-            series.push(Series {
-                label: fig.clone(),
-                style: SeriesStyle::LinePoints,
-                points: pts,
-            });
+        for (prefix, what) in [
+            ("contact_overlap_", "overlapping pairs: contact query"),
+            ("reject_separated_", "separated pairs: intersection test"),
+        ] {
+            let mut series = Vec::new();
+            for (fig, _, _) in figures.iter().filter(|(f, _, _)| f.starts_with(prefix)) {
+                let pts: Vec<(f64, f64)> = history
+                    .iter()
+                    .filter(|r| r.len() == HEADER.len() && r[2] == machine && &r[3] == fig)
+                    .enumerate()
+                    .filter_map(|(i, r)| Some(((i + 1) as f64, r[7].parse::<f64>().ok()?)))
+                    .collect();
+                series.push(Series {
+                    label: fig.trim_start_matches(prefix).to_string(),
+                    style: SeriesStyle::LinePoints,
+                    points: pts,
+                });
+            }
+            ctx.plot(&Plot {
+                name: format!("{}history", prefix),
+                title: format!("Time ratio ours / parry3d-f64, {what}"),
+                x_label: "run number on this machine".into(),
+                y_label: "time ratio ours / parry (lower is faster)".into(),
+                x_log: false,
+                y_log: false,
+                series,
+                caption: "One point per `cargo validate perf` run on this machine, one line per shape class.".into(),
+                legend: Legend::LowerLeft,
+            })?;
         }
-        ctx.plot(&Plot {
-            name: "ratio_history".into(),
-            title: "Speed ratio ours / parry3d-f64 per figure, this machine".into(),
-            x_label: "run number on this machine".into(),
-            y_label: "time ratio ours / parry (lower is faster)".into(),
-            x_log: false,
-            y_log: true,
-            series,
-            caption: "One point per `cargo validate perf` run.".into(),
-            legend: Legend::UpperRight,
-        })?;
         Ok(())
     }
 }
