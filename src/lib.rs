@@ -10,11 +10,14 @@
 //! - [`shape`]: convex polyhedra (hull, adjacency, principal frame, mass properties), spheres, planes.
 //! - [`contact`]: support mapping, GJK, EPA, the exact SAT oracle, fast paths per shape pair, dispatch.
 //! - [`dynamics`]: body state, leapfrog translation, the symplectic splitting rotation (paper eqs. 18–25).
+//! - [`law`]: contact laws as pure functions (normal power law, restitution damping, tangential spring).
 //! - [`special_functions`]: elliptic integrals and Jacobi elliptic functions for the analytic references.
 //! - [`world`]: the many-body engine: broad phase, contact store, step pipeline.
 
 pub mod contact;
 pub mod dynamics;
+pub mod io;
+pub mod law;
 pub mod math;
 pub mod shape;
 pub mod special_functions;

@@ -142,6 +142,8 @@ pub fn principal_frame(inertia: &Matrix) -> (Vector, Rotation) {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use rand::{Rng, SeedableRng};
+    use rand_chacha::ChaCha8Rng;
 
     fn cuboid(a: Real, b: Real, c: Real) -> (Vec<Point>, Vec<Vec<u32>>) {
         let (x, y, z) = (a / 2.0, b / 2.0, c / 2.0);
@@ -212,6 +214,206 @@ mod tests {
                 .matrix()
                 .determinant()
                 > 0.0
+        );
+    }
+
+    fn regular_tetrahedron(edge: Real) -> (Vec<Point>, Vec<Vec<u32>>) {
+        // Alternate corners of a cube of side edge/√2.
+        let h = edge / (2.0 * 2.0_f64.sqrt());
+        let vertices = vec![
+            Point::new(h, h, h),
+            Point::new(h, -h, -h),
+            Point::new(-h, h, -h),
+            Point::new(-h, -h, h),
+        ];
+        let faces = vec![vec![0, 1, 2], vec![0, 3, 1], vec![0, 2, 3], vec![1, 3, 2]];
+        (vertices, faces)
+    }
+
+    fn regular_octahedron(edge: Real) -> (Vec<Point>, Vec<Vec<u32>>) {
+        let r = edge / 2.0_f64.sqrt();
+        let vertices = vec![
+            Point::new(r, 0.0, 0.0),
+            Point::new(-r, 0.0, 0.0),
+            Point::new(0.0, r, 0.0),
+            Point::new(0.0, -r, 0.0),
+            Point::new(0.0, 0.0, r),
+            Point::new(0.0, 0.0, -r),
+        ];
+        let faces = vec![
+            vec![0, 2, 4],
+            vec![2, 1, 4],
+            vec![1, 3, 4],
+            vec![3, 0, 4],
+            vec![2, 0, 5],
+            vec![1, 2, 5],
+            vec![3, 1, 5],
+            vec![0, 3, 5],
+        ];
+        (vertices, faces)
+    }
+
+    #[test]
+    fn regular_tetrahedron_matches_closed_form() {
+        let a = 1.7;
+        let (vertices, faces) = regular_tetrahedron(a);
+        let mp = polyhedron_mass_properties(&vertices, &faces);
+        let v = a.powi(3) / (6.0 * 2.0_f64.sqrt());
+        let i = v * a * a / 20.0;
+        assert_close("tetrahedron volume", mp.volume, v, 1e-14 * v);
+        assert_close(
+            "tetrahedron centroid",
+            mp.centroid.coords.norm(),
+            0.0,
+            1e-15 * a,
+        );
+        for k in 0..3 {
+            assert_close(
+                &format!("tetrahedron principal moment {k}"),
+                mp.principal_moments[k],
+                i,
+                1e-13 * i,
+            );
+        }
+        let off_diagonal = (mp.inertia - Matrix::identity() * i).norm();
+        assert_close(
+            "tetrahedron inertia is isotropic",
+            off_diagonal,
+            0.0,
+            1e-13 * i,
+        );
+    }
+
+    #[test]
+    fn regular_octahedron_matches_closed_form() {
+        let a = 0.6;
+        let (vertices, faces) = regular_octahedron(a);
+        let mp = polyhedron_mass_properties(&vertices, &faces);
+        let v = 2.0_f64.sqrt() / 3.0 * a.powi(3);
+        let i = v * a * a / 10.0;
+        assert_close("octahedron volume", mp.volume, v, 1e-14 * v);
+        for k in 0..3 {
+            assert_close(
+                &format!("octahedron principal moment {k}"),
+                mp.principal_moments[k],
+                i,
+                1e-13 * i,
+            );
+        }
+    }
+
+    fn random_pose(rng: &mut ChaCha8Rng) -> crate::math::Pose {
+        let axis = Vector::new(
+            rng.random_range(-1.0..1.0),
+            rng.random_range(-1.0..1.0),
+            rng.random_range(-1.0..1.0),
+        );
+        let rotation = Rotation::from_scaled_axis(
+            axis.normalize() * rng.random_range(0.0..std::f64::consts::PI),
+        );
+        let shift = Vector::new(
+            rng.random_range(-100.0..100.0),
+            rng.random_range(-100.0..100.0),
+            rng.random_range(-100.0..100.0),
+        );
+        crate::math::Pose::from_parts(shift.into(), rotation)
+    }
+
+    #[test]
+    fn mass_properties_are_invariant_under_rigid_motion() {
+        let mut rng = ChaCha8Rng::seed_from_u64(2021);
+        let (a, b, c) = (0.5, 1.25, 2.0);
+        let (vertices, faces) = cuboid(a, b, c);
+        let reference = polyhedron_mass_properties(&vertices, &faces);
+        for case in 0..50 {
+            let pose = random_pose(&mut rng);
+            let moved: Vec<Point> = vertices.iter().map(|v| pose * v).collect();
+            let mp = polyhedron_mass_properties(&moved, &faces);
+            let tol = 1e-12;
+            assert_close(
+                &format!("case {case}: volume"),
+                mp.volume,
+                reference.volume,
+                tol * reference.volume,
+            );
+            assert_close(
+                &format!("case {case}: centroid vs pose translation"),
+                (mp.centroid.coords - pose.translation.vector).norm(),
+                0.0,
+                tol * 100.0,
+            );
+            for k in 0..3 {
+                assert_close(
+                    &format!("case {case}: principal moment {k}"),
+                    mp.principal_moments[k],
+                    reference.principal_moments[k],
+                    tol * reference.principal_moments[2],
+                );
+            }
+            // Distinct moments: each principal axis is the image of a cuboid axis (up to sign). The smallest
+            // moment belongs to the longest side c (z), the largest to the shortest side a (x).
+            let axes = mp.principal_axes.to_rotation_matrix();
+            let rotation = pose.rotation.to_rotation_matrix();
+            for (k, cuboid_axis) in [2usize, 1, 0].into_iter().enumerate() {
+                let alignment = axes
+                    .matrix()
+                    .column(k)
+                    .dot(&rotation.matrix().column(cuboid_axis))
+                    .abs();
+                assert_close(
+                    &format!("case {case}: principal axis {k} alignment"),
+                    alignment,
+                    1.0,
+                    1e-9,
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn volume_scales_cubically_and_inertia_to_the_fifth_power() {
+        let (vertices, faces) = regular_octahedron(1.0);
+        let reference = polyhedron_mass_properties(&vertices, &faces);
+        for s in [1e-3, 0.37, 12.0, 1e3] {
+            let scaled: Vec<Point> = vertices.iter().map(|v| v * s).collect();
+            let mp = polyhedron_mass_properties(&scaled, &faces);
+            let v = reference.volume * s.powi(3);
+            assert_close(&format!("volume at scale {s}"), mp.volume, v, 1e-13 * v);
+            for k in 0..3 {
+                let i = reference.principal_moments[k] * s.powi(5);
+                assert_close(
+                    &format!("moment {k} at scale {s}"),
+                    mp.principal_moments[k],
+                    i,
+                    1e-13 * i,
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn density_scales_mass_and_inertia() {
+        let (vertices, faces) = cuboid(1.0, 2.0, 3.0);
+        let mp = polyhedron_mass_properties(&vertices, &faces);
+        let density = 2650.0;
+        assert_close(
+            "mass",
+            mp.mass(density),
+            6.0 * density,
+            1e-12 * 6.0 * density,
+        );
+        let expected_x = 6.0 * density * (4.0 + 9.0) / 12.0;
+        assert_close(
+            "I_max",
+            mp.principal_inertia(density)[2],
+            expected_x,
+            1e-12 * expected_x,
+        );
+        assert_close(
+            "tensor I_xx",
+            mp.inertia_tensor(density)[(0, 0)],
+            expected_x,
+            1e-12 * expected_x,
         );
     }
 }

@@ -32,16 +32,6 @@ pub struct Series {
     pub points: Vec<(f64, f64)>,
 }
 
-/// Where the legend box goes.
-#[derive(Copy, Clone, Debug, PartialEq, Eq, Default)]
-pub enum Legend {
-    #[default]
-    UpperLeft,
-    UpperRight,
-    LowerLeft,
-    LowerRight,
-}
-
 /// A plot: title, axis labels (with units), axis scales and series.
 #[derive(Clone, Debug)]
 pub struct Plot {
@@ -55,7 +45,6 @@ pub struct Plot {
     pub series: Vec<Series>,
     /// Markdown text shown under the plot.
     pub caption: String,
-    pub legend: Legend,
 }
 
 const COLORS: [RGBColor; 8] = [
@@ -115,6 +104,55 @@ fn padded_range(lo: f64, hi: f64, log: bool) -> (f64, f64) {
         let pad = if lo == 0.0 { 1.0 } else { 0.1 * lo.abs() };
         (lo - pad, hi + pad)
     }
+}
+
+/// The corner of the plot area with the fewest data points (ties: upper left, upper right, lower left,
+/// lower right), so the legend hides as little as possible. A corner is the 40 % × 40 % box of the
+/// (transformed) axis ranges.
+fn legend_corner(data: &[Vec<(f64, f64)>], xr: (f64, f64), yr: (f64, f64)) -> SeriesLabelPosition {
+    let (wx, wy) = (0.4 * (xr.1 - xr.0), 0.4 * (yr.1 - yr.0));
+    let corners = [
+        (
+            SeriesLabelPosition::UpperLeft,
+            xr.0,
+            xr.0 + wx,
+            yr.1 - wy,
+            yr.1,
+        ),
+        (
+            SeriesLabelPosition::UpperRight,
+            xr.1 - wx,
+            xr.1,
+            yr.1 - wy,
+            yr.1,
+        ),
+        (
+            SeriesLabelPosition::LowerLeft,
+            xr.0,
+            xr.0 + wx,
+            yr.0,
+            yr.0 + wy,
+        ),
+        (
+            SeriesLabelPosition::LowerRight,
+            xr.1 - wx,
+            xr.1,
+            yr.0,
+            yr.0 + wy,
+        ),
+    ];
+    let mut best = (usize::MAX, SeriesLabelPosition::UpperLeft);
+    for (pos, xa, xb, ya, yb) in corners {
+        let n = data
+            .iter()
+            .flatten()
+            .filter(|(x, y)| *x >= xa && *x <= xb && *y >= ya && *y <= yb)
+            .count();
+        if n < best.0 {
+            best = (n, pos);
+        }
+    }
+    best.1
 }
 
 impl Plot {
@@ -241,12 +279,7 @@ impl Plot {
                 .background_style(WHITE.mix(0.85))
                 .border_style(BLACK)
                 .label_font(("sans-serif", 14))
-                .position(match self.legend {
-                    Legend::UpperLeft => SeriesLabelPosition::UpperLeft,
-                    Legend::UpperRight => SeriesLabelPosition::UpperRight,
-                    Legend::LowerLeft => SeriesLabelPosition::LowerLeft,
-                    Legend::LowerRight => SeriesLabelPosition::LowerRight,
-                })
+                .position(legend_corner(&data, (x0, x1), (y0, y1)))
                 .draw()
                 .map_err(|e| e.to_string())?;
             root.present().map_err(|e| e.to_string())?;
@@ -281,7 +314,6 @@ mod tests {
                 },
             ],
             caption: String::new(),
-            legend: Legend::UpperLeft,
         };
         let mut svg = String::new();
         plot.render(&mut svg).unwrap();

@@ -13,7 +13,7 @@ use crate::cases::contact::{random_set, timing};
 use crate::context::CaseContext;
 use crate::error::SuiteError;
 use crate::pairsets::{Intent, RandomSetSpec};
-use crate::plot::{Legend, Plot, Series, SeriesStyle};
+use crate::plot::{Plot, Series, SeriesStyle};
 use crate::provenance::Provenance;
 
 /// The case (registered in [`crate::cases::registry`]).
@@ -228,7 +228,6 @@ impl Case for Perf {
                 y_log: false,
                 series,
                 caption: "One point per `cargo validate perf` run on this machine, one line per shape class.".into(),
-                legend: Legend::LowerLeft,
             })?;
         }
         Ok(())

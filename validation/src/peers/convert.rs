@@ -1,8 +1,8 @@
 //! Every conversion between polydem's nalgebra types and the glam types of parry3d-f64 0.31 used by the
-//! harness, in one place.
+//! harness, in one place. rapier3d-f64 0.36 uses the same glam types (through parry3d-f64 0.31).
 
 use parry3d_f64::math::{Pose as GlamPose, Rot3 as GlamRot, Vector as GlamVec};
-use polydem::math::{Point, Pose, Vector};
+use polydem::math::{Point, Pose, Rotation, Vector};
 
 /// nalgebra point → glam vector.
 pub fn point_to_glam(p: &Point) -> GlamVec {
@@ -32,10 +32,21 @@ pub fn pose_to_glam(p: &Pose) -> GlamPose {
     GlamPose::from_parts(vector_to_glam(&p.translation.vector), rot)
 }
 
+/// nalgebra unit quaternion → glam quaternion (components copied, no re-normalisation).
+pub fn rotation_to_glam(r: &Rotation) -> GlamRot {
+    let q = r.quaternion();
+    GlamRot::from_xyzw(q.i, q.j, q.k, q.w)
+}
+
+/// glam quaternion → nalgebra unit quaternion (components copied; the caller's quaternion is unit up to
+/// round-off, so no re-normalisation is done either).
+pub fn glam_to_rotation(r: GlamRot) -> Rotation {
+    Rotation::new_unchecked(nalgebra::Quaternion::new(r.w, r.x, r.y, r.z))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
-    use polydem::math::Rotation;
 
     #[test]
     fn pose_conversion_maps_points_identically() {
@@ -47,5 +58,15 @@ mod tests {
         let a = pose * p;
         let b = glam_to_point(pose_to_glam(&pose).transform_point(point_to_glam(&p)));
         assert!((a - b).norm() < 1e-14, "nalgebra {a} vs glam {b}");
+    }
+
+    #[test]
+    fn rotation_conversion_round_trips_and_rotates_identically() {
+        let r = Rotation::from_scaled_axis(Vector::new(-0.4, 1.3, 0.2));
+        let v = Vector::new(0.3, -1.0, 2.0);
+        let a = r.transform_vector(&v);
+        let b = glam_to_vector(rotation_to_glam(&r) * vector_to_glam(&v));
+        assert!((a - b).norm() < 1e-14, "nalgebra {a} vs glam {b}");
+        assert_eq!(glam_to_rotation(rotation_to_glam(&r)), r);
     }
 }

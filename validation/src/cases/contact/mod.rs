@@ -20,7 +20,7 @@ use crate::case::{Case, CaseData, Profile, Target};
 use crate::context::CaseContext;
 use crate::error::SuiteError;
 use crate::pairsets::{self, degenerate::degenerate_set, Pair, RandomSetSpec};
-use crate::plot::{Legend, Plot, Series, SeriesStyle};
+use crate::plot::{Plot, Series, SeriesStyle};
 use eval::{build, evaluate, Built, Errors, Eval};
 use ours::{sat, Ours};
 
@@ -565,7 +565,6 @@ impl Case for Contact {
             y_log: true,
             series: vec![scatter("ours (GJK/EPA)", &|e| e.ours.gap), scatter("parry3d-f64", &|e| e.parry.gap), tol_line],
             caption: format!("All sizes pooled. Errors below {PLOT_FLOOR:e} × size (including exact zeros) are drawn at {PLOT_FLOOR:e}."),
-            legend: Legend::UpperLeft,
         })?;
 
         ctx.section("Error distribution");
@@ -602,7 +601,6 @@ impl Case for Contact {
                 "Errors below {PLOT_FLOOR:e} × size are drawn at {PLOT_FLOOR:e}. Lines drawn through at most \
                  {CDF_POINTS} ranks per method (the CSV has the same points)."
             ),
-            legend: Legend::LowerRight,
         })?;
 
         // ---- timing and work-precision ------------------------------------------------------------
@@ -756,7 +754,6 @@ impl Case for Contact {
                  answer would count as an infinite error.",
                 pooled_overlap.len()
             ),
-            legend: Legend::UpperRight,
         })?;
         ctx.table(
             Some("work_precision_table"),

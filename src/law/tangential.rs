@@ -1,0 +1,252 @@
+//! Tangential law: an incremental spring with a Coulomb cap (the paper's "classic Coulomb friction law").
+//!
+//! Per contact the caller stores a [`TangentialHistory`]: the accumulated tangential displacement u (m, of
+//! B relative to A, world frame, in the tangent plane) and the normal it was last expressed in. Each
+//! evaluation:
+//! 1. rotates u into the current tangent plane by the smallest rotation taking the stored normal to the
+//!    current one (Rodrigues), then removes any remaining normal component (round-off) keeping |u|;
+//! 2. adds the tangential relative displacement of this step, u ← u + v_t Δt;
+//! 3. forms the trial force F_t = −k_t u (on B);
+//! 4. caps it: if |F_t| > μ F_n (F_n the compressive normal force, ≥ 0), F_t ← μ F_n F_t/|F_t| and
+//!    u ← −F_t / k_t (sliding); the friction work dissipated in this step is μ F_n |u_trial − u|.
+//!
+//! Spring energy: ½ k_t |u|² (exact for a constant k_t; for the Mindlin k_t ∝ δ^(1/2) it is the usual
+//! instantaneous estimate, as YADE's `shearEnergy`).
+//!
+//! Pair order: the history belongs to the ordered pair (A, B). If the caller swaps the order, n and u change
+//! sign: use [`TangentialHistory::swapped`].
+
+use super::{check_range, LawError};
+use crate::math::{Real, Vector};
+
+/// The per-contact tangential state, stored by the caller (the contact store), keyed by the ordered pair.
+#[derive(Clone, Copy, Debug, PartialEq, Default, serde::Serialize, serde::Deserialize)]
+pub struct TangentialHistory {
+    /// Accumulated tangential displacement of B relative to A (m), world frame.
+    pub displacement: Vector,
+    /// The contact normal (A → B) the displacement was last expressed in; zero for a new contact.
+    pub normal: Vector,
+}
+
+impl TangentialHistory {
+    /// The same history seen from the swapped pair (B, A).
+    pub fn swapped(&self) -> Self {
+        Self {
+            displacement: -self.displacement,
+            normal: -self.normal,
+        }
+    }
+}
+
+/// The tangential slot.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case", deny_unknown_fields)]
+pub enum TangentialLaw {
+    /// Frictionless.
+    None,
+    /// Constant stiffness k_t (N/m) and friction coefficient μ.
+    Spring { stiffness: Real, friction: Real },
+    /// Mindlin no-slip stiffness k_t = coefficient · δ^(1/2) (coefficient = 8 G* √R*, N/m^1.5), friction μ.
+    Mindlin { coefficient: Real, friction: Real },
+}
+
+impl TangentialLaw {
+    /// Validated constant-stiffness spring.
+    pub fn spring(stiffness: Real, friction: Real) -> Result<Self, LawError> {
+        check_range(
+            "tangential stiffness k_t",
+            stiffness,
+            0.0,
+            Real::MAX,
+            true,
+            "(0, ∞)",
+        )?;
+        check_range("friction μ", friction, 0.0, Real::MAX, false, "[0, ∞)")?;
+        Ok(Self::Spring {
+            stiffness,
+            friction,
+        })
+    }
+
+    /// The tangential stiffness (N/m) at overlap δ, and μ.
+    pub fn stiffness_and_friction(&self, overlap: Real) -> (Real, Real) {
+        match *self {
+            Self::None => (0.0, 0.0),
+            Self::Spring {
+                stiffness,
+                friction,
+            } => (stiffness, friction),
+            Self::Mindlin {
+                coefficient,
+                friction,
+            } => (coefficient * overlap.max(0.0).sqrt(), friction),
+        }
+    }
+}
+
+/// The result of one tangential evaluation.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TangentialResponse {
+    /// Tangential force on B (N), world frame.
+    pub force: Vector,
+    /// True when the Coulomb cap was active.
+    pub sliding: bool,
+    /// Friction work dissipated in this step (J, ≥ 0).
+    pub friction_dissipation: Real,
+    /// Spring energy ½ k_t |u|² after the step (J).
+    pub spring_energy: Real,
+}
+
+/// Rotates the displacement `u` expressed against `old_normal` into the plane perpendicular to `new_normal`
+/// (smallest rotation taking one normal to the other), keeping its length. A zero `old_normal` (new contact)
+/// only projects.
+pub fn rotate_into_tangent_plane(u: &Vector, old_normal: &Vector, new_normal: &Vector) -> Vector {
+    let length = u.norm();
+    if length == 0.0 {
+        return Vector::zeros();
+    }
+    let mut rotated = *u;
+    let axis = old_normal.cross(new_normal);
+    let sin = axis.norm();
+    let cos = old_normal.dot(new_normal);
+    if sin > 0.0 && old_normal.norm_squared() > 0.0 {
+        // Rodrigues with unit axis k = axis/sin: v cosθ + (k × v) sinθ + k (k·v)(1 − cosθ).
+        let k = axis / sin;
+        rotated = u * cos + k.cross(u) * sin + k * (k.dot(u) * (1.0 - cos));
+    }
+    // Remove round-off (or, for an opposite or unknown old normal, the whole) normal component.
+    rotated -= new_normal * rotated.dot(new_normal);
+    let projected = rotated.norm();
+    if projected == 0.0 {
+        Vector::zeros()
+    } else {
+        rotated * (length / projected)
+    }
+}
+
+/// One incremental step of the spring with Coulomb cap (see the module docs). `normal_force` is the
+/// compressive normal force magnitude (negative values are treated as zero: no friction without
+/// compression). `history` is updated in place.
+pub fn incremental_spring(
+    stiffness: Real,
+    friction: Real,
+    normal: &Vector,
+    normal_force: Real,
+    tangential_velocity: &Vector,
+    dt: Real,
+    history: &mut TangentialHistory,
+) -> TangentialResponse {
+    let mut u = rotate_into_tangent_plane(&history.displacement, &history.normal, normal);
+    u += tangential_velocity * dt;
+    let mut force = -stiffness * u;
+    let cap = friction * normal_force.max(0.0);
+    let magnitude = force.norm();
+    let mut sliding = false;
+    let mut friction_dissipation = 0.0;
+    if magnitude > cap {
+        sliding = true;
+        force *= if magnitude > 0.0 {
+            cap / magnitude
+        } else {
+            0.0
+        };
+        let u_capped = if stiffness > 0.0 {
+            -force / stiffness
+        } else {
+            Vector::zeros()
+        };
+        friction_dissipation = cap * (u - u_capped).norm();
+        u = u_capped;
+    }
+    history.displacement = u;
+    history.normal = *normal;
+    TangentialResponse {
+        force,
+        sliding,
+        friction_dissipation,
+        spring_energy: 0.5 * stiffness * u.norm_squared(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::math::Rotation;
+
+    #[test]
+    fn spring_is_rotated_rigidly_with_the_normal() {
+        let n_old = Vector::new(0.0, 0.0, 1.0);
+        let u = Vector::new(2e-5, -1e-5, 0.0);
+        let turn = Rotation::from_scaled_axis(Vector::new(0.3, -0.2, 0.0));
+        let n_new = turn.transform_vector(&n_old);
+        let rotated = rotate_into_tangent_plane(&u, &n_old, &n_new);
+        // The smallest rotation taking n_old to n_new is `turn` itself (its axis is perpendicular to n_old).
+        let expected = turn.transform_vector(&u);
+        assert!(
+            (rotated - expected).norm() < 1e-15 * u.norm() * 10.0,
+            "rotated spring {rotated:?}, expected {expected:?}"
+        );
+        assert!(
+            rotated.dot(&n_new).abs() < 1e-16 * u.norm() * 10.0,
+            "spring not in the new tangent plane"
+        );
+        assert!(
+            (rotated.norm() - u.norm()).abs() < 1e-15 * u.norm() * 10.0,
+            "length changed"
+        );
+    }
+
+    #[test]
+    fn coulomb_cap_limits_the_force_and_counts_the_slip_work() {
+        let normal = Vector::new(0.0, 0.0, 1.0);
+        let (k, mu, fn_) = (1e5, 0.3, 10.0);
+        let mut history = TangentialHistory::default();
+        let v = Vector::new(0.21, 0.0, 0.0);
+        let dt = 1e-5;
+        let mut dissipated = 0.0;
+        let mut slip_onset = None;
+        for step in 0..200 {
+            let r = incremental_spring(k, mu, &normal, fn_, &v, dt, &mut history);
+            assert!(
+                r.force.norm() <= mu * fn_ * (1.0 + 1e-15),
+                "|F_t| = {} above μF_n = {}",
+                r.force.norm(),
+                mu * fn_
+            );
+            if r.sliding && slip_onset.is_none() {
+                slip_onset = Some(step);
+            }
+            dissipated += r.friction_dissipation;
+        }
+        // Sticking while k|u| ≤ μF_n = 3 N: after step i, k|u| = 0.21 (i + 1) N, first above 3 N at i = 14.
+        let onset = slip_onset.expect("never slid");
+        assert_eq!(
+            onset, 14,
+            "slip onset at step {onset}, expected 14 (k v Δt (i+1) > μ F_n)"
+        );
+        // Work balance: total tangential displacement = spring stretch + slip; dissipated = μF_n · slip.
+        let total = v.norm() * dt * 200.0;
+        let slip = total - mu * fn_ / k;
+        let expected = mu * fn_ * slip;
+        assert!(
+            (dissipated - expected).abs() < 1e-12 * expected,
+            "dissipated {dissipated}, expected μF_n·slip = {expected}"
+        );
+        // No compression, no friction.
+        let mut h = TangentialHistory::default();
+        let r = incremental_spring(k, mu, &normal, -5.0, &v, dt, &mut h);
+        assert_eq!(r.force, Vector::zeros());
+    }
+
+    #[test]
+    fn swapping_the_pair_flips_the_history() {
+        let h = TangentialHistory {
+            displacement: Vector::new(1e-6, 2e-6, 0.0),
+            normal: Vector::new(0.0, 0.0, 1.0),
+        };
+        let s = h.swapped();
+        assert_eq!(s.displacement, -h.displacement);
+        assert_eq!(s.normal, -h.normal);
+        assert_eq!(s.swapped(), h);
+    }
+}
