@@ -3,7 +3,44 @@
 //! The narrow phase answers one question per pair — where and how much do these two shapes overlap — and
 //! returns a [`ContactGeometry`]. It never computes forces: contact laws live elsewhere and consume the
 //! geometry.
+//!
+//! Files, one job each: [`minkowski`] (support of A ⊖ B), [`gjk`], [`epa`], [`sat`] (exact oracle and
+//! fallback), [`features`] (closest points of small features), one file per shape pair, [`counters`],
+//! [`tolerances`].
 
+pub mod contact_polyhedron_plane;
+pub mod contact_polyhedron_polyhedron;
+pub mod contact_sphere_plane;
+pub mod contact_sphere_polyhedron;
+pub mod contact_sphere_sphere;
+pub mod counters;
+pub mod dispatch;
+pub mod epa;
+pub mod features;
 mod geometry;
+pub mod gjk;
+pub mod minkowski;
+pub mod sat;
+pub mod tolerances;
 
+#[cfg(test)]
+pub(crate) mod testing;
+#[cfg(test)]
+mod tests_degenerate;
+#[cfg(test)]
+mod tests_oracle;
+
+pub use contact_polyhedron_plane::contact_plane_polytope;
+pub use contact_polyhedron_polyhedron::{
+    intersect_polyhedra_cached, intersect_polytopes_cached, query_polyhedra,
+    query_polyhedra_cached, query_polyhedra_with, query_polytopes_cached, sat_polyhedra, PairCache,
+};
+pub use contact_sphere_plane::contact_plane_sphere;
+pub use contact_sphere_polyhedron::contact_polytope_sphere;
+pub use contact_sphere_sphere::contact_sphere_sphere;
+pub use counters::QueryCounters;
+pub use dispatch::{query, query_with, swap_pair, ContactError};
+pub use epa::EpaScratch;
 pub use geometry::{ContactGeometry, ContactKind, SolverStatus};
+pub use sat::{sat_polytopes, Polytope};
+pub use tolerances::ContactTolerances;

@@ -1,0 +1,99 @@
+//! Sphere–sphere contact, in closed form.
+//!
+//! With centres c_A, c_B at distance d and radii r_A, r_B: n = (c_B − c_A)/d, δ = r_A + r_B − d,
+//! c1 = c_A + r_A n, c2 = c_B − r_B n (so c1 − c2 = δ n). Concentric spheres have no preferred direction;
+//! the normal is then the world x axis, deterministically. Exact up to round-off; status `Exact`.
+
+use super::tolerances::ContactTolerances;
+use super::{ContactGeometry, ContactKind, SolverStatus};
+use crate::math::{Point, Real, Vector};
+
+/// Contact of the sphere (centre `c1`, radius `r1`) with the sphere (`c2`, `r2`), world frame.
+pub fn contact_sphere_sphere(
+    c1: &Point,
+    r1: Real,
+    c2: &Point,
+    r2: Real,
+    tol: &ContactTolerances,
+) -> ContactGeometry {
+    let scale = 2.0 * r1.max(r2);
+    let touch = tol.touching * scale;
+    let d_vec = c2 - c1;
+    let d = d_vec.norm();
+    let normal = if d > 0.0 { d_vec / d } else { Vector::x() };
+    let point_a = c1 + normal * r1;
+    let point_b = c2 - normal * r2;
+    let signed = r1 + r2 - d;
+    let (kind, depth, distance) = classify(signed, touch);
+    ContactGeometry {
+        kind,
+        depth,
+        distance,
+        normal,
+        point_a,
+        point_b,
+        point: nalgebra::center(&point_a, &point_b),
+        status: SolverStatus::Exact,
+    }
+}
+
+/// Kind, depth and distance from a signed overlap (positive = overlap) and the touching band.
+pub(crate) fn classify(signed: Real, touch: Real) -> (ContactKind, Real, Real) {
+    if signed > touch {
+        (ContactKind::Overlap, signed, 0.0)
+    } else if signed < -touch {
+        (ContactKind::Separated, 0.0, -signed)
+    } else {
+        (ContactKind::Touching, 0.0, 0.0)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn overlapping_spheres_closed_form() {
+        let tol = ContactTolerances::default();
+        for scale in [1e-3, 1.0, 1e3] {
+            let g = contact_sphere_sphere(
+                &Point::new(0.0, 0.0, 0.0),
+                1.0 * scale,
+                &Point::new(3.0, 4.0, 0.0).map(|x| x * scale * 0.3),
+                0.6 * scale,
+                &tol,
+            );
+            // d = 1.5 s, δ = 1.6 s − 1.5 s = 0.1 s.
+            let want = 0.1 * scale;
+            assert_eq!(g.kind, ContactKind::Overlap, "scale {scale}: {g:?}");
+            assert!(
+                (g.depth - want).abs() <= 1e-14 * scale,
+                "depth {} want {want}",
+                g.depth
+            );
+            assert!(
+                (g.normal - Vector::new(0.6, 0.8, 0.0)).norm() < 1e-15,
+                "normal {:?}",
+                g.normal
+            );
+            let diff = (g.point_a - g.point_b) - g.normal * g.depth;
+            assert!(diff.norm() <= 1e-14 * scale, "c1 − c2 − δn = {diff:?}");
+        }
+    }
+
+    #[test]
+    fn separated_and_touching_spheres() {
+        let tol = ContactTolerances::default();
+        let g = contact_sphere_sphere(&Point::origin(), 1.0, &Point::new(0.0, 0.0, 2.5), 1.0, &tol);
+        assert_eq!(g.kind, ContactKind::Separated);
+        assert!((g.distance - 0.5).abs() < 1e-15, "distance {}", g.distance);
+        let g = contact_sphere_sphere(&Point::origin(), 1.0, &Point::new(0.0, 0.0, 2.0), 1.0, &tol);
+        assert_eq!(g.kind, ContactKind::Touching, "{g:?}");
+        let g = contact_sphere_sphere(&Point::origin(), 1.0, &Point::origin(), 0.5, &tol);
+        assert_eq!(g.kind, ContactKind::Overlap);
+        assert!(
+            (g.depth - 1.5).abs() < 1e-15 && g.normal == Vector::x(),
+            "{g:?}"
+        );
+    }
+}

@@ -1,0 +1,115 @@
+//! Counters of the narrow phase: how many queries of each kind ran, how many solver iterations they took and
+//! how often the exact fallback was needed, and why.
+//!
+//! The caller owns a [`QueryCounters`] and passes it by `&mut` to the hot-path queries; nothing is global.
+//! Counters of several threads are combined with [`QueryCounters::merge`].
+
+use std::fmt;
+
+/// Per-caller statistics of contact queries.
+#[derive(Copy, Clone, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub struct QueryCounters {
+    /// Queries answered, by the pair kind.
+    pub polyhedron_polyhedron: u64,
+    pub sphere_sphere: u64,
+    pub sphere_plane: u64,
+    pub polyhedron_plane: u64,
+    pub sphere_polyhedron: u64,
+    /// Pairs rejected by the bounding spheres before any support call.
+    pub bounding_sphere_rejections: u64,
+    /// Pairs rejected by the cached separating direction (one support call per shape).
+    pub cached_axis_rejections: u64,
+    /// GJK runs and their total iterations.
+    pub gjk_runs: u64,
+    pub gjk_iterations: u64,
+    /// EPA runs and their total iterations.
+    pub epa_runs: u64,
+    pub epa_iterations: u64,
+    /// Exact SAT fallbacks after GJK or EPA hit its iteration cap.
+    pub fallback_max_iterations: u64,
+    /// Exact SAT fallbacks after GJK or EPA met a degenerate configuration (flat start, broken horizon,
+    /// buffer full).
+    pub fallback_degenerate: u64,
+    /// Results by kind.
+    pub overlapping: u64,
+    pub touching: u64,
+    pub separated: u64,
+}
+
+impl QueryCounters {
+    /// Adds the counts of `other` (e.g. of another thread) to `self`.
+    pub fn merge(&mut self, other: &QueryCounters) {
+        self.polyhedron_polyhedron += other.polyhedron_polyhedron;
+        self.sphere_sphere += other.sphere_sphere;
+        self.sphere_plane += other.sphere_plane;
+        self.polyhedron_plane += other.polyhedron_plane;
+        self.sphere_polyhedron += other.sphere_polyhedron;
+        self.bounding_sphere_rejections += other.bounding_sphere_rejections;
+        self.cached_axis_rejections += other.cached_axis_rejections;
+        self.gjk_runs += other.gjk_runs;
+        self.gjk_iterations += other.gjk_iterations;
+        self.epa_runs += other.epa_runs;
+        self.epa_iterations += other.epa_iterations;
+        self.fallback_max_iterations += other.fallback_max_iterations;
+        self.fallback_degenerate += other.fallback_degenerate;
+        self.overlapping += other.overlapping;
+        self.touching += other.touching;
+        self.separated += other.separated;
+    }
+
+    /// Total number of exact fallbacks.
+    pub fn fallbacks(&self) -> u64 {
+        self.fallback_max_iterations + self.fallback_degenerate
+    }
+
+    /// Records the kind of a finished query's result.
+    pub(crate) fn record(&mut self, g: &super::ContactGeometry) {
+        match g.kind {
+            super::ContactKind::Overlap => self.overlapping += 1,
+            super::ContactKind::Touching => self.touching += 1,
+            super::ContactKind::Separated => self.separated += 1,
+        }
+        match g.status {
+            super::SolverStatus::FallbackAfterMaxIterations => self.fallback_max_iterations += 1,
+            super::SolverStatus::FallbackAfterDegenerate => self.fallback_degenerate += 1,
+            _ => {}
+        }
+    }
+}
+
+impl fmt::Display for QueryCounters {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let per = |n: u64, d: u64| if d == 0 { 0.0 } else { n as f64 / d as f64 };
+        writeln!(
+            f,
+            "queries: polyhedron-polyhedron {}, sphere-sphere {}, sphere-plane {}, polyhedron-plane {}, sphere-polyhedron {}",
+            self.polyhedron_polyhedron,
+            self.sphere_sphere,
+            self.sphere_plane,
+            self.polyhedron_plane,
+            self.sphere_polyhedron
+        )?;
+        writeln!(
+            f,
+            "results: overlap {}, touching {}, separated {}; early rejections: bounding sphere {}, cached axis {}",
+            self.overlapping,
+            self.touching,
+            self.separated,
+            self.bounding_sphere_rejections,
+            self.cached_axis_rejections
+        )?;
+        writeln!(
+            f,
+            "gjk: {} runs, {:.2} iterations/run; epa: {} runs, {:.2} iterations/run",
+            self.gjk_runs,
+            per(self.gjk_iterations, self.gjk_runs),
+            self.epa_runs,
+            per(self.epa_iterations, self.epa_runs)
+        )?;
+        write!(
+            f,
+            "exact fallbacks: {} after max iterations, {} after degeneracy",
+            self.fallback_max_iterations, self.fallback_degenerate
+        )
+    }
+}

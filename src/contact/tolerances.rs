@@ -1,0 +1,45 @@
+//! Tolerances of the contact queries, all relative to the pair's length scale.
+//!
+//! Every tolerance here is a dimensionless factor multiplied by the length scale `L` of the pair (the larger
+//! bounding radius of the two shapes), so that a pair of 1 mm grains and a pair of 1 km blocks are decided
+//! alike. Iteration caps are counts. A harness may sweep [`ContactTolerances::epa_gap`] to draw a
+//! work-precision curve; the defaults are what the engine uses.
+
+use crate::math::Real;
+
+/// Tolerances and caps of GJK, EPA and the classification of a pair (dimensionless, times `L`).
+#[derive(Copy, Clone, Debug, PartialEq)]
+pub struct ContactTolerances {
+    /// Touching band: a pair whose overlap or gap is at most `touching · L` is [`Touching`].
+    /// Default 1e-11: far below the smallest overlap a DEM step produces (≳ 1e-9 L) and far above the
+    /// round-off of coordinates of size `L` (≈ 1e-16 L), so exact face-on-face contacts built in floating
+    /// point are classified as touching and not as a spurious overlap or gap.
+    ///
+    /// [`Touching`]: super::ContactKind::Touching
+    pub touching: Real,
+    /// GJK stops when the duality gap |v| − v̂·w (an upper bound of the distance error) is at most
+    /// `gjk_gap · L`. Default 1e-13: on polytopes GJK terminates exactly, this only guards round-off.
+    pub gjk_gap: Real,
+    /// EPA stops when the support point along the normal of the closest face lies within `epa_gap · L` of
+    /// that face's plane; the reported depth then exceeds the exact one by at most this much. Default 1e-13:
+    /// on polytopes EPA reaches a facet of the Minkowski difference exactly, so the gap only absorbs round-off.
+    pub epa_gap: Real,
+    /// Iteration cap of GJK (default 128; polytope pairs converge in fewer than 30). Reaching it triggers the
+    /// exact fallback.
+    pub gjk_max_iterations: u32,
+    /// Iteration cap of EPA (default 256; each iteration adds one vertex). Reaching it triggers the exact
+    /// fallback.
+    pub epa_max_iterations: u32,
+}
+
+impl Default for ContactTolerances {
+    fn default() -> Self {
+        Self {
+            touching: 1e-11,
+            gjk_gap: 1e-13,
+            epa_gap: 1e-13,
+            gjk_max_iterations: 128,
+            epa_max_iterations: 256,
+        }
+    }
+}
