@@ -1,8 +1,8 @@
 //! The calls into polydem's contact core used by the case, in one place.
 
 use polydem::contact::{
-    intersect_polytopes_cached, query_polytopes_cached, sat_polytopes, ContactGeometry,
-    ContactTolerances, EpaScratch, PairCache, QueryCounters, SolverStatus,
+    intersect_polyhedra_cached, query_polyhedra_with, sat_polyhedra, ContactGeometry,
+    ContactTolerances, EpaScratch, PairCache, QueryCounters,
 };
 use polydem::math::Pose;
 use polydem::shape::ConvexPolyhedron;
@@ -14,14 +14,7 @@ pub fn sat(
     pos2: &Pose,
     b: &ConvexPolyhedron,
 ) -> ContactGeometry {
-    sat_polytopes(
-        pos1,
-        a,
-        pos2,
-        b,
-        &ContactTolerances::default(),
-        SolverStatus::Exact,
-    )
+    sat_polyhedra(pos1, a, pos2, b)
 }
 
 /// Our state for a run of queries: tolerances, EPA scratch, counters.
@@ -49,7 +42,7 @@ impl Ours {
         b: &ConvexPolyhedron,
     ) -> ContactGeometry {
         let mut cache = PairCache::default();
-        query_polytopes_cached(
+        query_polyhedra_with(
             pos1,
             a,
             pos2,
@@ -61,7 +54,7 @@ impl Ours {
         )
     }
 
-    /// Boolean intersection test from a cold pair cache (separated-pair rejection).
+    /// Boolean intersection test from a cold pair cache (separated-pair rejection), default tolerances.
     pub fn intersects(
         &mut self,
         pos1: &Pose,
@@ -70,6 +63,6 @@ impl Ours {
         b: &ConvexPolyhedron,
     ) -> bool {
         let mut cache = PairCache::default();
-        intersect_polytopes_cached(pos1, a, pos2, b, &self.tol, &mut cache, &mut self.counters)
+        intersect_polyhedra_cached(pos1, a, pos2, b, &mut cache, &mut self.counters)
     }
 }
