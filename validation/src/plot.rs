@@ -322,11 +322,15 @@ mod tests {
             "overlap / size",
             "depth error / size",
             "ours",
+            "parry3d-f64",
             "1e-9",
         ] {
             assert!(svg.contains(needle), "SVG lacks `{needle}`");
         }
-        assert_eq!(plot.hidden_points(), vec![("ours".to_string(), 1)]);
+        assert_eq!(
+            plot.hidden_points(),
+            vec![("ours".to_string(), 1), ("parry3d-f64".to_string(), 0)]
+        );
         // Left in the temp directory for a look: `rsvg-convert` it to PNG.
         let path = std::env::temp_dir().join("polydem_plot_test.svg");
         plot.write_svg(&path).unwrap();
