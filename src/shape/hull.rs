@@ -10,9 +10,10 @@
 //!
 //! # Pipeline
 //! 1. Reject unusable input with a typed error: fewer than 4 points, NaN/inf, all points coincident,
-//!    collinear or coplanar (distances measured against `HULL_REL_TOL × extent`, where the extent is the
-//!    diagonal of the cloud's axis-aligned box).
-//! 2. Triangulated hull from parry (guarded: a panic inside the library becomes [`ShapeError::HullFailed`]).
+//!    collinear or coplanar (largest distance from a line / plane at most `FLAT_REL_TOL × extent`, where
+//!    the extent is the diagonal of the cloud's axis-aligned box).
+//! 2. Triangulated hull from parry of the affinely whitened cloud (see `whiten`; guarded: a panic inside
+//!    the library becomes [`ShapeError::HullFailed`]).
 //! 3. Orient every triangle outward (against a point strictly inside the initial tetrahedron).
 //! 4. Merge coplanar triangles into faces by region growing: seeds taken by decreasing area, a neighbour
 //!    joins when all its vertices lie within the tolerance of the seed's plane. The face's boundary loop is
@@ -34,6 +35,12 @@ use super::polygon::supporting_plane;
 /// extent. Round-off in coordinates of size L is ~1e-16 L; 1e-10 leaves six orders of magnitude for rounding
 /// accumulated by the caller's transformations, while any real feature of a particle is far larger.
 pub(crate) const HULL_REL_TOL: Real = 1e-10;
+
+/// Relative thickness below which a cloud is rejected as collinear or coplanar. A face of width w and
+/// length ℓ has its normal resolved by f64 only to ~ε ℓ/w, so its far corners sit ~ε ℓ²/w off the computed
+/// plane; keeping that below `HULL_REL_TOL × extent` with a margin of ten requires w ≳ 1e-5 ℓ. Particles
+/// with aspect ratios beyond 1e5 are outside any DEM use, so such clouds are reported as degenerate.
+pub(crate) const FLAT_REL_TOL: Real = 1e-5;
 
 /// A closed convex polygonal mesh: faces are vertex loops, counter-clockwise seen from outside.
 #[derive(Clone, Debug)]
@@ -140,7 +147,7 @@ fn farthest(points: &[Point], distance: impl Fn(&Point) -> Real) -> (usize, Real
 pub(crate) fn convex_hull(points: &[Point]) -> Result<PolygonMesh, ShapeError> {
     let extent = validate_points(points)?;
     let tol = HULL_REL_TOL * extent;
-    let tetra = spanning_tetrahedron(points, extent, tol)?;
+    let tetra = spanning_tetrahedron(points, extent, FLAT_REL_TOL * extent)?;
     let interior = Point::from(
         (points[tetra[0]].coords
             + points[tetra[1]].coords
@@ -149,7 +156,8 @@ pub(crate) fn convex_hull(points: &[Point]) -> Result<PolygonMesh, ShapeError> {
             / 4.0,
     );
 
-    let input: Vec<_> = points.iter().map(to_parry_vector).collect();
+    let whitened = whiten(points);
+    let input: Vec<_> = whitened.iter().map(to_parry_vector).collect();
     let hull = std::panic::catch_unwind(|| parry3d_f64::transformation::try_convex_hull(&input));
     let (hull_vertices, triangles) = match hull {
         Ok(Ok(hull)) => hull,
@@ -164,7 +172,21 @@ pub(crate) fn convex_hull(points: &[Point]) -> Result<PolygonMesh, ShapeError> {
             })
         }
     };
-    let vertices: Vec<Point> = hull_vertices.into_iter().map(from_parry_vector).collect();
+    // parry returns copies of (some of) its input points: find each one's original point, bit for bit.
+    let key = |p: &Point| [p.x.to_bits(), p.y.to_bits(), p.z.to_bits()];
+    let mut original: HashMap<[u64; 3], usize> = HashMap::with_capacity(whitened.len());
+    for (i, w) in whitened.iter().enumerate() {
+        original.entry(key(w)).or_insert(i);
+    }
+    let mut vertices = Vec::with_capacity(hull_vertices.len());
+    for v in hull_vertices {
+        let Some(&i) = original.get(&key(&from_parry_vector(v))) else {
+            return Err(ShapeError::HullFailed {
+                reason: "parry3d returned a vertex that is not an input point".to_string(),
+            });
+        };
+        vertices.push(points[i]);
+    }
     if triangles.len() < 4 || vertices.len() < 4 {
         return Err(ShapeError::HullFailed {
             reason: format!(
@@ -180,6 +202,29 @@ pub(crate) fn convex_hull(points: &[Point]) -> Result<PolygonMesh, ShapeError> {
     let mesh = drop_non_corner_vertices(vertices, faces)?;
     verify_contains(&mesh, points, tol)?;
     Ok(mesh)
+}
+
+/// Maps the cloud by the affine whitening transform (centre at the mean, principal axes of the point
+/// covariance scaled to unit variance). The hull's combinatorics are affine-invariant, and the hull library
+/// judges degeneracy with absolute epsilons on a unit-box-normalised cloud, so thin or elongated clouds
+/// (slabs, needles) are handed to it as well-conditioned, roughly round ones. Vertex indices are unchanged,
+/// and the hull's geometry is always taken from the original points.
+fn whiten(points: &[Point]) -> Vec<Point> {
+    let n = points.len() as Real;
+    let mean = points.iter().fold(Vector::zeros(), |acc, p| acc + p.coords) / n;
+    let covariance = points.iter().fold(crate::math::Matrix::zeros(), |acc, p| {
+        let d = p.coords - mean;
+        acc + d * d.transpose()
+    }) / n;
+    let eigen = nalgebra::SymmetricEigen::new(covariance);
+    let scale = eigen
+        .eigenvalues
+        .map(|l| if l > 0.0 { 1.0 / l.sqrt() } else { 1.0 });
+    let to_principal = eigen.eigenvectors.transpose();
+    points
+        .iter()
+        .map(|p| Point::from((to_principal * (p.coords - mean)).component_mul(&scale)))
+        .collect()
 }
 
 fn orient_outward(
