@@ -5,8 +5,8 @@ use polydem_validation::{run_case_in_memory, Profile};
 
 #[test]
 fn single_contact_energy_case_passes_every_check() {
-    let report =
-        run_case_in_memory("single_contact_energy", Profile::Quick).expect("single_contact_energy case is registered");
+    let report = run_case_in_memory("single_contact_energy", Profile::Quick)
+        .expect("single_contact_energy case is registered");
     assert!(
         report.error.is_none(),
         "single_contact_energy case failed to complete: {:?}",
