@@ -65,13 +65,14 @@ fn normal_along_the_line_of_centres_does_not_conserve_energy() {
 }
 
 /// Open problem: an edge of a spinning box landing flat on a wall (both end vertices penetrate). The
-/// polyhedron–plane fast path (`contact_polyhedron_plane.rs`) applies the force at the depth-weighted
-/// centroid of the penetrating vertices, which is not the gradient point of k_n δ^(n+1)/(n+1) with δ the
-/// deepest vertex's depth: measured energy error 9.8 % (linear law), the same at every dt from t_c/50 to
-/// t_c/3200. Taking the deepest vertex instead (`Variant::WallSupportPoint`) reduces it to 2.5e-3, but that
-/// does not shrink with dt either: δ = max(d₁, d₂) has a kink where the two vertices are equally deep, and
-/// the box rocks across it. A single vertex landing first (`BoxWallVertex`, main gate) conserves energy at
-/// second order. Kept as a failing gate until the wall contact is made energy-consistent.
+/// polyhedron–plane fast path (`contact_polyhedron_plane.rs`) first applied the force at the depth-weighted
+/// centroid of the penetrating vertices: measured energy error 9.8 % (linear law), the same at every dt from
+/// t_c/50 to t_c/3200. It now applies it at the deepest vertex (the gradient point of δ = max(d_i)), as the
+/// `Variant::WallSupportPoint` check here does: 2.5e-3, still the same at every dt. δ = max(d₁, d₂) has a kink
+/// where the two vertices are equally deep, and the spinning box rocks across it, so the force is
+/// discontinuous and velocity Verlet loses its second order. A single vertex landing first
+/// (`BoxWallVertex`, main gate) conserves energy at second order. Kept as a failing gate until the wall
+/// contact of a flat edge or face is made energy-consistent.
 #[test]
 #[ignore = "open problem: an edge landing flat on a wall is not energy-conserving (see the doc comment)"]
 fn elastic_box_edge_on_wall_conserves_energy() {
