@@ -70,7 +70,7 @@ fn splitting_conserves_world_angular_momentum_to_round_off() {
         // The splitting map itself, on (q, L̄): R(q) L̄ stays fixed up to round-off, since every sub-rotation
         // turns q and L̄ consistently. The rounding repeats coherently along the periodic body-frame motion, so
         // it grows linearly: the bound is one unit of 1e-16 per step (a scheme error would be O(dt³) per step,
-        // ~1e-7 here). Measured: 1.4e-12 after 1e5 steps (Cayley).
+        // ~1e-7 here). The measured value is in the precession report (section Notes).
         let inertia_p = PrincipalInertia::new(inertia).unwrap();
         let (mut q, mut lb) = (q0, omega0.component_mul(&inertia));
         let l0 = q.transform_vector(&lb);

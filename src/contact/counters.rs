@@ -25,6 +25,10 @@ pub struct QueryCounters {
     /// EPA runs and their total iterations.
     pub epa_runs: u64,
     pub epa_iterations: u64,
+    /// EPA runs started from the pair's previous terminal face, and how many of them proved the overlap
+    /// (the others continued on the cold path).
+    pub epa_warm_starts: u64,
+    pub epa_warm_hits: u64,
     /// Exact SAT fallbacks after GJK or EPA hit its iteration cap.
     pub fallback_max_iterations: u64,
     /// Exact SAT fallbacks after GJK or EPA met a degenerate configuration (flat start, broken horizon,
@@ -50,6 +54,8 @@ impl QueryCounters {
         self.gjk_iterations += other.gjk_iterations;
         self.epa_runs += other.epa_runs;
         self.epa_iterations += other.epa_iterations;
+        self.epa_warm_starts += other.epa_warm_starts;
+        self.epa_warm_hits += other.epa_warm_hits;
         self.fallback_max_iterations += other.fallback_max_iterations;
         self.fallback_degenerate += other.fallback_degenerate;
         self.overlapping += other.overlapping;
@@ -100,11 +106,13 @@ impl fmt::Display for QueryCounters {
         )?;
         writeln!(
             f,
-            "gjk: {} runs, {:.2} iterations/run; epa: {} runs, {:.2} iterations/run",
+            "gjk: {} runs, {:.2} iterations/run; epa: {} runs, {:.2} iterations/run, {} warm starts ({} proved the overlap)",
             self.gjk_runs,
             per(self.gjk_iterations, self.gjk_runs),
             self.epa_runs,
-            per(self.epa_iterations, self.epa_runs)
+            per(self.epa_iterations, self.epa_runs),
+            self.epa_warm_starts,
+            self.epa_warm_hits
         )?;
         write!(
             f,

@@ -86,6 +86,9 @@ pub enum EpaOutcome {
         normal: Vector,
         point_a: Vector,
         point_b: Vector,
+        /// Support hints (vertex indices) of the terminal face's three vertices: a warm start for the next
+        /// query of the same pair.
+        face: [[u32; 2]; 3],
     },
     MaxIterations,
     Degenerate(Degeneracy),
@@ -481,7 +484,7 @@ fn finish(scratch: &EpaScratch, start: u32, h: Real, coplanar_tol: Real) -> EpaO
                 pa += sp.a * (lam[k].max(0.0) / total);
                 pb += sp.b * (lam[k].max(0.0) / total);
             }
-            return symmetric(pa, pb, n, h);
+            return symmetric(pa, pb, n, h, face_ids(verts, face));
         }
         // Cross the edge opposite the most negative weight, if the neighbour lies in the same plane.
         let e = (kmin + 1) % 3;
@@ -498,11 +501,7 @@ fn finish(scratch: &EpaScratch, start: u32, h: Real, coplanar_tol: Real) -> EpaO
     let face = &scratch.faces[fi as usize];
     for k in 0..3 {
         let sp = verts[face.v[k] as usize];
-        s.pts[k] = SupportPoint {
-            w: sp.w - p,
-            a: sp.a,
-            b: sp.b,
-        };
+        s.pts[k] = SupportPoint { w: sp.w - p, ..sp };
     }
     s.len = 3;
     closest_to_origin(&mut s);
@@ -512,11 +511,15 @@ fn finish(scratch: &EpaScratch, start: u32, h: Real, coplanar_tol: Real) -> EpaO
         pa += s.pts[k].a * s.bary[k];
         pb += s.pts[k].b * s.bary[k];
     }
-    symmetric(pa, pb, n, h)
+    symmetric(pa, pb, n, h, face_ids(verts, face))
+}
+
+fn face_ids(verts: &[SupportPoint], face: &Face) -> [[u32; 2]; 3] {
+    face.v.map(|i| [verts[i as usize].ia, verts[i as usize].ib])
 }
 
 /// Points with c1 − c2 = h n exactly, centred on the barycentric pair (pa, pb).
-fn symmetric(pa: Vector, pb: Vector, n: Vector, h: Real) -> EpaOutcome {
+fn symmetric(pa: Vector, pb: Vector, n: Vector, h: Real, face: [[u32; 2]; 3]) -> EpaOutcome {
     let mid = (pa + pb) * 0.5;
     let half = n * (0.5 * h);
     EpaOutcome::Converged {
@@ -524,5 +527,6 @@ fn symmetric(pa: Vector, pb: Vector, n: Vector, h: Real) -> EpaOutcome {
         normal: n,
         point_a: mid + half,
         point_b: mid - half,
+        face,
     }
 }

@@ -19,6 +19,8 @@ pub(crate) struct Stats {
     pub touching: usize,
     pub separated: usize,
     pub fallbacks: usize,
+    pub warm_starts: usize,
+    pub warm_hits: usize,
     pub max_value_err: Real,
     pub max_normal_err: Real,
     pub max_surface_err: Real,
@@ -65,9 +67,10 @@ pub(crate) fn check_pair<A: Polytope, B: Polytope>(
 ) -> Result<(), String> {
     let tol = ContactTolerances::default();
     let oracle = sat_polytopes(pos1, a, pos2, b, &tol, SolverStatus::Exact);
-    let mut cache = PairCache::default();
     let mut scratch = EpaScratch::default();
     let mut counters = QueryCounters::default();
+    // Cold: a fresh cache.
+    let mut cache = PairCache::default();
     let g = query_polytopes_cached(
         pos1,
         a,
@@ -78,6 +81,71 @@ pub(crate) fn check_pair<A: Polytope, B: Polytope>(
         &mut scratch,
         &mut counters,
     );
+    check_result(
+        &format!("{ctx} [cold]"),
+        pos1,
+        a,
+        pos2,
+        b,
+        &g,
+        &oracle,
+        stats,
+    )?;
+    // Warm: the cache of a query at a nearby pose (B moved by 1e-3 of the size and turned by 1e-3 rad), as in
+    // a time step of a simulation.
+    let scale = a.bounding_radius().max(b.bounding_radius());
+    let nudge = Pose::from_parts(
+        (Vector::new(0.6, -0.8, 0.3) * 1e-3 * scale).into(),
+        crate::math::Rotation::from_scaled_axis(Vector::new(0.3, 0.5, -0.8) * 1e-3),
+    );
+    let mut cache = PairCache::default();
+    let pos2_before = pos2 * nudge;
+    query_polytopes_cached(
+        pos1,
+        a,
+        &pos2_before,
+        b,
+        &tol,
+        &mut cache,
+        &mut scratch,
+        &mut counters,
+    );
+    let g = query_polytopes_cached(
+        pos1,
+        a,
+        pos2,
+        b,
+        &tol,
+        &mut cache,
+        &mut scratch,
+        &mut counters,
+    );
+    stats.warm_starts += counters.epa_warm_starts as usize;
+    stats.warm_hits += counters.epa_warm_hits as usize;
+    check_result(
+        &format!("{ctx} [warm]"),
+        pos1,
+        a,
+        pos2,
+        b,
+        &g,
+        &oracle,
+        stats,
+    )
+}
+
+#[allow(clippy::too_many_arguments)]
+fn check_result<A: Polytope, B: Polytope>(
+    ctx: &str,
+    pos1: &Pose,
+    a: &A,
+    pos2: &Pose,
+    b: &B,
+    g: &ContactGeometry,
+    oracle: &ContactGeometry,
+    stats: &mut Stats,
+) -> Result<(), String> {
+    let tol = ContactTolerances::default();
     let scale = a.bounding_radius().max(b.bounding_radius());
     let desc =
         || format!("{ctx}: pos1 = {pos1:?}, pos2 = {pos2:?}\n ours = {g:?}\n sat = {oracle:?}");
@@ -407,5 +475,70 @@ fn sweep() {
     for (seed, size) in [(11u64, 1.0), (12, 1e-3), (13, 1e3)] {
         let s = random_pairs(seed, n, size, &CLASSES);
         println!("{size:e}: {s:?}");
+    }
+}
+
+/// A solver that hits its cap never reports "no contact": the query falls back to the exact SAT answer,
+/// says so in the status and counts it.
+#[test]
+fn capped_solvers_fall_back_to_the_exact_answer_and_are_counted() {
+    let mut rng = ChaCha8Rng::seed_from_u64(77);
+    let capped = [
+        ContactTolerances {
+            gjk_max_iterations: 1,
+            ..ContactTolerances::default()
+        },
+        ContactTolerances {
+            epa_max_iterations: 0,
+            ..ContactTolerances::default()
+        },
+    ];
+    for (k, tol) in capped.iter().enumerate() {
+        let mut counters = QueryCounters::default();
+        let mut scratch = EpaScratch::new(tol);
+        let mut fallbacks = 0;
+        for i in 0..200 {
+            let a = random_polyhedron(&mut rng, 1.0, 3);
+            let b = random_polyhedron(&mut rng, 1.0, 6);
+            let pos1 = random_pose(&mut rng, 1.0);
+            let rot2 = random_rotation(&mut rng);
+            let u = random_unit(&mut rng);
+            let t0 = touching_offset(&pos1, &a, &rot2, &b, &u);
+            let t = t0 - 0.1 + 0.2 * (i % 2) as Real;
+            let pos2 = Pose::from_parts((pos1.translation.vector + u * t).into(), rot2);
+            let g = query_polytopes_cached(
+                &pos1,
+                &a,
+                &pos2,
+                &b,
+                tol,
+                &mut PairCache::default(),
+                &mut scratch,
+                &mut counters,
+            );
+            let exact = sat_polytopes(&pos1, &a, &pos2, &b, tol, SolverStatus::Exact);
+            assert_eq!(
+                g.kind, exact.kind,
+                "cap set {k}, pair {i}: {g:?} vs {exact:?}"
+            );
+            let (v, e) = (g.depth + g.distance, exact.depth + exact.distance);
+            assert!(
+                (v - e).abs() <= 1e-10 + 1e-9 * e,
+                "cap set {k}, pair {i}: value {v} vs exact {e}"
+            );
+            if g.status == SolverStatus::FallbackAfterMaxIterations {
+                fallbacks += 1;
+            } else {
+                assert_eq!(g.status, SolverStatus::Converged, "cap set {k}, pair {i}");
+            }
+        }
+        assert!(
+            fallbacks > 50,
+            "cap set {k}: only {fallbacks} of 200 queries hit the cap"
+        );
+        assert_eq!(
+            counters.fallback_max_iterations, fallbacks as u64,
+            "cap set {k}: {counters}"
+        );
     }
 }

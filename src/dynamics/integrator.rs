@@ -5,6 +5,11 @@
 //! dynamic body this is velocity Verlet in translation and the leapfrog-equivalent arrangement of the
 //! paper's rotation scheme (see [`crate::dynamics::rotation`] for why the half kicks reproduce eq. 18).
 //! Fixed bodies keep zero velocities; prescribed bodies move kinematically and ignore forces.
+//!
+//! Velocity-dependent forces (contact damping, friction increments) evaluated between the drift and the
+//! second half kick see the half-step velocities v_{n+1/2}, ω_{n+1/2}: the scheme is then first order in
+//! those terms. Measured effect (tests/law_gates.rs): the restitution of a damped collision is within
+//! 2 Δt/t_c of its input, e.g. 0.17 % for the Hertz law at Δt = t_c/200.
 
 use crate::dynamics::body::{Motion, RigidBody};
 use crate::dynamics::rotation::{drift_rotation, RotationScheme};

@@ -2,7 +2,7 @@
 //!
 //! With the Minkowski overlap δ_M, normal n_M and point c_M this force derives from the potential
 //! U(δ) = k_n δ^(n+1)/(n+1), which is what makes an elastic impact conserve energy (paper section 2.3 and its
-//! reference [14]); [`power_law_potential`] reports it for the energy ledger.
+//! reference 14); [`power_law_potential`] reports it for the energy ledger.
 
 use super::{check_range, LawError};
 use crate::math::Real;

@@ -139,6 +139,11 @@ impl CaseContext {
         format_value(value)
     }
 
+    /// The case's output directory `<out>/<case>/` (created), or `None` for an in-memory run.
+    pub fn output_dir(&self) -> Result<Option<PathBuf>, SuiteError> {
+        self.case_dir()
+    }
+
     fn case_dir(&self) -> Result<Option<PathBuf>, SuiteError> {
         match &self.out {
             None => Ok(None),

@@ -75,7 +75,7 @@ fn axis_label(v: f64, log: bool) -> String {
         if (v - v.round()).abs() < 1e-9 {
             format!("1e{}", v.round() as i64)
         } else {
-            format!("{p:.0e}")
+            format!("{p:.1e}")
         }
     } else if v != 0.0 && (v.abs() >= 1e4 || v.abs() < 1e-2) {
         format!("{v:.1e}")
@@ -104,6 +104,55 @@ fn padded_range(lo: f64, hi: f64, log: bool) -> (f64, f64) {
         let pad = if lo == 0.0 { 1.0 } else { 0.1 * lo.abs() };
         (lo - pad, hi + pad)
     }
+}
+
+/// The corner of the plot area with the fewest data points (ties: upper left, upper right, lower left,
+/// lower right), so the legend hides as little as possible. A corner is the 40 % × 40 % box of the
+/// (transformed) axis ranges.
+fn legend_corner(data: &[Vec<(f64, f64)>], xr: (f64, f64), yr: (f64, f64)) -> SeriesLabelPosition {
+    let (wx, wy) = (0.4 * (xr.1 - xr.0), 0.4 * (yr.1 - yr.0));
+    let corners = [
+        (
+            SeriesLabelPosition::UpperLeft,
+            xr.0,
+            xr.0 + wx,
+            yr.1 - wy,
+            yr.1,
+        ),
+        (
+            SeriesLabelPosition::UpperRight,
+            xr.1 - wx,
+            xr.1,
+            yr.1 - wy,
+            yr.1,
+        ),
+        (
+            SeriesLabelPosition::LowerLeft,
+            xr.0,
+            xr.0 + wx,
+            yr.0,
+            yr.0 + wy,
+        ),
+        (
+            SeriesLabelPosition::LowerRight,
+            xr.1 - wx,
+            xr.1,
+            yr.0,
+            yr.0 + wy,
+        ),
+    ];
+    let mut best = (usize::MAX, SeriesLabelPosition::UpperLeft);
+    for (pos, xa, xb, ya, yb) in corners {
+        let n = data
+            .iter()
+            .flatten()
+            .filter(|(x, y)| *x >= xa && *x <= xb && *y >= ya && *y <= yb)
+            .count();
+        if n < best.0 {
+            best = (n, pos);
+        }
+    }
+    best.1
 }
 
 impl Plot {
@@ -230,7 +279,7 @@ impl Plot {
                 .background_style(WHITE.mix(0.85))
                 .border_style(BLACK)
                 .label_font(("sans-serif", 14))
-                .position(SeriesLabelPosition::UpperLeft)
+                .position(legend_corner(&data, (x0, x1), (y0, y1)))
                 .draw()
                 .map_err(|e| e.to_string())?;
             root.present().map_err(|e| e.to_string())?;
@@ -252,11 +301,18 @@ mod tests {
             y_label: "depth error / size".into(),
             x_log: true,
             y_log: true,
-            series: vec![Series {
-                label: "ours".into(),
-                style: SeriesStyle::Points,
-                points: vec![(1e-9, 1e-17), (1e-3, 2e-16), (0.0, 1.0)],
-            }],
+            series: vec![
+                Series {
+                    label: "ours".into(),
+                    style: SeriesStyle::Points,
+                    points: vec![(1e-9, 1e-17), (1e-3, 2e-16), (0.0, 1.0)],
+                },
+                Series {
+                    label: "parry3d-f64".into(),
+                    style: SeriesStyle::LinePoints,
+                    points: vec![(1e-8, 1e-12), (1e-2, 3e-3)],
+                },
+            ],
             caption: String::new(),
         };
         let mut svg = String::new();
@@ -266,10 +322,17 @@ mod tests {
             "overlap / size",
             "depth error / size",
             "ours",
+            "parry3d-f64",
             "1e-9",
         ] {
             assert!(svg.contains(needle), "SVG lacks `{needle}`");
         }
-        assert_eq!(plot.hidden_points(), vec![("ours".to_string(), 1)]);
+        assert_eq!(
+            plot.hidden_points(),
+            vec![("ours".to_string(), 1), ("parry3d-f64".to_string(), 0)]
+        );
+        // Left in the temp directory for a look: `rsvg-convert` it to PNG.
+        let path = std::env::temp_dir().join("polydem_plot_test.svg");
+        plot.write_svg(&path).unwrap();
     }
 }

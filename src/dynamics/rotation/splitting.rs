@@ -8,6 +8,9 @@ use nalgebra::Quaternion;
 /// One sub-rotation: the flow of T_i = L̄_i²/(2J̄_i) over the time `h` about body axis `axis` (0, 1, 2).
 ///
 /// q ← q ⊗ q_i(θ), L̄ ← R_i(−θ) L̄ with θ = h L̄_i / J̄_i (or the Cayley angle 4 atan(θ/4)).
+///
+/// # Panics
+/// If `axis` is not 0, 1 or 2 (a programming error, never user input).
 pub fn sub_rotation(
     form: SubRotation,
     axis: usize,
@@ -16,6 +19,24 @@ pub fn sub_rotation(
     inertia: &PrincipalInertia,
     h: Real,
 ) {
+    match axis {
+        0 => sub_rotation_about::<0>(form, orientation, angular_momentum_body, inertia, h),
+        1 => sub_rotation_about::<1>(form, orientation, angular_momentum_body, inertia, h),
+        2 => sub_rotation_about::<2>(form, orientation, angular_momentum_body, inertia, h),
+        _ => panic!("body axis index {axis} is not 0, 1 or 2"),
+    }
+}
+
+/// [`sub_rotation`] with the axis known at compile time (the index arithmetic folds away).
+#[inline]
+fn sub_rotation_about<const AXIS: usize>(
+    form: SubRotation,
+    orientation: &mut Rotation,
+    angular_momentum_body: &mut Vector,
+    inertia: &PrincipalInertia,
+    h: Real,
+) {
+    let axis = AXIS;
     let theta = h * angular_momentum_body[axis] / inertia.0[axis];
     // (w, s) = (cos, sin) of half the rotation angle.
     let (w, s) = match form {
@@ -23,23 +44,27 @@ pub fn sub_rotation(
             // Paper eq. 21 with φ = ½ h L̄_i / J̄_i = θ/2.
             let phi = 0.5 * theta;
             let quarter = 0.25 * phi * phi;
-            let denominator = 1.0 + quarter;
-            ((1.0 - quarter) / denominator, phi / denominator)
+            let reciprocal = 1.0 / (1.0 + quarter);
+            ((1.0 - quarter) * reciprocal, phi * reciprocal)
         }
         SubRotation::Exact => {
             let (s, w) = (0.5 * theta).sin_cos();
             (w, s)
         }
     };
-    let mut imaginary = Vector::zeros();
-    imaginary[axis] = s;
-    let increment = Rotation::new_unchecked(Quaternion::from_parts(w, imaginary));
-    *orientation *= increment;
-    // Rotate L̄ by −angle about the same axis: cos and sin of the full angle from the half-angle pair,
-    // divided by w² + s² so that the pair lies on the unit circle up to one rounding.
-    let norm = w * w + s * s;
-    let cos_full = (w * w - s * s) / norm;
-    let sin_full = 2.0 * w * s / norm;
+    // q ← q ⊗ (w, s e_i), written out for the sparse right factor: with q = (q₀, v),
+    // q ⊗ (w, s e_i) = (w q₀ − s v_i, w v + s (q₀ e_i + v × e_i)).
+    let q = orientation.quaternion();
+    let (q0, v) = (q.w, q.imag());
+    let mut v_cross_e = Vector::zeros();
+    v_cross_e[(axis + 1) % 3] = v[(axis + 2) % 3];
+    v_cross_e[(axis + 2) % 3] = -v[(axis + 1) % 3];
+    let mut imaginary = w * v + s * v_cross_e;
+    imaginary[axis] += s * q0;
+    *orientation = Rotation::new_unchecked(Quaternion::from_parts(w * q0 - s * v[axis], imaginary));
+    // Rotate L̄ by −angle about the same axis: cos and sin of the full angle from the half-angle pair.
+    let cos_full = w * w - s * s;
+    let sin_full = 2.0 * w * s;
     let (j, k) = ((axis + 1) % 3, (axis + 2) % 3);
     let (lj, lk) = (angular_momentum_body[j], angular_momentum_body[k]);
     angular_momentum_body[j] = cos_full * lj + sin_full * lk;
@@ -56,9 +81,11 @@ pub fn drift_splitting(
     dt: Real,
 ) {
     let half = 0.5 * dt;
-    for (axis, h) in [(0, half), (1, half), (2, dt), (1, half), (0, half)] {
-        sub_rotation(form, axis, orientation, angular_momentum_body, inertia, h);
-    }
+    sub_rotation_about::<0>(form, orientation, angular_momentum_body, inertia, half);
+    sub_rotation_about::<1>(form, orientation, angular_momentum_body, inertia, half);
+    sub_rotation_about::<2>(form, orientation, angular_momentum_body, inertia, dt);
+    sub_rotation_about::<1>(form, orientation, angular_momentum_body, inertia, half);
+    sub_rotation_about::<0>(form, orientation, angular_momentum_body, inertia, half);
     orientation.renormalize_fast();
 }
 

@@ -32,12 +32,17 @@ struct Cli {
     /// Report directory (default: `reports/` at the workspace root).
     #[arg(long)]
     out: Option<PathBuf>,
+    /// Write the contact pair sets as JSONL (the `polydem contact` input format) with a provenance README
+    /// into this directory (e.g. `reference/contact`) and exit.
+    #[arg(long, value_name = "DIR")]
+    export_pairs: Option<PathBuf>,
     /// Cases to run (default: every case of the default run; see --list).
     cases: Vec<String>,
 }
 
 fn workspace_root() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..")
+    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..");
+    root.canonicalize().unwrap_or(root)
 }
 
 fn main() -> ExitCode {
@@ -73,6 +78,11 @@ fn run() -> anyhow::Result<bool> {
                 data.title
             );
         }
+        return Ok(true);
+    }
+    if let Some(dir) = &cli.export_pairs {
+        polydem_validation::cases::contact::export_reference(dir, profile)?;
+        println!("pair sets written to {}", dir.display());
         return Ok(true);
     }
     let cases = runner::select(&cli.cases)?;

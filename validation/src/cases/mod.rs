@@ -3,9 +3,11 @@
 
 use crate::case::Case;
 
+pub mod contact;
+pub mod perf;
 pub mod precession;
 
 /// Every case of the suite, in the order they run.
 pub fn registry() -> Vec<&'static dyn Case> {
-    vec![&precession::Precession]
+    vec![&contact::Contact, &precession::Precession, &perf::Perf]
 }
