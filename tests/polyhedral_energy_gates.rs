@@ -68,9 +68,10 @@ fn normal_along_the_line_of_centres_does_not_conserve_energy() {
 /// polyhedron–plane fast path (`contact_polyhedron_plane.rs`) first applied the force at the depth-weighted
 /// centroid of the penetrating vertices: measured energy error 9.8 % (linear law), the same at every dt from
 /// t_c/50 to t_c/3200. It now applies it at the deepest vertex (the gradient point of δ = max(d_i)), as the
-/// `Variant::WallSupportPoint` check here does: 2.5e-3, still the same at every dt. δ = max(d₁, d₂) has a kink
-/// where the two vertices are equally deep, and the spinning box rocks across it, so the force is
-/// discontinuous and velocity Verlet loses its second order. A single vertex landing first
+/// `Variant::WallSupportPoint` check here does: 2.5e-3 at t_c/200 (and at t_c/800), converging only at first
+/// order over the whole sweep (fitted 0.86 from t_c/50 to t_c/6400, 3.6e-4 at t_c/6400; report
+/// `single_contact_energy`). δ = max(d₁, d₂) has a kink where the two vertices are equally deep, and the
+/// spinning box rocks across it, so the force is discontinuous and velocity Verlet loses its second order. A single vertex landing first
 /// (`BoxWallVertex`, main gate) conserves energy at second order. Kept as a failing gate until the wall
 /// contact of a flat edge or face is made energy-consistent.
 #[test]
