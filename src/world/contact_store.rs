@@ -162,10 +162,7 @@ impl ContactStore {
 
     /// The entry of `key`, if stored.
     pub fn get(&self, key: &ContactKey) -> Option<&ContactState> {
-        self.keys
-            .binary_search(key)
-            .ok()
-            .map(|i| &self.states[i])
+        self.keys.binary_search(key).ok().map(|i| &self.states[i])
     }
 
     pub fn len(&self) -> usize {
@@ -188,11 +185,7 @@ mod tests {
         store.sync(&[k(0, 1), k(0, 2), k(1, 2)], 0);
         store.states_mut()[0].history.displacement = Vector::new(1.0, 0.0, 0.0);
         let counts = store.sync(
-            &[
-                k(0, 1),
-                k(1, 3),
-                ContactKey::Wall { body: 0, wall: 0 },
-            ],
+            &[k(0, 1), k(1, 3), ContactKey::Wall { body: 0, wall: 0 }],
             5,
         );
         assert_eq!(

@@ -234,6 +234,7 @@ pub fn step(
         }
     }
     let external_power_start = world.loads.external_power;
+    let damping_power_start = world.loads.damping_power;
     let viscous_start = viscous_power(world, |m| params.damping.coefficient(m));
 
     // 1–2. First half kick with the kept loads, drift.
@@ -265,7 +266,7 @@ pub fn step(
     // 9. Ledger and counters.
     let viscous_end = viscous_power(world, |m| params.damping.coefficient(m));
     let ledger = &mut world.ledger;
-    ledger.dissipated_damping += world.loads.damping_power * dt;
+    ledger.dissipated_damping += 0.5 * (damping_power_start + world.loads.damping_power) * dt;
     ledger.dissipated_friction += world.loads.friction_dissipation;
     ledger.dissipated_viscous += 0.5 * (viscous_start + viscous_end) * dt;
     ledger.external_work += 0.5 * (external_power_start + world.loads.external_power) * dt;
@@ -362,8 +363,7 @@ fn evaluate_loads(
             &mut state.cache,
             &mut scratch.epa,
             &mut counters.query,
-        )
-        {
+        ) {
             Ok(g) => g,
             Err(source) => {
                 world.contacts = contacts;

@@ -13,10 +13,10 @@
 //! - The material-pair table maps an unordered pair of material ids to one [`ContactModel`]; a pair with
 //!   no model is refused when a body or wall of those materials is added (so a step never meets one).
 
+use crate::dynamics::RigidBody;
 use crate::law::ContactModel;
 use crate::math::{Point, Pose, Real, Vector};
 use crate::shape::{Plane, Shape};
-use crate::dynamics::RigidBody;
 
 use super::broad_phase::BroadPhase;
 use super::contact_store::ContactStore;
