@@ -134,8 +134,8 @@ fn face_plane(verts: &[SupportPoint], v: [u32; 3]) -> Option<(Vector, Real)> {
     if !nn.is_finite() || nn <= 0.0 {
         return None;
     }
-    let n = n / nn;
-    let offset = (n.dot(&a) + n.dot(&b) + n.dot(&c)) / 3.0;
+    let n = n * (1.0 / nn);
+    let offset = (n.dot(&a) + n.dot(&b) + n.dot(&c)) * (1.0 / 3.0);
     Some((n, offset))
 }
 
@@ -201,7 +201,7 @@ impl EpaScratch {
     }
 
     fn silhouette(&mut self, f: u32, edge: u8, w: &Vector, vis_eps: Real) {
-        let face = self.faces[f as usize];
+        let face = &mut self.faces[f as usize];
         if !face.alive {
             return;
         }
@@ -209,10 +209,11 @@ impl EpaScratch {
             self.horizon.push((f, edge));
             return;
         }
-        self.faces[f as usize].alive = false;
+        face.alive = false;
+        let (adj, adj_edge) = (face.adj, face.adj_edge);
         for j in 1..3u8 {
             let e = ((edge + j) % 3) as usize;
-            self.silhouette(face.adj[e], face.adj_edge[e], w, vis_eps);
+            self.silhouette(adj[e], adj_edge[e], w, vis_eps);
         }
     }
 }
