@@ -6,8 +6,14 @@ use crate::case::Case;
 pub mod contact;
 pub mod perf;
 pub mod precession;
+pub mod single_contact_energy;
 
 /// Every case of the suite, in the order they run.
 pub fn registry() -> Vec<&'static dyn Case> {
-    vec![&contact::Contact, &precession::Precession, &perf::Perf]
+    vec![
+        &contact::Contact,
+        &precession::Precession,
+        &single_contact_energy::SingleContactEnergy,
+        &perf::Perf,
+    ]
 }
