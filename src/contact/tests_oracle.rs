@@ -570,3 +570,34 @@ fn capped_solvers_fall_back_to_the_exact_answer_and_are_counted() {
         );
     }
 }
+
+/// Non-finite input (a NaN or infinite pose) must not panic: the query returns a geometry whose non-finite
+/// values the caller's checks catch.
+#[test]
+fn non_finite_poses_do_not_panic() {
+    let mut rng = ChaCha8Rng::seed_from_u64(5);
+    let a = random_polyhedron(&mut rng, 1.0, 4);
+    let b = random_polyhedron(&mut rng, 1.0, 6);
+    let tol = ContactTolerances::default();
+    for bad in [Real::NAN, Real::INFINITY, -Real::INFINITY] {
+        let pos2 = Pose::translation(bad, 0.1, 0.2);
+        let mut counters = QueryCounters::default();
+        let g = query_polytopes_cached(
+            &Pose::identity(),
+            &a,
+            &pos2,
+            &b,
+            &tol,
+            &mut PairCache::default(),
+            &mut EpaScratch::default(),
+            &mut counters,
+        );
+        let finite =
+            g.depth.is_finite() && g.distance.is_finite() && g.normal.iter().all(|x| x.is_finite());
+        assert!(
+            !finite || g.kind == ContactKind::Separated,
+            "translation {bad}: {g:?}"
+        );
+        let _ = sat_polytopes(&Pose::identity(), &a, &pos2, &b, &tol, SolverStatus::Exact);
+    }
+}
