@@ -7,7 +7,7 @@
 //! Files, one job each: [`minkowski`] (support of A ⊖ B in A's frame), [`gjk`] (distance / intersection),
 //! [`epa`] (Minkowski overlap), [`sat`] (exact oracle and fallback), [`features`] (closest points of small
 //! features), one file per shape pair ([`contact_polyhedron_polyhedron`], [`contact_sphere_polyhedron`],
-//! [`contact_polyhedron_plane`], [`contact_sphere_plane`], [`contact_sphere_sphere`]), [`dispatch`] (over
+//! [`contact_polyhedron_plane`], [`contact_sphere_plane`], [`contact_sphere_sphere`](mod@contact_sphere_sphere)), [`dispatch`] (over
 //! [`Shape`](crate::shape::Shape)), [`counters`], [`tolerances`].
 //!
 //! Entry points: [`query`] (any shapes, hot path), [`query_polyhedra_cached`] / [`query_polyhedra`] /
