@@ -48,6 +48,8 @@ struct Face {
 pub struct EpaScratch {
     verts: Vec<SupportPoint>,
     faces: Vec<Face>,
+    /// Plane offset of each face, +∞ once the face is removed: the closest-face scan reads only this.
+    live_offsets: Vec<Real>,
     horizon: Vec<(u32, u8)>,
     new_faces: Vec<u32>,
     max_verts: usize,
@@ -68,6 +70,7 @@ impl EpaScratch {
         Self {
             verts: Vec::with_capacity(max_verts),
             faces: Vec::with_capacity(max_faces),
+            live_offsets: Vec::with_capacity(max_faces),
             horizon: Vec::with_capacity(max_faces),
             new_faces: Vec::with_capacity(max_faces),
             max_verts,
@@ -134,8 +137,8 @@ fn face_plane(verts: &[SupportPoint], v: [u32; 3]) -> Option<(Vector, Real)> {
     if !nn.is_finite() || nn <= 0.0 {
         return None;
     }
-    let n = n / nn;
-    let offset = (n.dot(&a) + n.dot(&b) + n.dot(&c)) / 3.0;
+    let n = n * (1.0 / nn);
+    let offset = (n.dot(&a) + n.dot(&b) + n.dot(&c)) * (1.0 / 3.0);
     Some((n, offset))
 }
 
@@ -153,6 +156,7 @@ impl EpaScratch {
             offset,
             alive: true,
         });
+        self.live_offsets.push(offset);
         Some(self.faces.len() as u32 - 1)
     }
 
@@ -172,6 +176,7 @@ impl EpaScratch {
             std::mem::swap(&mut p1, &mut p2);
         }
         self.faces.clear();
+        self.live_offsets.clear();
         for f in [[p0, p2, p1], [p0, p1, p3], [p0, p3, p2], [p1, p2, p3]] {
             if self.push_face(f).is_none() {
                 return false;
@@ -201,7 +206,7 @@ impl EpaScratch {
     }
 
     fn silhouette(&mut self, f: u32, edge: u8, w: &Vector, vis_eps: Real) {
-        let face = self.faces[f as usize];
+        let face = &mut self.faces[f as usize];
         if !face.alive {
             return;
         }
@@ -209,10 +214,12 @@ impl EpaScratch {
             self.horizon.push((f, edge));
             return;
         }
-        self.faces[f as usize].alive = false;
+        face.alive = false;
+        let (adj, adj_edge) = (face.adj, face.adj_edge);
+        self.live_offsets[f as usize] = Real::INFINITY;
         for j in 1..3u8 {
             let e = ((edge + j) % 3) as usize;
-            self.silhouette(face.adj[e], face.adj_edge[e], w, vis_eps);
+            self.silhouette(adj[e], adj_edge[e], w, vis_eps);
         }
     }
 }
@@ -230,6 +237,7 @@ pub fn epa<A: SupportMap + ?Sized, B: SupportMap + ?Sized>(
     let vis_eps = 0.5 * gap_tol;
     scratch.verts.clear();
     scratch.faces.clear();
+    scratch.live_offsets.clear();
     let mut ok = false;
     if simplex.len == 4 {
         scratch.verts.extend_from_slice(&simplex.pts);
@@ -290,9 +298,9 @@ pub fn epa<A: SupportMap + ?Sized, B: SupportMap + ?Sized>(
         // The closest face (smallest signed plane offset) among the live ones.
         let mut best = u32::MAX;
         let mut best_offset = Real::INFINITY;
-        for (i, f) in scratch.faces.iter().enumerate() {
-            if f.alive && f.offset < best_offset {
-                best_offset = f.offset;
+        for (i, &o) in scratch.live_offsets.iter().enumerate() {
+            if o < best_offset {
+                best_offset = o;
                 best = i as u32;
             }
         }
@@ -326,6 +334,7 @@ pub fn epa<A: SupportMap + ?Sized, B: SupportMap + ?Sized>(
 
         scratch.horizon.clear();
         scratch.faces[best as usize].alive = false;
+        scratch.live_offsets[best as usize] = Real::INFINITY;
         for e in 0..3 {
             scratch.silhouette(face.adj[e], face.adj_edge[e], &s.w, vis_eps);
         }

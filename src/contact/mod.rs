@@ -4,9 +4,16 @@
 //! returns a [`ContactGeometry`]. It never computes forces: contact laws live elsewhere and consume the
 //! geometry.
 //!
-//! Files, one job each: [`minkowski`] (support of A ⊖ B), [`gjk`], [`epa`], [`sat`] (exact oracle and
-//! fallback), [`features`] (closest points of small features), one file per shape pair, [`counters`],
-//! [`tolerances`].
+//! Files, one job each: [`minkowski`] (support of A ⊖ B in A's frame), [`gjk`] (distance / intersection),
+//! [`epa`] (Minkowski overlap), [`sat`] (exact oracle and fallback), [`features`] (closest points of small
+//! features), one file per shape pair ([`contact_polyhedron_polyhedron`], [`contact_sphere_polyhedron`],
+//! [`contact_polyhedron_plane`], [`contact_sphere_plane`], [`contact_sphere_sphere`](mod@contact_sphere_sphere)), [`dispatch`] (over
+//! [`Shape`](crate::shape::Shape)), [`counters`], [`tolerances`].
+//!
+//! Entry points: [`query`] (any shapes, hot path), [`query_polyhedra_cached`] / [`query_polyhedra`] /
+//! [`sat_polyhedra`] (polyhedra: hot path, convenience, exact oracle), [`intersect_polyhedra_cached`]
+//! (rejection test). References: Gilbert, Johnson & Keerthi (1988); van den Bergen, *Collision Detection in
+//! Interactive 3D Environments* (2001); Feng & Tan's Minkowski overlap as used by Zhao et al. (2021).
 
 pub mod contact_polyhedron_plane;
 pub mod contact_polyhedron_polyhedron;

@@ -217,6 +217,10 @@ fn points_along(
         .filter(|p| -n.dot(p) >= hb - eps)
         .map(|p| p + n * s)
         .collect();
+    if fa.is_empty() || fb.is_empty() {
+        // Only with non-finite input (every comparison false): no feature, report the centres' points.
+        return (va[0], vb[0]);
+    }
     let (x, y, _) = closest_point_sets(&fa, &fb);
     let mid = (x + y) * 0.5;
     (mid, mid - n * s)

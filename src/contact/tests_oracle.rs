@@ -347,7 +347,7 @@ pub(crate) fn voronoi_cell_points(rng: &mut impl Rng, size: Real, neighbours: us
 }
 
 /// Shape classes of the random sets, all built by the production constructor.
-pub(crate) const CLASS_NAMES: [&str; 8] = [
+pub(crate) const CLASS_NAMES: [&str; 10] = [
     "tetrahedron",
     "box",
     "hull8",
@@ -356,6 +356,8 @@ pub(crate) const CLASS_NAMES: [&str; 8] = [
     "hull64",
     "voronoi",
     "box-exact",
+    "plate",
+    "needle",
 ];
 
 pub(crate) fn random_polyhedron(rng: &mut impl Rng, size: Real, class: usize) -> ConvexPolyhedron {
@@ -366,6 +368,26 @@ pub(crate) fn random_polyhedron(rng: &mut impl Rng, size: Real, class: usize) ->
         3 => ellipsoid_points(rng, size, 16),
         4 => ellipsoid_points(rng, size, 32),
         5 => ellipsoid_points(rng, size, 64),
+        8 => {
+            TestPolytope::cuboid(
+                Vector::new(
+                    1.0,
+                    rng.random_range(0.5..1.0),
+                    rng.random_range(0.005..0.02),
+                ) * size,
+            )
+            .verts
+        }
+        9 => {
+            let axes = Vector::new(
+                1.0,
+                rng.random_range(0.02..0.08),
+                rng.random_range(0.02..0.08),
+            ) * size;
+            (0..16)
+                .map(|_| Point::from(random_unit(rng).component_mul(&axes)))
+                .collect()
+        }
         _ => voronoi_cell_points(rng, size, 24),
     };
     ConvexPolyhedron::from_points(&pts)
@@ -395,7 +417,8 @@ fn random_pairs(seed: u64, count: usize, size: Real, classes: &[(usize, usize)])
         let u = random_unit(&mut rng);
         let t0 = touching_offset(&pos1, &a, &rot2, &b, &u);
         // 0..5: overlaps log-spread over 1e-9..0.3 of the size; 6: touching; 7: separated (log-spread).
-        let mode = i % 8;
+        // Every class pair meets every mode.
+        let mode = (i / classes.len()) % 8;
         let x = size * 10f64.powf(rng.random_range(-9.0..(0.3f64).log10()));
         let t = match mode {
             6 => t0,
@@ -427,7 +450,7 @@ fn random_pairs(seed: u64, count: usize, size: Real, classes: &[(usize, usize)])
     stats
 }
 
-const CLASSES: [(usize, usize); 16] = [
+const CLASSES: [(usize, usize); 21] = [
     (0, 0),
     (1, 1),
     (2, 2),
@@ -444,23 +467,28 @@ const CLASSES: [(usize, usize); 16] = [
     (5, 1),
     (6, 2),
     (4, 0),
+    (8, 8),
+    (9, 9),
+    (8, 1),
+    (9, 6),
+    (8, 9),
 ];
 
 #[test]
 fn random_pairs_match_sat_at_unit_size() {
-    let s = random_pairs(1, 1200, 1.0, &CLASSES);
+    let s = random_pairs(1, 1344, 1.0, &CLASSES);
     println!("{s:?}");
 }
 
 #[test]
 fn random_pairs_match_sat_at_millimetre_size() {
-    let s = random_pairs(2, 480, 1e-3, &CLASSES);
+    let s = random_pairs(2, 504, 1e-3, &CLASSES);
     println!("{s:?}");
 }
 
 #[test]
 fn random_pairs_match_sat_at_kilometre_size() {
-    let s = random_pairs(3, 480, 1e3, &CLASSES);
+    let s = random_pairs(3, 504, 1e3, &CLASSES);
     println!("{s:?}");
 }
 
@@ -540,5 +568,36 @@ fn capped_solvers_fall_back_to_the_exact_answer_and_are_counted() {
             counters.fallback_max_iterations, fallbacks as u64,
             "cap set {k}: {counters}"
         );
+    }
+}
+
+/// Non-finite input (a NaN or infinite pose) must not panic: the query returns a geometry whose non-finite
+/// values the caller's checks catch.
+#[test]
+fn non_finite_poses_do_not_panic() {
+    let mut rng = ChaCha8Rng::seed_from_u64(5);
+    let a = random_polyhedron(&mut rng, 1.0, 4);
+    let b = random_polyhedron(&mut rng, 1.0, 6);
+    let tol = ContactTolerances::default();
+    for bad in [Real::NAN, Real::INFINITY, -Real::INFINITY] {
+        let pos2 = Pose::translation(bad, 0.1, 0.2);
+        let mut counters = QueryCounters::default();
+        let g = query_polytopes_cached(
+            &Pose::identity(),
+            &a,
+            &pos2,
+            &b,
+            &tol,
+            &mut PairCache::default(),
+            &mut EpaScratch::default(),
+            &mut counters,
+        );
+        let finite =
+            g.depth.is_finite() && g.distance.is_finite() && g.normal.iter().all(|x| x.is_finite());
+        assert!(
+            !finite || g.kind == ContactKind::Separated,
+            "translation {bad}: {g:?}"
+        );
+        let _ = sat_polytopes(&Pose::identity(), &a, &pos2, &b, &tol, SolverStatus::Exact);
     }
 }

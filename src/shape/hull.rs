@@ -39,6 +39,14 @@ use super::polygon::supporting_plane;
 /// accumulated by the caller's transformations, while any real feature of a particle is far larger.
 pub(crate) const HULL_REL_TOL: Real = 1e-10;
 
+/// The absolute tolerance of hull construction for `points` of the given extent: `HULL_REL_TOL × extent`
+/// plus the round-off the coordinates themselves carry, 64 ε × the largest coordinate magnitude (a small
+/// particle far from the origin has coordinates rounded at a larger fraction of its size).
+pub(crate) fn hull_tolerance(points: &[Point], extent: Real) -> Real {
+    let largest = points.iter().map(|p| p.coords.amax()).fold(0.0, Real::max);
+    HULL_REL_TOL * extent + 64.0 * Real::EPSILON * largest
+}
+
 /// Relative thickness below which a cloud is rejected as collinear or coplanar. A face of width w and
 /// length ℓ has its normal resolved by f64 only to ~ε ℓ/w, so its far corners sit ~ε ℓ²/w off the computed
 /// plane; keeping that below `HULL_REL_TOL × extent` with a margin of ten requires w ≳ 1e-5 ℓ. Particles
@@ -149,7 +157,7 @@ fn farthest(points: &[Point], distance: impl Fn(&Point) -> Real) -> (usize, Real
 /// The convex hull of `points` with coplanar triangles merged into polygonal faces (see the module docs).
 pub(crate) fn convex_hull(points: &[Point]) -> Result<PolygonMesh, ShapeError> {
     let extent = validate_points(points)?;
-    let tol = HULL_REL_TOL * extent;
+    let tol = hull_tolerance(points, extent);
     let tetra = spanning_tetrahedron(points, extent, FLAT_REL_TOL * extent)?;
     let interior = Point::from(
         (points[tetra[0]].coords
@@ -582,7 +590,7 @@ mod tests {
                 Ok(mesh) => {
                     built += 1;
                     let extent = validate_points(&points).unwrap();
-                    let tol = HULL_REL_TOL * extent;
+                    let tol = hull_tolerance(&points, extent);
                     let edges: usize = mesh.faces.iter().map(Vec::len).sum::<usize>() / 2;
                     assert_eq!(
                         mesh.vertices.len() as i64 - edges as i64 + mesh.faces.len() as i64,

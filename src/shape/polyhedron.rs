@@ -14,13 +14,13 @@
 //! # Tolerances
 //! [`ConvexPolyhedron::length_scale`] is the diameter of the bounding sphere centred at the centroid
 //! (twice [`ConvexPolyhedron::bounding_radius`]). Construction tolerances are relative to the input's extent
-//! (see `hull::HULL_REL_TOL`); contact code scales its tolerances by `length_scale()`.
+//! (`hull::hull_tolerance`: 1e-10 of the extent plus the coordinates' own round-off); contact code scales its tolerances by `length_scale()`.
 
 use crate::math::{Matrix, Point, Pose, Real, Rotation, Vector};
 
 use super::aabb::Aabb;
 use super::error::ShapeError;
-use super::hull::{self, HULL_REL_TOL};
+use super::hull;
 use super::mass::{polyhedron_mass_properties, MassProperties};
 use super::polygon::{newell_normal, supporting_plane};
 use super::support::SupportMap;
@@ -71,7 +71,7 @@ impl ConvexPolyhedron {
     /// outside). The mesh is validated: at least 4 vertices, all finite and used; every face has ≥ 3 distinct
     /// valid indices and is planar; the surface is closed, consistently oriented, of sphere topology, with
     /// outward orientation and positive volume; and the solid is convex. Tolerances are relative to the
-    /// vertices' extent (`HULL_REL_TOL`).
+    /// vertices' extent (`hull::hull_tolerance`).
     ///
     /// Returns the polyhedron in its principal frame and the pose mapping that frame to the input frame.
     pub fn from_vertices_faces(
@@ -79,7 +79,7 @@ impl ConvexPolyhedron {
         faces: &[Vec<u32>],
     ) -> Result<(ConvexPolyhedron, Pose), ShapeError> {
         let extent = hull::validate_points(vertices)?;
-        let tol = HULL_REL_TOL * extent;
+        let tol = hull::hull_tolerance(vertices, extent);
         validate_topology(vertices.len(), faces)?;
         let signed_volume = polyhedron_mass_properties(vertices, faces).volume;
         if signed_volume < 0.0 {
@@ -1017,6 +1017,93 @@ mod tests {
                 assert!(
                     nearest <= 1e-12 * 100.0,
                     "case {case}: vertex maps {nearest:e} away from the input"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn small_boxes_far_from_the_origin_keep_their_faces() {
+        // Particle size 1e-3 placed 1e3 away: coordinates carry round-off ~1e-13, a 1e-10 fraction of the
+        // size, which the hull tolerance must absorb (it includes the coordinates' own round-off).
+        let mut rng = ChaCha8Rng::seed_from_u64(31);
+        for case in 0..50 {
+            let rotation = random_rotation(&mut rng);
+            let shift = Vector::new(
+                rng.random_range(-1e3..1e3),
+                rng.random_range(-1e3..1e3),
+                1e3,
+            );
+            let points: Vec<Point> = box_corners(1e-3, 2e-3, 1.5e-3)
+                .iter()
+                .map(|q| rotation * q + shift)
+                .collect();
+            let built = ConvexPolyhedron::from_points(&points);
+            let Ok((p, pose)) = built else {
+                panic!("case {case}: {:?}", built.err());
+            };
+            assert_eq!(
+                (p.vertices().len(), p.num_faces(), p.edges().len()),
+                (8, 6, 12),
+                "case {case}: box of size 1e-3 at {shift:?}"
+            );
+            let volume = p.mass_properties().volume;
+            let expected = 1e-3 * 2e-3 * 1.5e-3;
+            assert!(
+                (volume - expected).abs() <= 1e-6 * expected,
+                "case {case}: volume {volume:e}, expected {expected:e}"
+            );
+            let centre_error = (pose.translation.vector - shift).norm();
+            assert!(
+                centre_error <= 1e-12,
+                "case {case}: centroid off by {centre_error:e}"
+            );
+        }
+    }
+
+    #[test]
+    fn from_vertices_faces_pose_maps_back_to_a_moved_cuboid() {
+        let mut rng = ChaCha8Rng::seed_from_u64(41);
+        let (cube, faces) = cube_faces();
+        let stretch = Vector::new(0.5, 2.0, 1.25);
+        let local: Vec<Point> = cube
+            .iter()
+            .map(|q| Point::from(q.coords.component_mul(&stretch)))
+            .collect();
+        for case in 0..10 {
+            let rotation = random_rotation(&mut rng);
+            let shift = Vector::new(
+                rng.random_range(-10.0..10.0),
+                rng.random_range(-10.0..10.0),
+                4.0,
+            );
+            let moved: Vec<Point> = local.iter().map(|q| rotation * q + shift).collect();
+            let (p, pose) = ConvexPolyhedron::from_vertices_faces(&moved, &faces).unwrap();
+            check_invariants(&p, &format!("moved cuboid case {case}"));
+            for (v, q) in p.vertices().iter().zip(&moved) {
+                let err = (pose * v - q).norm();
+                assert!(
+                    err <= 1e-13,
+                    "case {case}: vertex maps back with error {err:e}"
+                );
+            }
+            // Principal moments ascending: smallest about the longest side (y, 2.0).
+            let (a, b, c) = (stretch.x, stretch.y, stretch.z);
+            let volume = a * b * c;
+            let mut expected = [
+                volume * (b * b + c * c) / 12.0,
+                volume * (a * a + c * c) / 12.0,
+                volume * (a * a + b * b) / 12.0,
+            ];
+            expected.sort_by(Real::total_cmp);
+            let m = p.mass_properties().principal_moments;
+            for k in 0..3 {
+                assert!(
+                    (m[k] - expected[k]).abs() <= 1e-12 * expected[2],
+                    "case {case}: moment {k} {} vs {} (tol {:e})",
+                    m[k],
+                    expected[k],
+                    1e-12 * expected[2]
                 );
             }
         }
