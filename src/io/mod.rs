@@ -1,5 +1,7 @@
 //! Input and output formats of the engine, one format per file.
 //!
 //! - [`pairs_jsonl`]: the `polydem contact` pair format (JSON Lines in, JSON Lines out).
+//! - [`csv_output`]: the CSV time series of `polydem run` (tracked bodies, energy ledger).
 
+pub mod csv_output;
 pub mod pairs_jsonl;

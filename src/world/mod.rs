@@ -1,3 +1,19 @@
-//! The many-body world: broad phase, contact store and the step pipeline.
+//! The many-body world: broad phase, contact store, the step pipeline and the energy ledger.
+//!
+//! - [`broad_phase`]: candidate pairs from bounding spheres in a uniform grid with a Verlet skin.
+//! - [`world`]: the plain data of a simulation (bodies, walls, shapes, material-pair laws, kept state).
+//! - [`contact_store`]: per-pair state (warm start, tangential history) keyed by the ordered pair.
+//! - [`step`]: one time step, stage by stage, with timers and counters.
+//! - [`energy`]: the energy ledger that audits a run.
 
 pub mod broad_phase;
+pub mod contact_store;
+pub mod energy;
+pub mod step;
+#[allow(clippy::module_inception)]
+pub mod world;
+
+pub use contact_store::{ContactKey, ContactState, ContactStore};
+pub use energy::{EnergyLedger, EnergyReport};
+pub use step::{step, StepCounters, StepError, StepParams, StepReport, StepScratch};
+pub use world::{Loads, MaterialTable, Wall, World, WorldError};

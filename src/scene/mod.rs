@@ -1,0 +1,16 @@
+//! Scene files: a TOML description of a simulation (materials, contact laws, shapes, bodies, walls, time
+//! stepping and output), read into typed structs ([`schema`]), validated, and built into a ready-to-run
+//! [`Simulation`] ([`build`]). The time step is derived from the shortest contact time unless given, and a
+//! given one above the stability limit is refused ([`time_step`]). The format is documented for users in
+//! `docs/scene-format.md`.
+//!
+//! Every error names the file, the line and the field ([`SceneError`]); reading a scene never panics.
+
+pub mod build;
+pub mod run;
+pub mod schema;
+pub mod time_step;
+
+pub use build::{load_scene, parse_scene, SceneError, Simulation};
+pub use run::{RunError, RunSummary};
+pub use time_step::TimeStepInfo;

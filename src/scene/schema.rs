@@ -1,0 +1,133 @@
+//! The typed schema of a scene file (TOML): one struct per table, `deny_unknown_fields` everywhere, and
+//! every value that validation may refuse wrapped in [`Spanned`] so that the error can name its line.
+//!
+//! Only the fields whose absence has an obvious physical meaning are optional (initial velocities, a wall's
+//! velocity, the motion kind, tracking, global damping); every material constant and law parameter is
+//! required. `docs/scene-format.md` is the user's description of this schema.
+
+use serde::Deserialize;
+use toml::Spanned;
+
+/// A 3-vector in the file.
+pub type Vec3 = [f64; 3];
+
+/// The whole file.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SceneFile {
+    pub simulation: SimulationSection,
+    #[serde(default, rename = "material")]
+    pub materials: Vec<MaterialSection>,
+    #[serde(default, rename = "interaction")]
+    pub interactions: Vec<InteractionSection>,
+    #[serde(default, rename = "shape")]
+    pub shapes: Vec<ShapeSection>,
+    #[serde(default, rename = "body")]
+    pub bodies: Vec<BodySection>,
+    #[serde(default, rename = "wall")]
+    pub walls: Vec<WallSection>,
+}
+
+/// `[simulation]`: time stepping, gravity, output.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SimulationSection {
+    /// Gravitational acceleration (m/s²).
+    pub gravity: Spanned<Vec3>,
+    /// Simulated duration (s).
+    pub end_time: Spanned<f64>,
+    /// Interval between output rows (s); rounded to a whole number of steps (at least one).
+    pub output_interval: Spanned<f64>,
+    /// A given time step (s), refused when above the stability limit. Exclusive with `steps_per_contact`.
+    pub time_step: Option<Spanned<f64>>,
+    /// N in Δt = t_c,min / N (see the docs for t_c). Exclusive with `time_step`.
+    pub steps_per_contact: Option<Spanned<f64>>,
+    /// Impact speed (m/s) at which the contact time and stability of nonlinear laws are evaluated;
+    /// required when some law has an exponent other than 1.
+    pub characteristic_speed: Option<Spanned<f64>>,
+    /// Rate α (1/s) of a global mass-proportional viscous damping c = α m (paper eq. 6); absent = none.
+    pub viscous_damping_rate: Option<Spanned<f64>>,
+    /// Verlet skin of the broad phase (m); absent = 0.2 × the smallest bounding radius.
+    pub skin: Option<Spanned<f64>>,
+}
+
+/// `[[material]]`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MaterialSection {
+    pub name: Spanned<String>,
+    /// Density (kg/m³).
+    pub density: Spanned<f64>,
+}
+
+/// `[[interaction]]`: the contact law of a pair of materials.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct InteractionSection {
+    pub materials: Spanned<[String; 2]>,
+    /// `"linear"` (f_n = k_n δ) or `"power"` (f_n = k_n δ^n).
+    pub law: Spanned<String>,
+    /// k_n (N/m^n).
+    pub normal_stiffness: Spanned<f64>,
+    /// n (power law only; 1 ≤ n ≤ 3).
+    pub exponent: Option<Spanned<f64>>,
+    /// Coefficient of restitution e, 0 < e ≤ 1.
+    pub restitution: Spanned<f64>,
+    /// k_t (N/m); required when `friction` > 0.
+    pub tangential_stiffness: Option<Spanned<f64>>,
+    /// Coulomb friction coefficient μ ≥ 0.
+    pub friction: Spanned<f64>,
+}
+
+/// `[[shape]]`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ShapeSection {
+    pub name: Spanned<String>,
+    /// `"box"`, `"sphere"` or `"polyhedron"`.
+    pub kind: Spanned<String>,
+    /// Box: half extents (m).
+    pub half_extents: Option<Spanned<Vec3>>,
+    /// Sphere: radius (m).
+    pub radius: Option<Spanned<f64>>,
+    /// Polyhedron: points (m) whose convex hull is the shape (≥ 4, not coplanar).
+    pub points: Option<Spanned<Vec<Vec3>>>,
+}
+
+/// `[[body]]`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BodySection {
+    pub name: Spanned<String>,
+    pub shape: Spanned<String>,
+    pub material: Spanned<String>,
+    /// Where the origin of the shape's own coordinates goes (m).
+    pub position: Spanned<Vec3>,
+    /// Unit quaternion `[w, x, y, z]` turning the shape's coordinates into the world; exclusive with
+    /// `axis_angle`; absent = identity.
+    pub orientation: Option<Spanned<[f64; 4]>>,
+    /// Rotation vector (axis × angle, rad); exclusive with `orientation`.
+    pub axis_angle: Option<Spanned<Vec3>>,
+    /// Velocity of the centre of mass (m/s); absent = zero.
+    pub velocity: Option<Spanned<Vec3>>,
+    /// Angular velocity (rad/s, world frame); absent = zero.
+    pub angular_velocity: Option<Spanned<Vec3>>,
+    /// `"dynamic"` (absent), `"fixed"` or `"prescribed"` (moves with `velocity`, `angular_velocity`).
+    pub motion: Option<Spanned<String>>,
+    /// Write this body to `bodies.csv`; absent = false.
+    pub track: Option<bool>,
+}
+
+/// `[[wall]]`: the half-space behind a plane.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct WallSection {
+    pub name: Spanned<String>,
+    pub material: Spanned<String>,
+    /// A point of the plane (m).
+    pub point: Spanned<Vec3>,
+    /// Outward normal, pointing to the free side where the bodies are (normalised on reading).
+    pub normal: Spanned<Vec3>,
+    /// Prescribed velocity (m/s); absent = fixed.
+    pub velocity: Option<Spanned<Vec3>>,
+}

@@ -1,0 +1,224 @@
+//! Per-contact state that must survive from one step to the next, keyed by the ordered pair.
+//!
+//! # Keys and order
+//! A [`ContactKey`] is either a body pair `Body { a, b }` with `a < b`, or a body–wall pair
+//! `Wall { body, wall }`. The derived order (all body pairs, sorted, then all wall pairs sorted by body then
+//! wall) is the order of every later stage — narrow phase, laws and the accumulation of forces — so the
+//! result does not depend on anything but the candidate list.
+//!
+//! # Orientation of a pair (which shape is A)
+//! - Body pair: A is body `a` (the lower index), B is body `b`; the geometry's normal points from `a` to
+//!   `b`, and the tangential displacement is that of `b` relative to `a`.
+//! - Body–wall pair: A is the **wall**, B is the body; the normal is the wall's outward normal direction.
+//!
+//! The order never changes for a stored pair because indices do not change during a run. Whoever needs the
+//! other order (a new pair convention, a renumbering) must convert a stored entry with
+//! [`ContactState::swapped`]: the geometry goes through [`crate::contact::swap_pair`], the tangential
+//! history through [`TangentialHistory::swapped`] (n and u change sign), and the GJK/EPA warm-start cache is
+//! reset — it is expressed in A's frame with A's and B's vertex hints, and a cold start costs a few
+//! iterations once, whereas a mis-oriented warm start would cost correctness checks. The tangential spring
+//! is rotated into each new tangent plane by the law itself ([`crate::law::tangential::rotate_into_tangent_plane`])
+//! from the normal stored with it, so the store only has to keep `TangentialHistory` intact.
+//!
+//! # Lifetime
+//! [`ContactStore::sync`] merges the store (sorted by key) with the step's sorted candidate list: a
+//! candidate with a stored entry keeps it, a new candidate gets a fresh one, and an entry whose pair left the
+//! candidate list is dropped in the same pass. It is one linear merge, with no hashing, so the store is
+//! plain sorted data that serialises and compares bit for bit.
+
+use crate::contact::{swap_pair, ContactGeometry, ContactKind, PairCache, SolverStatus};
+use crate::law::TangentialHistory;
+use crate::math::{Point, Vector};
+
+/// The ordered pair a contact belongs to (see the module docs for the orientation).
+#[derive(Copy, Clone, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub enum ContactKey {
+    /// Two bodies, `a < b`; A = body a, B = body b.
+    Body { a: u32, b: u32 },
+    /// A body and a wall; A = the wall, B = the body.
+    Wall { body: u32, wall: u32 },
+}
+
+/// What the store keeps for one pair.
+#[derive(Copy, Clone, Debug, PartialEq)]
+pub struct ContactState {
+    /// Warm start of GJK/EPA (in A's frame).
+    pub cache: PairCache,
+    /// The tangential spring (B relative to A) and the normal it is expressed in.
+    pub history: TangentialHistory,
+    /// The step at which the pair entered the candidate list.
+    pub since_step: u64,
+    /// The last step at which the pair was in the candidate list (and evaluated).
+    pub last_touched: u64,
+    /// The geometry of the last evaluation (A → B).
+    pub geometry: ContactGeometry,
+    /// The force on B of the last evaluation (N); A received its opposite.
+    pub force_on_b: Vector,
+}
+
+impl ContactState {
+    /// A fresh entry for a pair entering the candidate list at `step`.
+    pub fn new(step: u64) -> Self {
+        Self {
+            cache: PairCache::default(),
+            history: TangentialHistory::default(),
+            since_step: step,
+            last_touched: step,
+            geometry: ContactGeometry {
+                kind: ContactKind::Separated,
+                depth: 0.0,
+                distance: 0.0,
+                normal: Vector::zeros(),
+                point_a: Point::origin(),
+                point_b: Point::origin(),
+                point: Point::origin(),
+                status: SolverStatus::Exact,
+            },
+            force_on_b: Vector::zeros(),
+        }
+    }
+
+    /// The same entry for the pair taken in the other order (B, A): see the module docs.
+    pub fn swapped(&self) -> Self {
+        Self {
+            cache: PairCache::default(),
+            history: self.history.swapped(),
+            geometry: swap_pair(&self.geometry),
+            force_on_b: -self.force_on_b,
+            ..*self
+        }
+    }
+
+    /// Whether the last evaluation found the shapes overlapping.
+    pub fn is_active(&self) -> bool {
+        self.geometry.kind == ContactKind::Overlap
+    }
+}
+
+/// The contact store: entries sorted by key, aligned with the current candidate list after [`sync`].
+///
+/// [`sync`]: ContactStore::sync
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct ContactStore {
+    keys: Vec<ContactKey>,
+    states: Vec<ContactState>,
+    // Scratch for the merge, kept to avoid reallocating every step.
+    next_keys: Vec<ContactKey>,
+    next_states: Vec<ContactState>,
+}
+
+/// What [`ContactStore::sync`] did.
+#[derive(Copy, Clone, Debug, Default, PartialEq, Eq)]
+pub struct SyncCounts {
+    pub kept: usize,
+    pub created: usize,
+    pub dropped: usize,
+}
+
+impl ContactStore {
+    /// Makes the store hold exactly one entry per key of `candidates` (sorted, no duplicates), in that
+    /// order: kept entries are marked touched at `step`, new ones are created, the others dropped.
+    pub fn sync(&mut self, candidates: &[ContactKey], step: u64) -> SyncCounts {
+        debug_assert!(candidates.windows(2).all(|w| w[0] < w[1]));
+        self.next_keys.clear();
+        self.next_states.clear();
+        let mut counts = SyncCounts::default();
+        let mut old = 0;
+        for &key in candidates {
+            while old < self.keys.len() && self.keys[old] < key {
+                old += 1;
+                counts.dropped += 1;
+            }
+            let state = if old < self.keys.len() && self.keys[old] == key {
+                let mut s = self.states[old];
+                old += 1;
+                counts.kept += 1;
+                s.last_touched = step;
+                s
+            } else {
+                counts.created += 1;
+                ContactState::new(step)
+            };
+            self.next_keys.push(key);
+            self.next_states.push(state);
+        }
+        counts.dropped += self.keys.len() - old;
+        std::mem::swap(&mut self.keys, &mut self.next_keys);
+        std::mem::swap(&mut self.states, &mut self.next_states);
+        counts
+    }
+
+    pub fn keys(&self) -> &[ContactKey] {
+        &self.keys
+    }
+
+    pub fn states(&self) -> &[ContactState] {
+        &self.states
+    }
+
+    pub fn states_mut(&mut self) -> &mut [ContactState] {
+        &mut self.states
+    }
+
+    /// The entry of `key`, if stored.
+    pub fn get(&self, key: &ContactKey) -> Option<&ContactState> {
+        self.keys.binary_search(key).ok().map(|i| &self.states[i])
+    }
+
+    pub fn len(&self) -> usize {
+        self.keys.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.keys.is_empty()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn sync_keeps_creates_and_drops_in_key_order() {
+        let mut store = ContactStore::default();
+        let k = |a, b| ContactKey::Body { a, b };
+        store.sync(&[k(0, 1), k(0, 2), k(1, 2)], 0);
+        store.states_mut()[0].history.displacement = Vector::new(1.0, 0.0, 0.0);
+        let counts = store.sync(
+            &[k(0, 1), k(1, 3), ContactKey::Wall { body: 0, wall: 0 }],
+            5,
+        );
+        assert_eq!(
+            counts,
+            SyncCounts {
+                kept: 1,
+                created: 2,
+                dropped: 2
+            }
+        );
+        assert_eq!(
+            store.keys(),
+            &[k(0, 1), k(1, 3), ContactKey::Wall { body: 0, wall: 0 }]
+        );
+        let kept = store.get(&k(0, 1)).expect("kept entry");
+        assert_eq!(kept.history.displacement, Vector::new(1.0, 0.0, 0.0));
+        assert_eq!((kept.since_step, kept.last_touched), (0, 5));
+        assert_eq!(store.get(&k(1, 3)).expect("new entry").since_step, 5);
+        assert!(store.get(&k(0, 2)).is_none());
+    }
+
+    #[test]
+    fn swapping_twice_restores_history_and_geometry() {
+        let mut s = ContactState::new(3);
+        s.history.displacement = Vector::new(0.0, 1e-4, 0.0);
+        s.history.normal = Vector::z();
+        s.geometry.normal = Vector::z();
+        s.geometry.point_a = Point::new(0.0, 0.0, 1.0);
+        s.force_on_b = Vector::new(0.0, 0.0, 2.0);
+        let back = s.swapped().swapped();
+        assert_eq!(back.history, s.history);
+        assert_eq!(back.geometry, s.geometry);
+        assert_eq!(back.force_on_b, s.force_on_b);
+        assert_eq!(s.swapped().history.normal, -Vector::z());
+    }
+}

@@ -1,0 +1,303 @@
+//! The world: plain data for every body, wall, shape and material pair, plus the state that persists between
+//! steps (contact store, broad phase, the forces of the last evaluation, the energy ledger).
+//!
+//! # Layout
+//! - Shapes live in a table ([`World::shapes`]); a body refers to its shape by index, so a thousand rocks
+//!   cut from ten shapes share ten hulls.
+//! - Bodies are stored as parallel arrays (struct of arrays): the integrator walks `bodies`, the broad
+//!   phase walks `radii`, and the narrow phase reads `shape_of` without touching the rest.
+//! - Walls are a separate list of planes, not bodies: a half-space has no bounding sphere for the broad
+//!   phase and no mass. A wall is fixed or moves with a prescribed constant velocity (translation only); its
+//!   pose is updated in the drift. Every body is tested against every wall whose plane its bounding sphere
+//!   reaches, which is O(bodies × walls) cheap tests for the handful of walls of a box.
+//! - The material-pair table maps an unordered pair of material ids to one [`ContactModel`]; a pair with
+//!   no model is refused when a body or wall of those materials is added (so a step never meets one).
+
+use crate::dynamics::RigidBody;
+use crate::law::ContactModel;
+use crate::math::{Point, Pose, Real, Vector};
+use crate::shape::{Plane, Shape};
+
+use super::broad_phase::BroadPhase;
+use super::contact_store::ContactStore;
+use super::energy::EnergyLedger;
+
+/// Why a body, wall or material could not be added.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum WorldError {
+    #[error("body '{body}': shape index {shape} does not exist ({count} shapes)")]
+    UnknownShape {
+        body: String,
+        shape: usize,
+        count: usize,
+    },
+    #[error("body '{body}': a plane cannot be a body's shape (planes are walls)")]
+    PlaneBody { body: String },
+    #[error("'{owner}': material index {material} does not exist ({count} materials)")]
+    UnknownMaterial {
+        owner: String,
+        material: usize,
+        count: usize,
+    },
+    #[error("'{owner}': no contact law for the material pair ('{a}', '{b}')")]
+    MissingLaw { owner: String, a: String, b: String },
+    #[error("wall '{wall}': {what} must be finite")]
+    NonFiniteWall { wall: String, what: &'static str },
+}
+
+/// A wall: a half-space (see [`Plane`] for its convention) placed by a pose that moves with a prescribed
+/// constant velocity (zero for a fixed wall).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Wall {
+    pub name: String,
+    pub plane: Plane,
+    /// Places the plane in the world (m).
+    pub pose: Pose,
+    /// Prescribed velocity (m/s), world frame; zero for a fixed wall.
+    pub velocity: Vector,
+    pub material: u32,
+}
+
+impl Wall {
+    /// Unit outward normal in the world frame (points to the free side).
+    pub fn normal_world(&self) -> Vector {
+        self.pose.rotation * self.plane.normal()
+    }
+
+    /// Signed distance (m) of `x` from the wall, positive on the free side.
+    pub fn signed_distance(&self, x: &Point) -> Real {
+        self.plane.signed_distance(&self.pose, x)
+    }
+}
+
+/// The symmetric table material pair → contact model.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct MaterialTable {
+    names: Vec<String>,
+    /// Row-major n × n, symmetric.
+    models: Vec<Option<ContactModel>>,
+}
+
+impl MaterialTable {
+    /// Adds a material; returns its id.
+    pub fn add_material(&mut self, name: &str) -> u32 {
+        let n = self.names.len();
+        let mut models = vec![None; (n + 1) * (n + 1)];
+        for i in 0..n {
+            for j in 0..n {
+                models[i * (n + 1) + j] = self.models[i * n + j];
+            }
+        }
+        self.models = models;
+        self.names.push(name.to_owned());
+        n as u32
+    }
+
+    /// Sets the model of the unordered pair (a, b).
+    pub fn set_model(&mut self, a: u32, b: u32, model: ContactModel) {
+        let n = self.names.len();
+        let (a, b) = (a as usize, b as usize);
+        self.models[a * n + b] = Some(model);
+        self.models[b * n + a] = Some(model);
+    }
+
+    /// The model of the pair (a, b), if one was set.
+    pub fn model(&self, a: u32, b: u32) -> Option<&ContactModel> {
+        let n = self.names.len();
+        self.models
+            .get(a as usize * n + b as usize)
+            .and_then(|m| m.as_ref())
+    }
+
+    pub fn len(&self) -> usize {
+        self.names.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.names.is_empty()
+    }
+
+    pub fn name(&self, id: u32) -> &str {
+        &self.names[id as usize]
+    }
+}
+
+/// Resultant force and torque on each body from the last contact evaluation, and the sums the energy
+/// ledger needs from it. The step evaluates forces once, at the new positions, and reuses them for the
+/// next step's first half kick.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Loads {
+    /// Contact force on each body (N), world frame (gravity is added by the integrator).
+    pub forces: Vec<Vector>,
+    /// Contact torque about each body's centre of mass (N·m), world frame.
+    pub torques: Vec<Vector>,
+    /// Total contact force on each wall (N).
+    pub wall_forces: Vec<Vector>,
+    /// Σ of the elastic potentials (normal power law and tangential spring) of all contacts (J).
+    pub elastic_potential: Real,
+    /// Σ of the damping powers f_d δ̇ (W, ≥ 0 for dissipation).
+    pub damping_power: Real,
+    /// Σ of the friction work dissipated during the step that produced these loads (J).
+    pub friction_dissipation: Real,
+    /// Power (W) the non-dynamic bodies and the walls deliver to the system through contacts.
+    pub external_power: Real,
+    /// Whether these loads belong to the current state (false before the first evaluation).
+    pub current: bool,
+}
+
+/// Every body, wall, shape and material of a simulation, and the state kept between steps.
+#[derive(Clone, Debug)]
+pub struct World {
+    pub shapes: Vec<Shape>,
+    pub bodies: Vec<RigidBody>,
+    /// Index into `shapes` of each body's shape.
+    pub shape_of: Vec<u32>,
+    /// Material id of each body.
+    pub material_of: Vec<u32>,
+    /// Bounding-sphere radius of each body about its centre of mass (m).
+    pub radii: Vec<Real>,
+    pub names: Vec<String>,
+    pub walls: Vec<Wall>,
+    pub materials: MaterialTable,
+    /// Gravitational acceleration (m/s²).
+    pub gravity: Vector,
+    pub contacts: ContactStore,
+    pub broad_phase: BroadPhase,
+    pub loads: Loads,
+    pub ledger: EnergyLedger,
+    /// Simulated time (s) and completed steps.
+    pub time: Real,
+    pub step_index: u64,
+}
+
+impl World {
+    /// An empty world. `skin` (m) is the Verlet skin of the broad phase.
+    pub fn new(gravity: Vector, materials: MaterialTable, skin: Real) -> Self {
+        Self {
+            shapes: Vec::new(),
+            bodies: Vec::new(),
+            shape_of: Vec::new(),
+            material_of: Vec::new(),
+            radii: Vec::new(),
+            names: Vec::new(),
+            walls: Vec::new(),
+            materials,
+            gravity,
+            contacts: ContactStore::default(),
+            broad_phase: BroadPhase::new(skin),
+            loads: Loads::default(),
+            ledger: EnergyLedger::default(),
+            time: 0.0,
+            step_index: 0,
+        }
+    }
+
+    /// Adds a shape to the table; returns its index.
+    pub fn add_shape(&mut self, shape: Shape) -> u32 {
+        self.shapes.push(shape);
+        (self.shapes.len() - 1) as u32
+    }
+
+    /// Adds a body; returns its index. The body's material must have a law with every material already
+    /// present, so that no pair can meet without one.
+    pub fn add_body(
+        &mut self,
+        name: &str,
+        shape: u32,
+        material: u32,
+        body: RigidBody,
+    ) -> Result<u32, WorldError> {
+        let radius = match self.shapes.get(shape as usize) {
+            None => {
+                return Err(WorldError::UnknownShape {
+                    body: name.to_owned(),
+                    shape: shape as usize,
+                    count: self.shapes.len(),
+                })
+            }
+            Some(Shape::Plane(_)) => {
+                return Err(WorldError::PlaneBody {
+                    body: name.to_owned(),
+                })
+            }
+            Some(Shape::Polyhedron(p)) => p.bounding_radius(),
+            Some(Shape::Sphere(s)) => s.radius(),
+        };
+        self.check_material(name, material, false)?;
+        self.bodies.push(body);
+        self.shape_of.push(shape);
+        self.material_of.push(material);
+        self.radii.push(radius);
+        self.names.push(name.to_owned());
+        self.loads.current = false;
+        Ok((self.bodies.len() - 1) as u32)
+    }
+
+    /// Adds a wall; returns its index.
+    pub fn add_wall(&mut self, wall: Wall) -> Result<u32, WorldError> {
+        if !wall.velocity.iter().all(|v| v.is_finite()) {
+            return Err(WorldError::NonFiniteWall {
+                wall: wall.name.clone(),
+                what: "velocity",
+            });
+        }
+        if !wall.pose.translation.vector.iter().all(|v| v.is_finite()) {
+            return Err(WorldError::NonFiniteWall {
+                wall: wall.name.clone(),
+                what: "position",
+            });
+        }
+        self.check_material(&wall.name, wall.material, true)?;
+        self.walls.push(wall);
+        self.loads.current = false;
+        Ok((self.walls.len() - 1) as u32)
+    }
+
+    /// The material exists and has a law with the material of every body already present, and, for a body,
+    /// also with every wall and itself (walls never touch each other).
+    fn check_material(&self, owner: &str, material: u32, is_wall: bool) -> Result<(), WorldError> {
+        if material as usize >= self.materials.len() {
+            return Err(WorldError::UnknownMaterial {
+                owner: owner.to_owned(),
+                material: material as usize,
+                count: self.materials.len(),
+            });
+        }
+        let body_only: Vec<u32> = if is_wall {
+            Vec::new()
+        } else {
+            self.walls
+                .iter()
+                .map(|w| w.material)
+                .chain(std::iter::once(material))
+                .collect()
+        };
+        let others = self.material_of.iter().copied().chain(body_only);
+        for other in others {
+            if self.materials.model(material, other).is_none() {
+                return Err(WorldError::MissingLaw {
+                    owner: owner.to_owned(),
+                    a: self.materials.name(material).to_owned(),
+                    b: self.materials.name(other).to_owned(),
+                });
+            }
+        }
+        Ok(())
+    }
+
+    /// The pose of body `i` (body frame = the shape's principal frame → world).
+    pub fn pose(&self, i: usize) -> Pose {
+        let b = &self.bodies[i];
+        Pose::from_parts(b.position.coords.into(), b.orientation)
+    }
+
+    /// The shape of body `i`.
+    pub fn shape(&self, i: usize) -> &Shape {
+        &self.shapes[self.shape_of[i] as usize]
+    }
+
+    /// Characteristic length of body `i` (m): its shape's length scale (bounding diameter).
+    pub fn length_scale(&self, i: usize) -> Real {
+        self.shape(i).length_scale().unwrap_or(2.0 * self.radii[i])
+    }
+}
