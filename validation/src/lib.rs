@@ -17,6 +17,7 @@ pub mod progress;
 pub mod provenance;
 pub mod report;
 pub mod runner;
+pub mod sim;
 
 pub use case::{Case, CaseData, Check, Profile, Target};
 pub use error::SuiteError;

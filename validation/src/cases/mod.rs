@@ -6,6 +6,7 @@ use crate::case::Case;
 pub mod contact;
 pub mod perf;
 pub mod precession;
+pub mod restitution;
 pub mod single_contact_energy;
 
 /// Every case of the suite, in the order they run.
@@ -14,6 +15,7 @@ pub fn registry() -> Vec<&'static dyn Case> {
         &contact::Contact,
         &precession::Precession,
         &single_contact_energy::SingleContactEnergy,
+        &restitution::Restitution,
         &perf::Perf,
     ]
 }

@@ -1,0 +1,395 @@
+//! Restitution (issue 3, gate 3): the measured coefficient of restitution of normal impacts equals the input
+//! of the damping law, for sphere–sphere, sphere–wall and a cube face-on on a wall (through the contact
+//! core), with the linear and the Hertz-type law, over a range of input e. A time-step sweep shows the
+//! first-order error of the damping term (the contact ends between two steps) against its bound 2Δt/t_c.
+
+use std::sync::Arc;
+
+use polydem::contact::{query, EpaScratch, PairCache, QueryCounters};
+use polydem::dynamics::{Motion, PrincipalInertia, RigidBody};
+use polydem::law::{ContactModel, DampingLaw, NormalLaw, TangentialLaw};
+use polydem::math::{Point, Real, Rotation, Vector};
+use polydem::shape::{ConvexPolyhedron, Plane, Shape};
+
+use crate::case::{Case, CaseData, Profile, Target};
+use crate::cases::single_contact_energy::{body_of, pose};
+use crate::context::CaseContext;
+use crate::error::SuiteError;
+use crate::plot::{Plot, Series, SeriesStyle};
+use crate::sim::two_body::{impact, sphere_sphere, wall_sphere};
+
+const RADIUS: Real = 0.05;
+const SIDE: Real = 0.2;
+const DENSITY: Real = 2600.0;
+const SPEED: Real = 1.0;
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Pair {
+    SphereSphere,
+    SphereWall,
+    CubeFaceWall,
+}
+
+impl Pair {
+    fn tag(self) -> &'static str {
+        match self {
+            Pair::SphereSphere => "sphere_sphere",
+            Pair::SphereWall => "sphere_wall",
+            Pair::CubeFaceWall => "cube_face_wall",
+        }
+    }
+}
+
+const PAIRS: [Pair; 3] = [Pair::SphereSphere, Pair::SphereWall, Pair::CubeFaceWall];
+
+/// (name, tag, normal law): linear k_n = 1e6 N/m, Hertz-type k_n = 1e9 N/m^1.5 (chosen by us; the
+/// restitution does not depend on them).
+fn laws() -> [(&'static str, &'static str, NormalLaw); 2] {
+    [
+        ("linear", "linear", NormalLaw::linear(1e6).expect("k > 0")),
+        ("Hertz-type", "hertz", NormalLaw::hertz(1e9).expect("k > 0")),
+    ]
+}
+
+fn sphere_body(z: Real, vz: Real) -> RigidBody {
+    let mass = DENSITY * 4.0 / 3.0 * std::f64::consts::PI * RADIUS.powi(3);
+    let inertia =
+        PrincipalInertia::new(Vector::repeat(0.4 * mass * RADIUS * RADIUS)).expect("I > 0");
+    let mut b = RigidBody::new_dynamic(Point::new(0.0, 0.0, z), mass, inertia).expect("body");
+    b.velocity = Vector::new(0.0, 0.0, vz);
+    b
+}
+
+fn cube() -> Arc<ConvexPolyhedron> {
+    let h = 0.5 * SIDE;
+    let mut corners = Vec::new();
+    for sx in [-h, h] {
+        for sy in [-h, h] {
+            for sz in [-h, h] {
+                corners.push(Point::new(sx, sy, sz));
+            }
+        }
+    }
+    Arc::new(
+        ConvexPolyhedron::from_points(&corners)
+            .expect("cube hull")
+            .0,
+    )
+}
+
+/// Measured restitution of one normal impact at SPEED with input `restitution`, dt = t_c/`per_contact`.
+pub fn measure(
+    pair: Pair,
+    law: NormalLaw,
+    restitution: Real,
+    per_contact: Real,
+) -> Result<Real, String> {
+    let model = ContactModel {
+        normal: law,
+        damping: DampingLaw::from_restitution(law.exponent, restitution)
+            .map_err(|e| e.to_string())?,
+        tangential: TangentialLaw::None,
+    };
+    let gap = 1e-3 * RADIUS;
+    let outcome = match pair {
+        Pair::SphereSphere => {
+            let a = sphere_body(0.0, 0.5 * SPEED);
+            let b = sphere_body(2.0 * RADIUS + gap, -0.5 * SPEED);
+            let m_star = 0.5 * a.mass;
+            let dt = law.elastic_contact_time(m_star, SPEED) / per_contact;
+            impact(
+                &model,
+                a,
+                b,
+                m_star,
+                dt,
+                (20.0 * per_contact) as usize,
+                |a, b| sphere_sphere(RADIUS, RADIUS, a, b),
+            )
+        }
+        Pair::SphereWall => {
+            let mut wall = sphere_body(0.0, 0.0);
+            wall.motion = Motion::Fixed;
+            let b = sphere_body(RADIUS + gap, -SPEED);
+            let m_star = b.mass;
+            let dt = law.elastic_contact_time(m_star, SPEED) / per_contact;
+            impact(
+                &model,
+                wall,
+                b,
+                m_star,
+                dt,
+                (20.0 * per_contact) as usize,
+                |_, b| wall_sphere(RADIUS, b),
+            )
+        }
+        Pair::CubeFaceWall => {
+            let shape_a = Shape::Plane(Plane::new(Vector::z(), 0.0).map_err(|e| e.to_string())?);
+            let shape_b = Shape::Polyhedron(cube());
+            let wall = body_of(&shape_a, Point::origin(), Rotation::identity());
+            let mut b = body_of(
+                &shape_b,
+                Point::new(0.0, 0.0, 0.5 * SIDE + gap),
+                Rotation::identity(),
+            );
+            b.velocity = Vector::new(0.0, 0.0, -SPEED);
+            let m_star = b.mass;
+            let dt = law.elastic_contact_time(m_star, SPEED) / per_contact;
+            let (mut cache, mut scratch, mut counters) = (
+                PairCache::default(),
+                EpaScratch::default(),
+                QueryCounters::default(),
+            );
+            let mut failure = None;
+            let run = impact(
+                &model,
+                wall,
+                b,
+                m_star,
+                dt,
+                (20.0 * per_contact) as usize,
+                |a, b| match query(
+                    &pose(a),
+                    &shape_a,
+                    &pose(b),
+                    &shape_b,
+                    &mut cache,
+                    &mut scratch,
+                    &mut counters,
+                ) {
+                    Ok(g) => g,
+                    Err(e) => {
+                        failure = Some(e.to_string());
+                        wall_sphere(0.0, b)
+                    }
+                },
+            );
+            if let Some(e) = failure {
+                return Err(format!("contact query failed: {e}"));
+            }
+            run
+        }
+    };
+    if !outcome.separated {
+        return Err(format!(
+            "{pair:?}, n = {}, e = {restitution}, dt = t_c/{per_contact}: the bodies did not separate",
+            law.exponent
+        ));
+    }
+    Ok((outcome.b.velocity - outcome.a.velocity).z / SPEED)
+}
+
+/// Bound of the relative restitution error at dt = `dt_fraction`·t_c. Linear law: the damping force jumps
+/// to c v₀ at the start of the contact and from c e v₀ at its end (δ = 0), and each jump is mis-timed by at
+/// most one step, so |Δv| ≤ c Δt (1 + e) v₀/m*, i.e. |Δe/e| ≤ ζ̂ ω₀ Δt (1 + e)/e with c = ζ̂ √(m* k),
+/// ω₀ = √(k/m*) = π/t_c. Hertz-type law: the damping force vanishes with δ^(1/4) at both ends, there is no
+/// jump, and the documented bound `hertz_factor`·Δt/t_c applies.
+pub fn first_order_bound(
+    law: NormalLaw,
+    restitution: Real,
+    dt_fraction: Real,
+    hertz_factor: Real,
+) -> Real {
+    if law.exponent != 1.0 {
+        return hertz_factor * dt_fraction;
+    }
+    let coefficient = match DampingLaw::from_restitution(1.0, restitution) {
+        Ok(DampingLaw::Viscous { coefficient }) => coefficient,
+        _ => 0.0,
+    };
+    coefficient * std::f64::consts::PI * dt_fraction * (1.0 + restitution) / restitution
+}
+
+pub struct Restitution;
+
+#[derive(serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+struct Params {
+    /// Input coefficients of restitution.
+    restitutions: Vec<Real>,
+    /// Steps per elastic contact time at which the 1 % bound is checked.
+    check_at: Real,
+    /// Steps per contact time of the dt sweep.
+    steps_per_contact: Vec<Real>,
+}
+
+impl Case for Restitution {
+    fn name(&self) -> &'static str {
+        "restitution"
+    }
+
+    fn data(&self) -> &'static str {
+        include_str!("../../cases/restitution.toml")
+    }
+
+    fn run(
+        &self,
+        data: &CaseData,
+        profile: Profile,
+        ctx: &mut CaseContext,
+    ) -> Result<(), SuiteError> {
+        let p: Params = data.params(self.name(), profile)?;
+        let tol = data.tolerance(self.name(), "restitution_rel")?.value;
+        let bound = data.tolerance(self.name(), "first_order_bound")?.value;
+        let reference = data.reference(self.name(), "restitution")?.value;
+        let fail = |msg: String| SuiteError::Case {
+            case: "restitution".into(),
+            msg,
+        };
+        ctx.progress().stage(
+            "impacts",
+            (PAIRS.len() * 2 * (p.restitutions.len() + p.steps_per_contact.len() * 2)) as u64,
+        );
+        let mut rows = Vec::new();
+        let mut measured_series = Vec::new();
+        let mut sweep_series = Vec::new();
+        let mut sweep_rows = Vec::new();
+        // Largest error·(t_c/Δt) of the Hertz-type law at e = 0.1 (outside the documented bound's range).
+        let mut hertz_low_e: Real = 0.0;
+        for (law_name, law_tag, law) in laws() {
+            for pair in PAIRS {
+                let mut points = Vec::new();
+                let mut worst: Real = 0.0;
+                for &e in &p.restitutions {
+                    let measured = measure(pair, law, e, p.check_at).map_err(fail)?;
+                    let error = (measured / e - reference).abs();
+                    worst = worst.max(error);
+                    rows.push(vec![
+                        format!("{pair:?}"),
+                        law_name.to_string(),
+                        format!("{e}"),
+                        format!("{measured:.6}"),
+                        CaseContext::fmt(error),
+                    ]);
+                    points.push((e, measured));
+                    ctx.progress().inc(1);
+                }
+                ctx.check(
+                    &format!("restitution_rel_error_max_{}_{law_tag}", pair.tag()),
+                    worst,
+                    Target::at_most(tol),
+                    "1",
+                );
+                measured_series.push(Series {
+                    label: format!("{pair:?}, {law_name}"),
+                    style: SeriesStyle::Points,
+                    points,
+                });
+                // dt sweep: the measured error over its first-order bound.
+                let mut ratio: Real = 0.0;
+                for e in [0.1, 0.3, 0.7] {
+                    let mut points = Vec::new();
+                    for &n in &p.steps_per_contact {
+                        let measured = measure(pair, law, e, n).map_err(fail)?;
+                        let error = (measured / e - 1.0).abs();
+                        let over = error / first_order_bound(law, e, 1.0 / n, bound);
+                        // The documented Hertz-type bound covers e ≥ 0.3 only: e = 0.1 is shown, not checked.
+                        if law.exponent == 1.0 || e >= 0.3 {
+                            ratio = ratio.max(over);
+                        } else {
+                            hertz_low_e = hertz_low_e.max(error * n);
+                        }
+                        sweep_rows.push(vec![
+                            format!("{pair:?}"),
+                            law_name.to_string(),
+                            format!("{e}"),
+                            format!("{n}"),
+                            format!("{measured:.6}"),
+                            CaseContext::fmt(error),
+                        ]);
+                        points.push((1.0 / n, error));
+                        ctx.progress().inc(1);
+                    }
+                    sweep_series.push(Series {
+                        label: format!("{pair:?}, {law_name}, e = {e}"),
+                        style: SeriesStyle::LinePoints,
+                        points,
+                    });
+                }
+                ctx.check(
+                    &format!("error_over_bound_max_{}_{law_tag}", pair.tag()),
+                    ratio,
+                    Target::at_most(1.0),
+                    "1",
+                );
+            }
+        }
+        ctx.section("Measured against input restitution");
+        ctx.text(&format!(
+            "Impact speed {SPEED} m/s, density {DENSITY} kg/m³, spheres of radius {RADIUS} m, cube of side {SIDE} m \
+             face-on (contact core: plane–polyhedron path); dt = t_c/{} with t_c the elastic contact time.",
+            p.check_at
+        ));
+        ctx.table(
+            Some("restitution"),
+            &["pair", "law", "e input", "e measured", "|e_meas/e_in − 1|"],
+            &rows,
+        )?;
+        let diagonal: Vec<(Real, Real)> = p.restitutions.iter().map(|&e| (e, e)).collect();
+        measured_series.push(Series {
+            label: "input (e_measured = e_input)".into(),
+            style: SeriesStyle::Line,
+            points: diagonal,
+        });
+        ctx.plot(&Plot {
+            name: "measured_vs_input".into(),
+            title: "Measured against input coefficient of restitution".into(),
+            x_label: "input e (1)".into(),
+            y_label: "measured e (1)".into(),
+            x_log: false,
+            y_log: false,
+            series: measured_series,
+            caption: format!(
+                "All pairs and laws at dt = t_c/{}; the line is e_measured = e_input.",
+                p.check_at
+            ),
+        })?;
+        ctx.section("Error against the time step");
+        ctx.text(
+            "The damping force is evaluated at the step ends, and the contact ends between two steps, so the \
+             restitution error is first order in Δt, with a constant that depends on where the end falls \
+             (erratic from one Δt to the next). Linear law: the damping force jumps at both ends of the contact \
+             (c v₀ at the start, c e v₀ at the end), each mis-timed by at most one step: |Δe/e| ≤ ζ̂ π (Δt/t_c)(1 + e)/e \
+             (ζ̂ = c/√(m* k)); checked as max(error/bound) ≤ 1. Hertz-type law: no jump (the damping vanishes with \
+             δ^(1/4)); the documented bound 2Δt/t_c (line) is checked for e = 0.3 and 0.7.",
+        );
+        ctx.table(
+            Some("dt_sweep"),
+            &[
+                "pair",
+                "law",
+                "e input",
+                "t_c/Δt",
+                "e measured",
+                "|e_meas/e_in − 1|",
+            ],
+            &sweep_rows,
+        )?;
+        ctx.text(&format!(
+            "Not checked: the Hertz-type law at e = 0.1 reaches error = {:.2} Δt/t_c, above the documented \
+             2Δt/t_c (which was established for e = 0.3 and 0.7): the bound does not hold for strongly damped \
+             Hertz-type impacts.",
+            hertz_low_e
+        ));
+        sweep_series.push(Series {
+            label: "Hertz-type bound 2Δt/t_c".into(),
+            style: SeriesStyle::Line,
+            points: p
+                .steps_per_contact
+                .iter()
+                .map(|n| (1.0 / n, bound / n))
+                .collect(),
+        });
+        ctx.plot(&Plot {
+            name: "error_vs_dt".into(),
+            title: "Restitution error against the time step".into(),
+            x_label: "Δt / t_c".into(),
+            y_label: "|e_measured/e_input − 1|".into(),
+            x_log: true,
+            y_log: true,
+            series: sweep_series,
+            caption: "Each pair and law at e = 0.1, 0.3 and 0.7. Errors of exactly 0 cannot be shown on the log axis.".into(),
+        })?;
+        Ok(())
+    }
+}

@@ -1,0 +1,3 @@
+//! Small simulation drivers shared by the cases and the `tests/` gates (no copies of the time loop).
+
+pub mod two_body;
