@@ -382,13 +382,15 @@ fn build(ctx: &Ctx, file: &SceneFile) -> Result<Simulation, SceneError> {
                 })?;
                 (Shape::Polyhedron(Arc::new(p)), frame)
             }
-            other => return Err(ctx.invalid(
-                s.kind.span(),
-                f("kind"),
-                format!(
+            other => {
+                return Err(ctx.invalid(
+                    s.kind.span(),
+                    f("kind"),
+                    format!(
                     "unknown shape kind '{other}' (expected \"box\", \"sphere\" or \"polyhedron\")"
                 ),
-            )),
+                ))
+            }
         };
         shape_ids.insert(name, shapes.len());
         shapes.push(built);
@@ -457,13 +459,15 @@ fn build(ctx: &Ctx, file: &SceneFile) -> Result<Simulation, SceneError> {
                 velocity,
                 angular_velocity_world: omega,
             },
-            Some((other, span)) => return Err(ctx.invalid(
-                span,
-                f("motion"),
-                format!(
+            Some((other, span)) => {
+                return Err(ctx.invalid(
+                    span,
+                    f("motion"),
+                    format!(
                     "unknown motion '{other}' (expected \"dynamic\", \"fixed\" or \"prescribed\")"
                 ),
-            )),
+                ))
+            }
         };
         let (shape, frame) = &shapes[shape_index];
         let density = densities[mat as usize];
