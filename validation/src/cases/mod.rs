@@ -3,6 +3,7 @@
 
 use crate::case::Case;
 
+pub mod chung_ooi;
 pub mod contact;
 pub mod perf;
 pub mod precession;
@@ -16,6 +17,7 @@ pub fn registry() -> Vec<&'static dyn Case> {
         &precession::Precession,
         &single_contact_energy::SingleContactEnergy,
         &restitution::Restitution,
+        &chung_ooi::ChungOoi,
         &perf::Perf,
     ]
 }
