@@ -310,56 +310,14 @@ fn sliding_sphere_starts_rolling_at_five_sevenths_of_its_speed() {
     // conserved). It starts at the static overlap δ = (m g / k_n)^(2/3) so that the contact persists.
     let (v0, mu, g) = (1.0, 0.3, 9.81);
     let model = hertz_mindlin(&pair(Partner::Wall, 0.5, mu)).unwrap();
-    let mut wall = sphere(Point::origin(), Vector::zeros());
-    wall.motion = Motion::Fixed;
-    let probe = sphere(Point::origin(), Vector::zeros());
-    let static_overlap = (probe.mass * g / model.normal.stiffness).powf(2.0 / 3.0);
-    let mut ball = sphere(
-        Point::new(0.0, 0.0, RADIUS - static_overlap),
-        Vector::new(v0, 0.0, 0.0),
-    );
-    // Normal oscillation period about the static overlap, from the tangent stiffness (3/2) k δ^(1/2).
-    let stiffness = 1.5 * model.normal.stiffness * static_overlap.sqrt();
-    let period = 2.0 * std::f64::consts::PI * (ball.mass / stiffness).sqrt();
-    let dt = period / 100.0;
-    let sliding_time = 2.0 * v0 / (7.0 * mu * g);
-    let steps = (3.0 * sliding_time / dt) as usize;
-    let integrator = Integrator {
-        translation: TranslationParams {
-            gravity: Vector::new(0.0, 0.0, -g),
-            damping: ViscousDamping::None,
-        },
-        rotation: RotationScheme::default(),
-    };
-    let mut history = TangentialHistory::default();
-    let evaluate = |ball: &RigidBody, history: &mut TangentialHistory| {
-        let geometry = geometry(Partner::Wall, &wall, ball);
-        let kinematics = ContactKinematics {
-            relative_velocity: ball.velocity_at(&geometry.point),
-            effective_mass: ball.mass,
-            center_a: wall.position,
-            center_b: ball.position,
-            dt,
-        };
-        model.evaluate(&geometry, &kinematics, history)
-    };
-    let mut response = evaluate(&ball, &mut history);
-    let mut lost_contact = 0;
-    for _ in 0..steps {
-        integrator.first_half_kick(&mut ball, &response.force_on_b, &response.torque_on_b, dt);
-        integrator.drift(&mut ball, dt);
-        response = evaluate(&ball, &mut history);
-        integrator.second_half_kick(&mut ball, &response.force_on_b, &response.torque_on_b, dt);
-        if response.normal_force <= 0.0 {
-            lost_contact += 1;
-        }
-    }
+    let mass = sphere(Point::origin(), Vector::zeros()).mass;
+    let run = polydem_validation::sim::rolling::roll(&model, RADIUS, mass, v0, mu, g, 3.0);
+    let lost_contact = run.lost_contact;
     assert_eq!(
         lost_contact, 0,
         "the sphere left the wall in {lost_contact} steps"
     );
-    let v = ball.velocity.x;
-    let rolling = ball.angular_velocity().y * RADIUS;
+    let (v, rolling) = (run.velocity, run.rolling_speed);
     let expected = 5.0 / 7.0 * v0;
     println!("rolling: v/v0 = {}, ωR/v0 = {}", v / v0, rolling / v0);
     assert!(
