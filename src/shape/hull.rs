@@ -29,7 +29,8 @@
 
 use std::collections::HashMap;
 
-use crate::math::{from_parry_vector, to_parry_vector, Point, Real, Rotation, Vector};
+use crate::math::glam::{glam_to_point, point_to_glam};
+use crate::math::{Point, Real, Rotation, Vector};
 
 use super::error::ShapeError;
 use super::polygon::supporting_plane;
@@ -211,7 +212,7 @@ fn triangulated_hull(
     for (i, w) in transformed.iter().enumerate() {
         if let std::collections::hash_map::Entry::Vacant(slot) = original.entry(key(w)) {
             slot.insert(i);
-            input.push(to_parry_vector(w));
+            input.push(point_to_glam(w));
         }
     }
     let hull = std::panic::catch_unwind(|| parry3d_f64::transformation::try_convex_hull(&input));
@@ -230,7 +231,7 @@ fn triangulated_hull(
     };
     let mut vertices = Vec::with_capacity(hull_vertices.len());
     for v in hull_vertices {
-        let Some(&i) = original.get(&key(&from_parry_vector(v))) else {
+        let Some(&i) = original.get(&key(&glam_to_point(v))) else {
             return Err(ShapeError::HullFailed {
                 reason: "parry3d returned a vertex that is not an input point".to_string(),
             });

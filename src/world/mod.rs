@@ -1,9 +1,9 @@
 //! The many-body world: broad phase, contact store, the step pipeline and the energy ledger.
 //!
 //! - [`broad_phase`]: candidate pairs from bounding spheres in a uniform grid with a Verlet skin.
-//! - [`world`]: the plain data of a simulation (bodies, walls, shapes, material-pair laws, kept state).
+//! - [`world`](mod@world): the plain data of a simulation (bodies, walls, shapes, material-pair laws, kept state).
 //! - [`contact_store`]: per-pair state (warm start, tangential history) keyed by the ordered pair.
-//! - [`step`]: one time step, stage by stage, with timers and counters.
+//! - [`step`](mod@step): one time step, stage by stage, with timers and counters.
 //! - [`energy`]: the energy ledger that audits a run.
 
 pub mod broad_phase;

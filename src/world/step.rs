@@ -381,8 +381,11 @@ fn evaluate_loads(
     // 5. Laws.
     let t = Instant::now();
     scratch.responses.clear();
+    // The report describes the state at the end of the step: an initial evaluation's findings are
+    // replaced by those of the step's own evaluation.
     report.contacts = 0;
     report.max_overlap_ratio = 0.0;
+    report.overlap_warnings.clear();
     for ((key, g), state) in scratch
         .candidates
         .iter()

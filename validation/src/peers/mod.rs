@@ -2,8 +2,8 @@
 //!
 //! - [`parry`]: parry3d-f64 0.31 (GJK/EPA contact, intersection test, distance) on convex polyhedra.
 //! - [`rapier`]: rapier3d-f64 0.36's rigid-body integrator on a single free body (precession case).
-//! - [`convert`]: every nalgebra ↔ glam conversion of the harness (one file, project rule).
+//!
+//! Every nalgebra ↔ glam conversion lives in [`polydem::math::glam`] (one place, project rule).
 
-pub mod convert;
 pub mod parry;
 pub mod rapier;

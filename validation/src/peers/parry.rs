@@ -16,7 +16,7 @@ use parry3d_f64::shape::ConvexPolyhedron as ParryPolyhedron;
 use polydem::math::{Point, Pose, Vector};
 use polydem::shape::ConvexPolyhedron;
 
-use super::convert::{glam_to_point, glam_to_vector, point_to_glam, pose_to_glam};
+use polydem::math::glam::{glam_to_point, glam_to_vector, point_to_glam, pose_to_glam};
 
 /// A contact answer from parry, in polydem's conventions (world frame, normal from A to B).
 #[derive(Copy, Clone, Debug, PartialEq)]

@@ -9,7 +9,7 @@
 use polydem::math::{Real, Rotation, Vector};
 use rapier3d_f64::prelude::{MassProperties, PhysicsWorld, RigidBodyBuilder, RigidBodyHandle};
 
-use super::convert::{glam_to_rotation, glam_to_vector, rotation_to_glam, vector_to_glam};
+use polydem::math::glam::{glam_to_rotation, glam_to_vector, rotation_to_glam, vector_to_glam};
 
 /// A single free rigid body in a rapier world.
 pub struct RapierFreeBody {
