@@ -61,6 +61,13 @@ fn run_writes_the_documented_csv_files_and_summary() {
         .collect();
     assert_eq!(rows.len() as u64, outputs, "rows in energy.csv");
     assert_eq!(rows[0][9], 0.0, "the balance starts at zero");
+    let walls = std::fs::read_to_string(out.join("walls.csv")).expect("walls.csv");
+    assert_eq!(walls.lines().next(), Some("t,wall,fx,fy,fz"));
+    assert_eq!(
+        walls.lines().count(),
+        1,
+        "the scene has no walls: header only"
+    );
     let summary = std::fs::read_to_string(out.join("summary.txt")).expect("summary.txt");
     assert!(summary.contains("particle-steps per second"), "{summary}");
     let _ = std::fs::remove_dir_all(&out);

@@ -5,7 +5,7 @@
 //!   one JSON object per input line with two point clouds, one answer (or error record) per line.
 //!   `-` reads standard input; output goes to standard output unless `--out` is given.
 //! - `polydem run SCENE --out DIR`: runs a scene file (format in `docs/scene-format.md`) and writes
-//!   `DIR/bodies.csv`, `DIR/energy.csv` and `DIR/summary.txt`; the summary is also printed. A progress bar
+//!   `DIR/bodies.csv`, `DIR/energy.csv`, `DIR/walls.csv` and `DIR/summary.txt`; the summary is also printed. A progress bar
 //!   is drawn on standard error when it is a terminal.
 
 use std::fs::File;
@@ -96,6 +96,8 @@ fn run(scene: &std::path::Path, out_dir: &std::path::Path) -> Result<()> {
     let mut energy = create("energy.csv")?;
     csv_output::write_bodies_header(&mut bodies)?;
     csv_output::write_energy_header(&mut energy)?;
+    let mut walls = create("walls.csv")?;
+    csv_output::write_walls_header(&mut walls)?;
 
     let info = sim.time_step;
     let header = format!(
@@ -121,6 +123,7 @@ fn run(scene: &std::path::Path, out_dir: &std::path::Path) -> Result<()> {
         .run(
             |s| {
                 csv_output::write_bodies_rows(&mut bodies, s)?;
+                csv_output::write_walls_rows(&mut walls, s)?;
                 csv_output::write_energy_row(&mut energy, s)
             },
             |n| {
@@ -133,6 +136,7 @@ fn run(scene: &std::path::Path, out_dir: &std::path::Path) -> Result<()> {
     bar.finish_and_clear();
     bodies.flush()?;
     energy.flush()?;
+    walls.flush()?;
     let body_steps = summary.steps as f64 * sim.world.bodies.len() as f64;
     let final_energy = sim.world.energy();
     let text = format!(

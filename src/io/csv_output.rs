@@ -5,6 +5,8 @@
 //!   q the unit quaternion of the body's own frame (as the scene gave it) in the world, ω its angular
 //!   velocity (rad/s, world frame).
 //! - `energy.csv`: the columns of [`crate::world::EnergyReport::CSV_HEADER`] (J).
+//! - `walls.csv`: `t,wall,fx,fy,fz`, the total contact force on each wall (N, world frame), one row per wall
+//!   per output time.
 //!
 //! Numbers are written with Rust's shortest round-trip formatting, so a value read back is bit-identical.
 
@@ -46,4 +48,28 @@ pub fn write_energy_header(out: &mut impl Write) -> io::Result<()> {
 /// Writes the ledger at the simulation's current time.
 pub fn write_energy_row(out: &mut impl Write, sim: &Simulation) -> io::Result<()> {
     writeln!(out, "{}", sim.world.energy().csv_row())
+}
+
+/// Header of `walls.csv`: the total contact force each wall receives (N), world frame.
+pub const WALLS_HEADER: &str = "t,wall,fx,fy,fz";
+
+/// Writes the header of `walls.csv`.
+pub fn write_walls_header(out: &mut impl Write) -> io::Result<()> {
+    writeln!(out, "{WALLS_HEADER}")
+}
+
+/// Writes one row per wall: the contact force on it from the last evaluation (zero before the first step).
+pub fn write_walls_rows(out: &mut impl Write, sim: &Simulation) -> io::Result<()> {
+    let t = sim.world.time;
+    for (w, wall) in sim.world.walls.iter().enumerate() {
+        let f = sim
+            .world
+            .loads
+            .wall_forces
+            .get(w)
+            .copied()
+            .unwrap_or_else(crate::math::Vector::zeros);
+        writeln!(out, "{t},{},{},{},{}", wall.name, f.x, f.y, f.z)?;
+    }
+    Ok(())
 }
