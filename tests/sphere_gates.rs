@@ -1,19 +1,17 @@
 //! Sphere impacts against closed-form answers (issue 3, gates 3 and 5, sphere part): Hertz elastic impact
 //! (peak force, peak overlap, contact duration), restitution against a wall, and an oblique impact in gross
 //! sliding against the rigid-body impulse solution. Laws from `polydem::law::hertz_mindlin`, integration by
-//! the body integrator; sphere–sphere and sphere–wall geometry in closed form here (the contact core's fast
+//! the body integrator through the shared driver `polydem_validation::sim::two_body`; sphere–sphere and
+//! sphere–wall geometry in closed form there (the contact core's fast
 //! paths are not used, so these gates test the laws and the integrator only).
 
-use polydem::contact::{ContactGeometry, ContactKind, SolverStatus};
-use polydem::dynamics::{
-    Integrator, Motion, PrincipalInertia, RigidBody, RotationScheme, TranslationParams,
-    ViscousDamping,
-};
+use polydem::dynamics::{Motion, PrincipalInertia, RigidBody};
 use polydem::law::hertz_mindlin::{
     effective, effective_young_modulus, hertz_mindlin, ElasticMaterial, SpherePair,
 };
-use polydem::law::{ContactKinematics, ContactModel, ContactResponse, TangentialHistory};
+use polydem::law::ContactModel;
 use polydem::math::{Point, Real, Vector};
+use polydem_validation::sim::two_body;
 
 /// Aluminium-like material and a 0.1 m sphere at 10 m/s: chosen by us, not quoted from a paper.
 const RADIUS: Real = 0.1;
@@ -38,124 +36,38 @@ enum Partner {
     Wall,
 }
 
-fn geometry(partner: Partner, a: &RigidBody, b: &RigidBody) -> ContactGeometry {
-    let (normal, depth, point_a) = match partner {
-        Partner::Sphere => {
-            let d = b.position - a.position;
-            let n = d / d.norm();
-            (n, 2.0 * RADIUS - d.norm(), a.position + n * RADIUS)
-        }
-        Partner::Wall => {
-            let n = Vector::z();
-            (
-                n,
-                RADIUS - b.position.z,
-                Point::new(b.position.x, b.position.y, 0.0),
-            )
-        }
-    };
-    let point_b = b.position - normal * RADIUS;
-    ContactGeometry {
-        kind: if depth > 0.0 {
-            ContactKind::Overlap
-        } else {
-            ContactKind::Separated
-        },
-        depth: depth.max(0.0),
-        distance: (-depth).max(0.0),
-        normal,
-        point_a,
-        point_b,
-        point: Point::from((point_a.coords + point_b.coords) * 0.5),
-        status: SolverStatus::Exact,
-    }
-}
-
-struct Impact {
-    peak_force: Real,
-    peak_overlap: Real,
-    duration: Real,
-    b_after: RigidBody,
-    a_after: RigidBody,
-}
-
-/// Integrates until the contact has ended; dt = t_c/`per_contact` (t_c of the elastic law at the approach
-/// speed). Contact start and end times are interpolated linearly in the overlap between steps.
+/// Integrates until the contact has ended (shared driver `polydem_validation::sim::two_body::impact`);
+/// dt = t_c/`per_contact` (t_c of the elastic law at the approach speed).
 fn impact(
     partner: Partner,
     model: &ContactModel,
-    mut a: RigidBody,
-    mut b: RigidBody,
+    a: RigidBody,
+    b: RigidBody,
     per_contact: Real,
-) -> Impact {
+) -> two_body::Impact {
     let m_star = match partner {
         Partner::Sphere => a.mass * b.mass / (a.mass + b.mass),
         Partner::Wall => b.mass,
     };
-    let approach = -(b.velocity - a.velocity).dot(&geometry(partner, &a, &b).normal);
+    let approach = match partner {
+        Partner::Sphere => -(b.velocity - a.velocity).dot(&(b.position - a.position).normalize()),
+        Partner::Wall => -b.velocity.z,
+    };
     let dt = model.normal.elastic_contact_time(m_star, approach) / per_contact;
-    let integrator = Integrator {
-        translation: TranslationParams {
-            gravity: Vector::zeros(),
-            damping: ViscousDamping::None,
+    let outcome = two_body::impact(
+        model,
+        a,
+        b,
+        m_star,
+        dt,
+        (20.0 * per_contact) as usize,
+        |a, b| match partner {
+            Partner::Sphere => two_body::sphere_sphere(RADIUS, RADIUS, a, b),
+            Partner::Wall => two_body::wall_sphere(RADIUS, b),
         },
-        rotation: RotationScheme::default(),
-    };
-    let mut history = TangentialHistory::default();
-    let evaluate = |a: &RigidBody,
-                    b: &RigidBody,
-                    history: &mut TangentialHistory|
-     -> (ContactResponse, Real) {
-        let g = geometry(partner, a, b);
-        let kinematics = ContactKinematics {
-            relative_velocity: b.velocity_at(&g.point) - a.velocity_at(&g.point),
-            effective_mass: m_star,
-            center_a: a.position,
-            center_b: b.position,
-            dt,
-        };
-        // Signed overlap for interpolating the contact start and end.
-        let signed = if g.kind == ContactKind::Overlap {
-            g.depth
-        } else {
-            -g.distance
-        };
-        (model.evaluate(&g, &kinematics, history), signed)
-    };
-    let (mut response, mut overlap) = evaluate(&a, &b, &mut history);
-    let (mut peak_force, mut peak_overlap): (Real, Real) = (0.0, 0.0);
-    let (mut start, mut end) = (None, None);
-    for step in 0..(20.0 * per_contact) as usize {
-        integrator.first_half_kick(&mut a, &-response.force_on_b, &response.torque_on_a, dt);
-        integrator.first_half_kick(&mut b, &response.force_on_b, &response.torque_on_b, dt);
-        integrator.drift(&mut a, dt);
-        integrator.drift(&mut b, dt);
-        let previous = overlap;
-        (response, overlap) = evaluate(&a, &b, &mut history);
-        integrator.second_half_kick(&mut a, &-response.force_on_b, &response.torque_on_a, dt);
-        integrator.second_half_kick(&mut b, &response.force_on_b, &response.torque_on_b, dt);
-        peak_force = peak_force.max(response.normal_force);
-        peak_overlap = peak_overlap.max(overlap);
-        let t = (step as Real + previous / (previous - overlap)) * dt;
-        if previous <= 0.0 && overlap > 0.0 && start.is_none() {
-            start = Some(t);
-        }
-        if previous > 0.0 && overlap <= 0.0 && start.is_some() {
-            end = Some(t);
-            break;
-        }
-    }
-    let (start, end) = (
-        start.expect("no contact"),
-        end.expect("contact did not end"),
     );
-    Impact {
-        peak_force,
-        peak_overlap,
-        duration: end - start,
-        b_after: b,
-        a_after: a,
-    }
+    assert!(outcome.separated, "contact did not end");
+    outcome
 }
 
 fn pair(partner: Partner, restitution: Real, friction: Real) -> SpherePair {
@@ -172,27 +84,14 @@ fn pair(partner: Partner, restitution: Real, friction: Real) -> SpherePair {
     }
 }
 
-/// Hertz (Johnson 1985, §11.4): δ_max = (15 m* v²/(16 E* √R*))^(2/5), F_max = (4/3) E* √R* δ_max^(3/2),
-/// t_c = 2.9432 δ_max/v, the constant being 2∫₀¹(1 − x^(5/2))^(−1/2) dx (evaluated by quadrature here).
+/// Hertz theory (Johnson 1985, §11.4) through `two_body::hertz_theory`: (F_max, δ_max, t_c).
 fn hertz_theory(partner: Partner, mass: Real, speed: Real) -> (Real, Real, Real) {
     let e_star = effective_young_modulus(&material(), &material());
     let (r_star, m_star) = match partner {
         Partner::Sphere => (effective(RADIUS, Some(RADIUS)), effective(mass, Some(mass))),
         Partner::Wall => (RADIUS, mass),
     };
-    let delta = (15.0 * m_star * speed * speed / (16.0 * e_star * r_star.sqrt())).powf(0.4);
-    let force = 4.0 / 3.0 * e_star * r_star.sqrt() * delta.powf(1.5);
-    // Midpoint rule after x = 1 − s², which removes the end-point singularity.
-    let panels = 100_000;
-    let h = 1.0 / panels as Real;
-    let integral: Real = (0..panels)
-        .map(|i| {
-            let s = (i as Real + 0.5) * h;
-            let x: Real = 1.0 - s * s;
-            2.0 * s * h / (1.0 - x.powf(2.5)).sqrt()
-        })
-        .sum();
-    (force, delta, 2.0 * integral * delta / speed)
+    two_body::hertz_theory(e_star, r_star, m_star, speed)
 }
 
 #[test]
@@ -255,17 +154,13 @@ fn sphere_wall_restitution_equals_the_input() {
             Vector::new(0.0, 0.0, -speed),
         );
         let outcome = impact(Partner::Wall, &model, wall, ball, 400.0);
-        let measured = outcome.b_after.velocity.z / speed;
+        let measured = outcome.b.velocity.z / speed;
         println!("sphere–wall e = {e}: measured {measured}");
         assert!(
             (measured - e).abs() < 0.01 * e,
             "Hertz sphere–wall, v = {speed} m/s, dt = t_c/400: restitution {measured}, input {e}, tolerance 1 %"
         );
-        assert_eq!(
-            outcome.a_after.velocity,
-            Vector::zeros(),
-            "the fixed wall moved"
-        );
+        assert_eq!(outcome.a.velocity, Vector::zeros(), "the fixed wall moved");
     }
 }
 
@@ -285,7 +180,7 @@ fn oblique_impact_in_gross_sliding_matches_the_impulse_solution() {
         Vector::new(v_t, 0.0, -v_n),
     );
     let outcome = impact(Partner::Wall, &model, wall, ball, 400.0);
-    let after = outcome.b_after;
+    let after = outcome.b;
     let expected_vt = v_t - mu * (1.0 + e) * v_n;
     let expected_spin = 2.5 * mu * (1.0 + e) * v_n / RADIUS; // about +y: the rolling sense for motion along +x
     let checks = [
@@ -310,56 +205,14 @@ fn sliding_sphere_starts_rolling_at_five_sevenths_of_its_speed() {
     // conserved). It starts at the static overlap δ = (m g / k_n)^(2/3) so that the contact persists.
     let (v0, mu, g) = (1.0, 0.3, 9.81);
     let model = hertz_mindlin(&pair(Partner::Wall, 0.5, mu)).unwrap();
-    let mut wall = sphere(Point::origin(), Vector::zeros());
-    wall.motion = Motion::Fixed;
-    let probe = sphere(Point::origin(), Vector::zeros());
-    let static_overlap = (probe.mass * g / model.normal.stiffness).powf(2.0 / 3.0);
-    let mut ball = sphere(
-        Point::new(0.0, 0.0, RADIUS - static_overlap),
-        Vector::new(v0, 0.0, 0.0),
-    );
-    // Normal oscillation period about the static overlap, from the tangent stiffness (3/2) k δ^(1/2).
-    let stiffness = 1.5 * model.normal.stiffness * static_overlap.sqrt();
-    let period = 2.0 * std::f64::consts::PI * (ball.mass / stiffness).sqrt();
-    let dt = period / 100.0;
-    let sliding_time = 2.0 * v0 / (7.0 * mu * g);
-    let steps = (3.0 * sliding_time / dt) as usize;
-    let integrator = Integrator {
-        translation: TranslationParams {
-            gravity: Vector::new(0.0, 0.0, -g),
-            damping: ViscousDamping::None,
-        },
-        rotation: RotationScheme::default(),
-    };
-    let mut history = TangentialHistory::default();
-    let evaluate = |ball: &RigidBody, history: &mut TangentialHistory| {
-        let geometry = geometry(Partner::Wall, &wall, ball);
-        let kinematics = ContactKinematics {
-            relative_velocity: ball.velocity_at(&geometry.point),
-            effective_mass: ball.mass,
-            center_a: wall.position,
-            center_b: ball.position,
-            dt,
-        };
-        model.evaluate(&geometry, &kinematics, history)
-    };
-    let mut response = evaluate(&ball, &mut history);
-    let mut lost_contact = 0;
-    for _ in 0..steps {
-        integrator.first_half_kick(&mut ball, &response.force_on_b, &response.torque_on_b, dt);
-        integrator.drift(&mut ball, dt);
-        response = evaluate(&ball, &mut history);
-        integrator.second_half_kick(&mut ball, &response.force_on_b, &response.torque_on_b, dt);
-        if response.normal_force <= 0.0 {
-            lost_contact += 1;
-        }
-    }
+    let mass = sphere(Point::origin(), Vector::zeros()).mass;
+    let run = polydem_validation::sim::rolling::roll(&model, RADIUS, mass, v0, mu, g, 3.0);
+    let lost_contact = run.lost_contact;
     assert_eq!(
         lost_contact, 0,
         "the sphere left the wall in {lost_contact} steps"
     );
-    let v = ball.velocity.x;
-    let rolling = ball.angular_velocity().y * RADIUS;
+    let (v, rolling) = (run.velocity, run.rolling_speed);
     let expected = 5.0 / 7.0 * v0;
     println!("rolling: v/v0 = {}, ωR/v0 = {}", v / v0, rolling / v0);
     assert!(

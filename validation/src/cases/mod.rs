@@ -5,6 +5,7 @@ use crate::case::Case;
 
 pub mod chung_ooi;
 pub mod contact;
+pub mod friction;
 pub mod perf;
 pub mod precession;
 pub mod restitution;
@@ -18,6 +19,7 @@ pub fn registry() -> Vec<&'static dyn Case> {
         &single_contact_energy::SingleContactEnergy,
         &restitution::Restitution,
         &chung_ooi::ChungOoi,
+        &friction::Friction,
         &perf::Perf,
     ]
 }
