@@ -24,6 +24,7 @@
 //!   Gauss–Legendre quadrature (relative accuracy ~1e-13 for the panel widths used).
 
 use crate::math::{Real, Rotation, Vector};
+use crate::special_functions::gauss_legendre;
 use crate::special_functions::{
     complete_elliptic_k, incomplete_elliptic_f, jacobi_elliptic, EllipticError,
 };
@@ -240,7 +241,7 @@ impl AsymmetricTop {
     pub fn precession_angle(&self, t: Real) -> Real {
         let panels = ((t.abs() / (self.period() / 64.0)).ceil() as usize).max(1);
         let h = t / panels as Real;
-        let (nodes, weights) = gauss_legendre_8();
+        let (nodes, weights) = gauss_legendre(8);
         let mut sum = 0.0;
         for p in 0..panels {
             let mid = (p as Real + 0.5) * h;
@@ -265,35 +266,6 @@ impl AsymmetricTop {
     pub fn orientation(&self, t: Real) -> Rotation {
         self.frame * self.orientation_in_momentum_frame(t, self.precession_angle(t))
     }
-}
-
-/// Nodes and weights of 8-point Gauss–Legendre quadrature on [−1, 1], by Newton iteration on P₈.
-fn gauss_legendre_8() -> ([Real; 8], [Real; 8]) {
-    let n = 8;
-    let mut nodes = [0.0; 8];
-    let mut weights = [0.0; 8];
-    for i in 0..n {
-        let mut x = (std::f64::consts::PI * (i as Real + 0.75) / (n as Real + 0.5)).cos();
-        let mut derivative = 1.0;
-        for _ in 0..100 {
-            let (mut p0, mut p1) = (1.0, x);
-            for k in 2..=n {
-                let k = k as Real;
-                let p2 = ((2.0 * k - 1.0) * x * p1 - (k - 1.0) * p0) / k;
-                p0 = p1;
-                p1 = p2;
-            }
-            derivative = n as Real * (x * p1 - p0) / (x * x - 1.0);
-            let dx = p1 / derivative;
-            x -= dx;
-            if dx.abs() < 1e-16 {
-                break;
-            }
-        }
-        nodes[i] = x;
-        weights[i] = 2.0 / ((1.0 - x * x) * derivative * derivative);
-    }
-    (nodes, weights)
 }
 
 #[cfg(test)]

@@ -185,6 +185,7 @@ pub fn incomplete_elliptic_f(phi: Real, m: Real) -> Result<Real, EllipticError> 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::special_functions::gauss_legendre;
 
     /// K(m) by the trapezoidal rule over a full period of the smooth, π-periodic integrand
     /// 1/√(1 − m sin²θ): K = ½ ∫₀^π …, and the trapezoidal rule converges geometrically for periodic analytic
@@ -217,34 +218,6 @@ mod tests {
             }
         }
         sum
-    }
-
-    /// Gauss–Legendre nodes and weights by Newton iteration on the Legendre polynomial P_n.
-    fn gauss_legendre(n: usize) -> (Vec<Real>, Vec<Real>) {
-        let mut nodes = Vec::with_capacity(n);
-        let mut weights = Vec::with_capacity(n);
-        for i in 0..n {
-            let mut x = (PI * (i as Real + 0.75) / (n as Real + 0.5)).cos();
-            let mut derivative = 0.0;
-            for _ in 0..100 {
-                let (mut p0, mut p1) = (1.0, x);
-                for k in 2..=n {
-                    let k = k as Real;
-                    let p2 = ((2.0 * k - 1.0) * x * p1 - (k - 1.0) * p0) / k;
-                    p0 = p1;
-                    p1 = p2;
-                }
-                derivative = n as Real * (x * p1 - p0) / (x * x - 1.0);
-                let dx = p1 / derivative;
-                x -= dx;
-                if dx.abs() < 1e-16 {
-                    break;
-                }
-            }
-            nodes.push(x);
-            weights.push(2.0 / ((1.0 - x * x) * derivative * derivative));
-        }
-        (nodes, weights)
     }
 
     const PARAMETERS: [Real; 9] = [0.0, 1e-6, 0.1, 0.3, 0.5, 0.7, 0.9, 0.99, 0.999];

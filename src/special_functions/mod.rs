@@ -1,6 +1,6 @@
 //! Special functions the analytical reference solutions need: the complete elliptic integral of the first
 //! kind K(m), the incomplete integral F(φ | m), and the Jacobi elliptic functions sn, cn, dn and the
-//! amplitude am.
+//! amplitude am; and Gauss–Legendre quadrature, which the analytic solutions and the tests use.
 //!
 //! Conventions follow Abramowitz & Stegun (1964), chapters 16 and 17: the *parameter* m = k² (not the
 //! modulus k), with 0 ≤ m ≤ 1.
@@ -18,8 +18,10 @@
 //! while sn, cn, dn at m = 1 return the degenerate closed forms tanh, sech, sech.
 
 mod elliptic;
+mod quadrature;
 
 pub use elliptic::{
     complete_elliptic_k, incomplete_elliptic_f, jacobi_amplitude, jacobi_elliptic, EllipticError,
     JacobiElliptic,
 };
+pub use quadrature::gauss_legendre;
