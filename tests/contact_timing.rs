@@ -291,3 +291,72 @@ fn timing_against_parry() {
         println!("{counters}");
     }
 }
+
+#[inline(never)]
+fn ir_ours_overlap(set: &PairSet, scratch: &mut EpaScratch, counters: &mut QueryCounters) {
+    for (i, p1, p2) in &set.overlapping {
+        let (a, b) = &set.ours[*i];
+        black_box(query_polyhedra_cached(
+            p1,
+            a,
+            p2,
+            b,
+            &mut PairCache::default(),
+            scratch,
+            counters,
+        ));
+    }
+}
+
+#[inline(never)]
+fn ir_parry_overlap(set: &PairSet) {
+    for (i, p1, p2) in &set.overlapping {
+        let (a, b) = &set.parry[*i];
+        black_box(parry3d_f64::query::contact(&to_glam(p1), a, &to_glam(p2), b, 0.0).ok());
+    }
+}
+
+#[inline(never)]
+fn ir_ours_separated(set: &PairSet, counters: &mut QueryCounters) {
+    for (i, p1, p2) in &set.separated {
+        let (a, b) = &set.ours[*i];
+        black_box(intersect_polyhedra_cached(
+            p1,
+            a,
+            p2,
+            b,
+            &mut PairCache::default(),
+            counters,
+        ));
+    }
+}
+
+#[inline(never)]
+fn ir_parry_separated(set: &PairSet) {
+    for (i, p1, p2) in &set.separated {
+        let (a, b) = &set.parry[*i];
+        black_box(parry3d_f64::query::intersection_test(&to_glam(p1), a, &to_glam(p2), b).ok());
+    }
+}
+
+/// A fixed workload for instruction counting (no timing): each `ir_*` function runs one pass over the
+/// class's pairs, so that `callgrind_annotate --inclusive=yes` gives instructions per query (divide by the
+/// pair count printed here). Run by hand under
+/// `valgrind --tool=callgrind <test binary> --ignored --exact callgrind_workload`.
+#[test]
+#[ignore]
+fn callgrind_workload() {
+    let class = std::env::var("POLYDEM_IR_CLASS").unwrap_or_else(|_| "hull16".into());
+    let set = pair_set(42, &class, 50, 300);
+    let mut scratch = EpaScratch::default();
+    let mut counters = QueryCounters::default();
+    ir_ours_overlap(&set, &mut scratch, &mut counters);
+    ir_parry_overlap(&set);
+    ir_ours_separated(&set, &mut counters);
+    ir_parry_separated(&set);
+    println!(
+        "{class}: {} overlapping, {} separated pairs",
+        set.overlapping.len(),
+        set.separated.len()
+    );
+}

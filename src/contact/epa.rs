@@ -43,6 +43,16 @@ struct Face {
     alive: bool,
 }
 
+/// Neighbours of the start tetrahedron's faces `[p0, p2, p1], [p0, p1, p3], [p0, p3, p2], [p1, p2, p3]`:
+/// for face `f` and its edge `e` (from `v[e]` to `v[e + 1]`), the face across that edge and the index of
+/// the same edge (reversed) in it.
+const TETRAHEDRON_ADJACENCY: [([u32; 3], [u8; 3]); 4] = [
+    ([2, 3, 1], [2, 0, 0]),
+    ([0, 3, 2], [2, 2, 0]),
+    ([1, 3, 0], [2, 1, 0]),
+    ([0, 2, 1], [1, 1, 1]),
+];
+
 /// Reusable buffers of EPA (and of the other queries that need scratch space). One per thread.
 #[derive(Clone, Debug)]
 pub struct EpaScratch {
@@ -182,27 +192,14 @@ impl EpaScratch {
                 return false;
             }
         }
-        // Adjacency by matching reversed edges.
-        for fi in 0..4 {
-            for e in 0..3 {
-                let a = self.faces[fi].v[e];
-                let b = self.faces[fi].v[(e + 1) % 3];
-                for gj in 0..4 {
-                    if gj == fi {
-                        continue;
-                    }
-                    for k in 0..3 {
-                        if self.faces[gj].v[k] == b && self.faces[gj].v[(k + 1) % 3] == a {
-                            self.faces[fi].adj[e] = gj as u32;
-                            self.faces[fi].adj_edge[e] = k as u8;
-                        }
-                    }
-                }
-            }
+        // The adjacency of these four faces depends only on their vertex order, not on the points: it is
+        // the fixed table `TETRAHEDRON_ADJACENCY` (checked against edge matching in the tests), which saves
+        // the edge-matching loop on every query.
+        for (fi, (adj, adj_edge)) in TETRAHEDRON_ADJACENCY.iter().enumerate() {
+            self.faces[fi].adj = *adj;
+            self.faces[fi].adj_edge = *adj_edge;
         }
-        self.faces
-            .iter()
-            .all(|f| f.adj.iter().all(|&a| a != u32::MAX))
+        true
     }
 
     fn silhouette(&mut self, f: u32, edge: u8, w: &Vector, vis_eps: Real) {
@@ -537,5 +534,38 @@ fn symmetric(pa: Vector, pb: Vector, n: Vector, h: Real, face: [[u32; 2]; 3]) ->
         point_a: mid + half,
         point_b: mid - half,
         face,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The fixed adjacency table of the start tetrahedron equals the one found by matching reversed edges.
+    #[test]
+    fn tetrahedron_adjacency_table_matches_edge_matching() {
+        let faces: [[u32; 3]; 4] = [[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]];
+        for (fi, f) in faces.iter().enumerate() {
+            for e in 0..3 {
+                let (a, b) = (f[e], f[(e + 1) % 3]);
+                let mut found = Vec::new();
+                for (gj, g) in faces.iter().enumerate() {
+                    for k in 0..3 {
+                        if gj != fi && g[k] == b && g[(k + 1) % 3] == a {
+                            found.push((gj as u32, k as u8));
+                        }
+                    }
+                }
+                let table = (
+                    TETRAHEDRON_ADJACENCY[fi].0[e],
+                    TETRAHEDRON_ADJACENCY[fi].1[e],
+                );
+                assert_eq!(
+                    found,
+                    vec![table],
+                    "face {fi} {f:?}, edge {e}: edge matching gives {found:?}, table gives {table:?}"
+                );
+            }
+        }
     }
 }
