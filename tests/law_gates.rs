@@ -26,20 +26,19 @@ fn geometry(a: &RigidBody, b: &RigidBody) -> ContactGeometry {
     let depth = 2.0 * RADIUS - distance;
     let point_a = a.position + normal * RADIUS;
     let point_b = b.position - normal * RADIUS;
-    ContactGeometry {
-        kind: if depth > 0.0 {
+    ContactGeometry::from_points(
+        if depth > 0.0 {
             ContactKind::Overlap
         } else {
             ContactKind::Separated
         },
-        depth: depth.max(0.0),
-        distance: (-depth).max(0.0),
+        depth.max(0.0),
+        (-depth).max(0.0),
         normal,
         point_a,
         point_b,
-        point: Point::from((point_a.coords + point_b.coords) * 0.5),
-        status: SolverStatus::Exact,
-    }
+        SolverStatus::Exact,
+    )
 }
 
 struct Outcome {

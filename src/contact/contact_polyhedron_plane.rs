@@ -60,16 +60,15 @@ pub fn contact_plane_polytope<B: Polytope + ?Sized>(
     let c2_local = xbar - n2 * (n2.dot(&xbar) - lowest);
     let point_b = pos2 * Point::from(c2_local);
     let point_a = point_b + n * signed;
-    ContactGeometry {
+    ContactGeometry::from_points(
         kind,
         depth,
         distance,
-        normal: n,
+        n,
         point_a,
         point_b,
-        point: nalgebra::center(&point_a, &point_b),
-        status: SolverStatus::Exact,
-    }
+        SolverStatus::Exact,
+    )
 }
 
 #[cfg(test)]

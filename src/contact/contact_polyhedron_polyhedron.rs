@@ -65,16 +65,15 @@ pub(crate) fn geometry_to_world(
 ) -> ContactGeometry {
     let point_a = pos1 * Point::from(*point_a1);
     let point_b = pos1 * Point::from(*point_b1);
-    ContactGeometry {
+    ContactGeometry::from_points(
         kind,
         depth,
         distance,
-        normal: pos1.rotation * normal1,
+        pos1.rotation * normal1,
         point_a,
         point_b,
-        point: nalgebra::center(&point_a, &point_b),
         status,
-    }
+    )
 }
 
 /// Full contact query between two polytopes (hot path): see the module docs.

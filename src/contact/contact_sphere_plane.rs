@@ -26,16 +26,15 @@ pub fn contact_plane_sphere(
     let point_a = c2 - n * height;
     let point_b = c2 - n * r2;
     let (kind, depth, distance) = classify(r2 - height, tol.touching * 2.0 * r2);
-    ContactGeometry {
+    ContactGeometry::from_points(
         kind,
         depth,
         distance,
-        normal: n,
+        n,
         point_a,
         point_b,
-        point: nalgebra::center(&point_a, &point_b),
-        status: SolverStatus::Exact,
-    }
+        SolverStatus::Exact,
+    )
 }
 
 #[cfg(test)]

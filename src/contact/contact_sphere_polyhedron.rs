@@ -95,16 +95,7 @@ pub fn contact_polytope_sphere<A: Polytope + ?Sized>(
     let point_a = pos1 * Point::from(c1);
     let normal = pos1.rotation * n;
     let point_b = c2 - normal * r2;
-    let g = ContactGeometry {
-        kind,
-        depth,
-        distance,
-        normal,
-        point_a,
-        point_b,
-        point: nalgebra::center(&point_a, &point_b),
-        status,
-    };
+    let g = ContactGeometry::from_points(kind, depth, distance, normal, point_a, point_b, status);
     counters.record(&g);
     g
 }

@@ -25,16 +25,15 @@ pub fn contact_sphere_sphere(
     let point_b = c2 - normal * r2;
     let signed = r1 + r2 - d;
     let (kind, depth, distance) = classify(signed, touch);
-    ContactGeometry {
+    ContactGeometry::from_points(
         kind,
         depth,
         distance,
         normal,
         point_a,
         point_b,
-        point: nalgebra::center(&point_a, &point_b),
-        status: SolverStatus::Exact,
-    }
+        SolverStatus::Exact,
+    )
 }
 
 /// Kind, depth and distance from a signed overlap (positive = overlap) and the touching band.

@@ -51,3 +51,28 @@ pub struct ContactGeometry {
     pub point: Point,
     pub status: SolverStatus,
 }
+
+impl ContactGeometry {
+    /// The features from the two contact points: c_M = (c1 + c2)/2 (paper eq. 3) is derived here, so that
+    /// every query path reports the midpoint and none can get it wrong.
+    pub fn from_points(
+        kind: ContactKind,
+        depth: Real,
+        distance: Real,
+        normal: Vector,
+        point_a: Point,
+        point_b: Point,
+        status: SolverStatus,
+    ) -> Self {
+        Self {
+            kind,
+            depth,
+            distance,
+            normal,
+            point_a,
+            point_b,
+            point: nalgebra::center(&point_a, &point_b),
+            status,
+        }
+    }
+}

@@ -245,16 +245,15 @@ pub fn sat_polytopes<A: Polytope + ?Sized, B: Polytope + ?Sized>(
     let to_world = |n1: Vector, c1: Vector, c2: Vector, kind, depth, distance| {
         let point_a = pos1 * Point::from(c1);
         let point_b = pos1 * Point::from(c2);
-        ContactGeometry {
+        ContactGeometry::from_points(
             kind,
             depth,
             distance,
-            normal: pos1.rotation * n1,
+            pos1.rotation * n1,
             point_a,
             point_b,
-            point: nalgebra::center(&point_a, &point_b),
             status,
-        }
+        )
     };
     if s > touch {
         let (c1, c2) = points_along(&va, &vb, &n, s, scale);

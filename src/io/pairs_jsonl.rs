@@ -255,16 +255,15 @@ mod tests {
         let c1 = Point::from(pos1.translation.vector);
         let c2 = Point::from(pos2.translation.vector);
         let d = c2 - c1;
-        ContactGeometry {
-            kind: ContactKind::Separated,
-            depth: 0.0,
-            distance: d.norm(),
-            normal: d.normalize(),
-            point_a: c1,
-            point_b: c2,
-            point: Point::from((c1.coords + c2.coords) / 2.0),
-            status: SolverStatus::Exact,
-        }
+        ContactGeometry::from_points(
+            ContactKind::Separated,
+            0.0,
+            d.norm(),
+            d.normalize(),
+            c1,
+            c2,
+            SolverStatus::Exact,
+        )
     }
 
     fn cube_json(centre: [Real; 3], half: Real) -> String {

@@ -39,20 +39,19 @@ pub fn signed_overlap(g: &ContactGeometry) -> Real {
 }
 
 fn geometry_from(normal: Vector, depth: Real, point_a: Point, point_b: Point) -> ContactGeometry {
-    ContactGeometry {
-        kind: if depth > 0.0 {
+    ContactGeometry::from_points(
+        if depth > 0.0 {
             ContactKind::Overlap
         } else {
             ContactKind::Separated
         },
-        depth: depth.max(0.0),
-        distance: (-depth).max(0.0),
+        depth.max(0.0),
+        (-depth).max(0.0),
         normal,
         point_a,
         point_b,
-        point: Point::from((point_a.coords + point_b.coords) * 0.5),
-        status: SolverStatus::Exact,
-    }
+        SolverStatus::Exact,
+    )
 }
 
 /// Closed-form geometry of two spheres of radii `radius_a`, `radius_b` centred on the bodies.
