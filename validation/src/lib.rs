@@ -1,6 +1,6 @@
 //! polydem-validation: the verification suite behind `cargo validate` and the `cargo test` gates.
 //!
-//! - [`case`]: the [`Case`](case::Case) trait, profiles, checks and the TOML case data.
+//! - [`case`]: the [`Case`] trait, profiles, checks and the TOML case data.
 //! - [`cases`]: the registry, one module per case.
 //! - [`context`], [`plot`], [`progress`], [`report`], [`provenance`], [`runner`]: the machinery that runs
 //!   cases and writes `reports/`.

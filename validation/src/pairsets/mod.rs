@@ -64,7 +64,7 @@ pub fn pair_seed(seed: u64, class: usize, size: usize, index: usize) -> u64 {
     z ^ (z >> 31)
 }
 
-/// Generates one random pair (see [`random_set`]); `Err` names the class and seed when no draw succeeds.
+/// Generates pair `index` of shape class `ci` at size `si` of a [`RandomSetSpec`]; `Err` names the class and seed when no draw succeeds.
 pub fn random_pair(
     spec: &RandomSetSpec,
     ci: usize,
