@@ -3,11 +3,11 @@
 //! `cargo test --release --test contact_timing -- --ignored --nocapture`.
 //! The criterion benchmarks of the harness are the reference figures.
 
-use parry3d_f64::math::{Pose as GlamPose, Rot3 as GlamRot, Vector as GlamVec};
 use polydem::contact::{
     intersect_polyhedra_cached, query_polyhedra_cached, ContactKind, EpaScratch, PairCache,
     QueryCounters,
 };
+use polydem::math::glam::{point_to_glam, pose_to_glam};
 use polydem::math::{Point, Pose, Real, Rotation, Vector};
 use polydem::shape::ConvexPolyhedron;
 use rand::{Rng, SeedableRng};
@@ -84,14 +84,6 @@ fn voronoi_cell(rng: &mut impl Rng) -> Vec<Point> {
     pts
 }
 
-fn to_glam(p: &Pose) -> GlamPose {
-    let q = p.rotation.quaternion();
-    GlamPose::from_parts(
-        GlamVec::new(p.translation.x, p.translation.y, p.translation.z),
-        GlamRot::from_xyzw(q.i, q.j, q.k, q.w),
-    )
-}
-
 struct PairSet {
     ours: Vec<(ConvexPolyhedron, ConvexPolyhedron)>,
     parry: Vec<(
@@ -119,11 +111,7 @@ fn pair_set(seed: u64, class: &str, shapes: usize, poses: usize) -> PairSet {
             };
             let (shape, _) = ConvexPolyhedron::from_points(&pts).expect("shape");
             // parry gets exactly our (principal-frame) vertices.
-            let v: Vec<GlamVec> = shape
-                .vertices()
-                .iter()
-                .map(|p| GlamVec::new(p.x, p.y, p.z))
-                .collect();
+            let v: Vec<_> = shape.vertices().iter().map(point_to_glam).collect();
             let ps =
                 parry3d_f64::shape::ConvexPolyhedron::from_convex_hull(&v).expect("parry hull");
             (shape, ps)
@@ -176,6 +164,20 @@ fn min_ns(reps: usize, n: usize, mut f: impl FnMut()) -> f64 {
         .fold(f64::INFINITY, f64::min)
 }
 
+/// [`min_ns`] of one pass of `query` over `pairs` (shape-pair index, pose of A, pose of B; `k` is the
+/// position in `pairs`, for per-pair caches).
+fn time_pairs(
+    reps: usize,
+    pairs: &[(usize, Pose, Pose)],
+    mut query: impl FnMut(usize, usize, &Pose, &Pose),
+) -> f64 {
+    min_ns(reps, pairs.len(), || {
+        for (k, (i, p1, p2)) in pairs.iter().enumerate() {
+            query(k, *i, p1, p2);
+        }
+    })
+}
+
 #[test]
 #[ignore]
 fn timing_against_parry() {
@@ -185,103 +187,94 @@ fn timing_against_parry() {
         let mut scratch = EpaScratch::default();
         let mut counters = QueryCounters::default();
         // Overlapping, cold cache.
-        let ours_cold = min_ns(reps, set.overlapping.len(), || {
-            for (i, p1, p2) in &set.overlapping {
-                let (a, b) = &set.ours[*i];
-                black_box(query_polyhedra_cached(
-                    p1,
-                    a,
-                    p2,
-                    b,
-                    &mut PairCache::default(),
-                    &mut scratch,
-                    &mut counters,
-                ));
-            }
+        let ours_cold = time_pairs(reps, &set.overlapping, |_, i, p1, p2| {
+            let (a, b) = &set.ours[i];
+            let mut cache = PairCache::default();
+            black_box(query_polyhedra_cached(
+                p1,
+                a,
+                p2,
+                b,
+                &mut cache,
+                &mut scratch,
+                &mut counters,
+            ));
         });
         // Overlapping, warm cache (the pair's cache from the previous query of the same pair).
         let mut caches = vec![PairCache::default(); set.overlapping.len()];
-        for (k, (i, p1, p2)) in set.overlapping.iter().enumerate() {
-            let (a, b) = &set.ours[*i];
+        time_pairs(1, &set.overlapping, |k, i, p1, p2| {
+            let (a, b) = &set.ours[i];
             query_polyhedra_cached(p1, a, p2, b, &mut caches[k], &mut scratch, &mut counters);
-        }
-        let ours_warm = min_ns(reps, set.overlapping.len(), || {
-            for (k, (i, p1, p2)) in set.overlapping.iter().enumerate() {
-                let (a, b) = &set.ours[*i];
-                black_box(query_polyhedra_cached(
-                    p1,
-                    a,
-                    p2,
-                    b,
-                    &mut caches[k],
-                    &mut scratch,
-                    &mut counters,
-                ));
-            }
         });
-        let parry = min_ns(reps, set.overlapping.len(), || {
-            for (i, p1, p2) in &set.overlapping {
-                let (a, b) = &set.parry[*i];
-                black_box(parry3d_f64::query::contact(&to_glam(p1), a, &to_glam(p2), b, 0.0).ok());
-            }
+        let ours_warm = time_pairs(reps, &set.overlapping, |k, i, p1, p2| {
+            let (a, b) = &set.ours[i];
+            black_box(query_polyhedra_cached(
+                p1,
+                a,
+                p2,
+                b,
+                &mut caches[k],
+                &mut scratch,
+                &mut counters,
+            ));
+        });
+        let parry = time_pairs(reps, &set.overlapping, |_, i, p1, p2| {
+            let (a, b) = &set.parry[i];
+            black_box(
+                parry3d_f64::query::contact(&pose_to_glam(p1), a, &pose_to_glam(p2), b, 0.0).ok(),
+            );
         });
         println!(
             "{class} overlapping: ours cold {ours_cold:.0} ns, warm {ours_warm:.0} ns, parry contact {parry:.0} ns, ratio cold/parry {:.2}",
             ours_cold / parry
         );
         // Separated: boolean rejection and full query.
-        let rej_cold = min_ns(reps, set.separated.len(), || {
-            for (i, p1, p2) in &set.separated {
-                let (a, b) = &set.ours[*i];
-                black_box(intersect_polyhedra_cached(
-                    p1,
-                    a,
-                    p2,
-                    b,
-                    &mut PairCache::default(),
-                    &mut counters,
-                ));
-            }
+        let rej_cold = time_pairs(reps, &set.separated, |_, i, p1, p2| {
+            let (a, b) = &set.ours[i];
+            black_box(intersect_polyhedra_cached(
+                p1,
+                a,
+                p2,
+                b,
+                &mut PairCache::default(),
+                &mut counters,
+            ));
         });
         let mut caches = vec![PairCache::default(); set.separated.len()];
-        for (k, (i, p1, p2)) in set.separated.iter().enumerate() {
-            let (a, b) = &set.ours[*i];
+        time_pairs(1, &set.separated, |k, i, p1, p2| {
+            let (a, b) = &set.ours[i];
             intersect_polyhedra_cached(p1, a, p2, b, &mut caches[k], &mut counters);
-        }
-        let rej_warm = min_ns(reps, set.separated.len(), || {
-            for (k, (i, p1, p2)) in set.separated.iter().enumerate() {
-                let (a, b) = &set.ours[*i];
-                black_box(intersect_polyhedra_cached(
-                    p1,
-                    a,
-                    p2,
-                    b,
-                    &mut caches[k],
-                    &mut counters,
-                ));
-            }
         });
-        let full_sep = min_ns(reps, set.separated.len(), || {
-            for (i, p1, p2) in &set.separated {
-                let (a, b) = &set.ours[*i];
-                black_box(query_polyhedra_cached(
-                    p1,
-                    a,
-                    p2,
-                    b,
-                    &mut PairCache::default(),
-                    &mut scratch,
-                    &mut counters,
-                ));
-            }
+        let rej_warm = time_pairs(reps, &set.separated, |k, i, p1, p2| {
+            let (a, b) = &set.ours[i];
+            black_box(intersect_polyhedra_cached(
+                p1,
+                a,
+                p2,
+                b,
+                &mut caches[k],
+                &mut counters,
+            ));
         });
-        let parry_sep = min_ns(reps, set.separated.len(), || {
-            for (i, p1, p2) in &set.separated {
-                let (a, b) = &set.parry[*i];
-                black_box(
-                    parry3d_f64::query::intersection_test(&to_glam(p1), a, &to_glam(p2), b).ok(),
-                );
-            }
+        let full_sep = time_pairs(reps, &set.separated, |_, i, p1, p2| {
+            let (a, b) = &set.ours[i];
+            let mut cache = PairCache::default();
+            black_box(query_polyhedra_cached(
+                p1,
+                a,
+                p2,
+                b,
+                &mut cache,
+                &mut scratch,
+                &mut counters,
+            ));
+        });
+        let parry_sep = time_pairs(reps, &set.separated, |_, i, p1, p2| {
+            let (a, b) = &set.parry[i];
+            black_box(
+                parry3d_f64::query::intersection_test(&pose_to_glam(p1), a, &pose_to_glam(p2), b)
+                    .ok(),
+            );
         });
         println!(
             "{class} separated: ours reject cold {rej_cold:.0} ns, warm {rej_warm:.0} ns, full query cold {full_sep:.0} ns; parry intersection_test {parry_sep:.0} ns; ratio cold/parry {:.2}, warm/parry {:.2}",
@@ -312,7 +305,9 @@ fn ir_ours_overlap(set: &PairSet, scratch: &mut EpaScratch, counters: &mut Query
 fn ir_parry_overlap(set: &PairSet) {
     for (i, p1, p2) in &set.overlapping {
         let (a, b) = &set.parry[*i];
-        black_box(parry3d_f64::query::contact(&to_glam(p1), a, &to_glam(p2), b, 0.0).ok());
+        black_box(
+            parry3d_f64::query::contact(&pose_to_glam(p1), a, &pose_to_glam(p2), b, 0.0).ok(),
+        );
     }
 }
 
@@ -335,7 +330,9 @@ fn ir_ours_separated(set: &PairSet, counters: &mut QueryCounters) {
 fn ir_parry_separated(set: &PairSet) {
     for (i, p1, p2) in &set.separated {
         let (a, b) = &set.parry[*i];
-        black_box(parry3d_f64::query::intersection_test(&to_glam(p1), a, &to_glam(p2), b).ok());
+        black_box(
+            parry3d_f64::query::intersection_test(&pose_to_glam(p1), a, &pose_to_glam(p2), b).ok(),
+        );
     }
 }
 

@@ -1,14 +1,15 @@
 //! Gates of the contact laws with the body integrator: two spheres in a head-on 1-D collision, laws from
-//! `polydem::law`, kick–drift–kick from `polydem::dynamics`. The sphere–sphere geometry is computed here in
-//! closed form (depth r_A + r_B − d, normal along the centre line, c_M midway between the surface points).
+//! `polydem::law`, kick–drift–kick from `polydem::dynamics`. The sphere–sphere geometry is the harness's closed
+//! form (`polydem_validation::sim::two_body::sphere_sphere`: depth r_A + r_B − d, normal along the centre line).
 
-use polydem::contact::{ContactGeometry, ContactKind, SolverStatus};
 use polydem::dynamics::{
     Integrator, PrincipalInertia, RigidBody, RotationScheme, TranslationParams, ViscousDamping,
 };
 use polydem::law::damping::DampingLaw;
 use polydem::law::{ContactKinematics, ContactModel, NormalLaw, TangentialHistory, TangentialLaw};
 use polydem::math::{Point, Real, Vector};
+use polydem_validation::sim::two_body::sphere_sphere;
+use polydem_validation::stats::fitted_order;
 
 const RADIUS: Real = 0.01;
 
@@ -17,28 +18,6 @@ fn sphere(x: Real, v: Real, mass: Real) -> RigidBody {
     let mut b = RigidBody::new_dynamic(Point::new(x, 0.0, 0.0), mass, inertia).unwrap();
     b.velocity = Vector::new(v, 0.0, 0.0);
     b
-}
-
-fn geometry(a: &RigidBody, b: &RigidBody) -> ContactGeometry {
-    let d = b.position - a.position;
-    let distance = d.norm();
-    let normal = d / distance;
-    let depth = 2.0 * RADIUS - distance;
-    let point_a = a.position + normal * RADIUS;
-    let point_b = b.position - normal * RADIUS;
-    ContactGeometry::from_points(
-        if depth > 0.0 {
-            ContactKind::Overlap
-        } else {
-            ContactKind::Separated
-        },
-        depth.max(0.0),
-        (-depth).max(0.0),
-        normal,
-        point_a,
-        point_b,
-        SolverStatus::Exact,
-    )
 }
 
 struct Outcome {
@@ -74,7 +53,7 @@ fn collide(model: &ContactModel, masses: (Real, Real), speed: Real, per_contact:
     let e0 = energy(&a, &b, 0.0);
     let mut history = TangentialHistory::default();
     let evaluate = |a: &RigidBody, b: &RigidBody, history: &mut TangentialHistory| {
-        let g = geometry(a, b);
+        let g = sphere_sphere(RADIUS, RADIUS, a, b);
         let kinematics = ContactKinematics {
             relative_velocity: b.velocity_at(&g.point) - a.velocity_at(&g.point),
             effective_mass: m_star,
@@ -112,16 +91,6 @@ fn collide(model: &ContactModel, masses: (Real, Real), speed: Real, per_contact:
         energy_error,
         kinetic_after_over_before: energy(&a, &b, 0.0) / e0,
     }
-}
-
-fn fitted_order(x: &[Real], y: &[Real]) -> Real {
-    let lx: Vec<Real> = x.iter().map(|v| v.ln()).collect();
-    let ly: Vec<Real> = y.iter().map(|v| v.ln()).collect();
-    let n = lx.len() as Real;
-    let (mx, my) = (lx.iter().sum::<Real>() / n, ly.iter().sum::<Real>() / n);
-    let sxy: Real = lx.iter().zip(&ly).map(|(a, b)| (a - mx) * (b - my)).sum();
-    let sxx: Real = lx.iter().map(|a| (a - mx) * (a - mx)).sum();
-    sxy / sxx
 }
 
 fn model(exponent: Real, stiffness: Real, restitution: Real) -> ContactModel {

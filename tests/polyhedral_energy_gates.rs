@@ -4,9 +4,8 @@
 
 use polydem::law::NormalLaw;
 use polydem::math::Real;
-use polydem_validation::cases::single_contact_energy::{
-    collide, fitted_order, laws, Setup, Variant, SETUPS,
-};
+use polydem_validation::cases::single_contact_energy::{collide, laws, Setup, Variant, SETUPS};
+use polydem_validation::stats::fitted_order;
 
 #[test]
 fn elastic_polyhedral_impacts_conserve_energy_at_second_order() {

@@ -8,6 +8,7 @@ use polydem::dynamics::{
     ViscousDamping,
 };
 use polydem::math::{Point, Real, Rotation, Vector};
+use polydem_validation::stats::fitted_order;
 
 const CAYLEY: RotationScheme = RotationScheme::Splitting {
     sub_rotation: SubRotation::Cayley,
@@ -48,17 +49,6 @@ fn integrator(rotation: RotationScheme) -> Integrator {
         },
         rotation,
     }
-}
-
-/// Least-squares slope of log(y) against log(x).
-fn fitted_order(x: &[Real], y: &[Real]) -> Real {
-    let lx: Vec<Real> = x.iter().map(|v| v.ln()).collect();
-    let ly: Vec<Real> = y.iter().map(|v| v.ln()).collect();
-    let n = lx.len() as Real;
-    let (mx, my) = (lx.iter().sum::<Real>() / n, ly.iter().sum::<Real>() / n);
-    let sxy: Real = lx.iter().zip(&ly).map(|(a, b)| (a - mx) * (b - my)).sum();
-    let sxx: Real = lx.iter().map(|a| (a - mx) * (a - mx)).sum();
-    sxy / sxx
 }
 
 #[test]

@@ -55,8 +55,7 @@ pub fn contact_plane_polytope<B: Polytope + ?Sized>(
             count += 1.0;
         }
     }
-    let wsum = count;
-    let xbar = sum / wsum;
+    let xbar = sum / count;
     let c2_local = xbar - n2 * (n2.dot(&xbar) - lowest);
     let point_b = pos2 * Point::from(c2_local);
     let point_a = point_b + n * signed;

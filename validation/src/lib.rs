@@ -18,6 +18,7 @@ pub mod provenance;
 pub mod report;
 pub mod runner;
 pub mod sim;
+pub mod stats;
 
 pub use case::{Case, CaseData, Check, Profile, Target};
 pub use error::SuiteError;

@@ -145,19 +145,13 @@ fn run(
     }
 }
 
-/// Least-squares slope of log y against log x (points with y ≤ 0 are skipped).
+/// Observed order from (step, error) points; an error of exactly zero (round-off luck) carries no order
+/// information on a log scale and is skipped.
 fn fitted_order(points: &[(Real, Real)]) -> Real {
-    let logs: Vec<(Real, Real)> = points
-        .iter()
-        .filter(|p| p.1 > 0.0)
-        .map(|p| (p.0.ln(), p.1.ln()))
-        .collect();
-    let n = logs.len() as Real;
-    let mx = logs.iter().map(|p| p.0).sum::<Real>() / n;
-    let my = logs.iter().map(|p| p.1).sum::<Real>() / n;
-    let sxy: Real = logs.iter().map(|p| (p.0 - mx) * (p.1 - my)).sum();
-    let sxx: Real = logs.iter().map(|p| (p.0 - mx).powi(2)).sum();
-    sxy / sxx
+    let kept: Vec<&(Real, Real)> = points.iter().filter(|p| p.1 > 0.0).collect();
+    let x: Vec<Real> = kept.iter().map(|p| p.0).collect();
+    let y: Vec<Real> = kept.iter().map(|p| p.1).collect();
+    crate::stats::fitted_order(&x, &y)
 }
 
 fn vector(a: [Real; 3]) -> Vector {

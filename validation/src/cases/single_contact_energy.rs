@@ -12,6 +12,7 @@
 //! vertices penetrate). See the doc comment of `elastic_box_edge_on_wall_conserves_energy` in
 //! `tests/polyhedral_energy_gates.rs`.
 
+use crate::stats::fitted_order;
 use std::sync::Arc;
 
 use polydem::contact::{query, ContactGeometry, EpaScratch, PairCache, QueryCounters};
@@ -311,16 +312,6 @@ pub fn collide(setup: Setup, law: NormalLaw, per_contact: Real, variant: Variant
         after: (kinetic(&a, &b) - e0).abs() / e0,
         steps_in_contact,
     }
-}
-
-pub fn fitted_order(x: &[Real], y: &[Real]) -> Real {
-    let lx: Vec<Real> = x.iter().map(|v| v.ln()).collect();
-    let ly: Vec<Real> = y.iter().map(|v| v.ln()).collect();
-    let n = lx.len() as Real;
-    let (mx, my) = (lx.iter().sum::<Real>() / n, ly.iter().sum::<Real>() / n);
-    let sxy: Real = lx.iter().zip(&ly).map(|(a, b)| (a - mx) * (b - my)).sum();
-    let sxx: Real = lx.iter().map(|a| (a - mx) * (a - mx)).sum();
-    sxy / sxx
 }
 
 /// The setups of the main gate (an edge landing flat on a wall is tested separately: see
