@@ -8,13 +8,19 @@
 //! - [`generation`]: the three above end to end;
 //! - [`statistics`]: realised size distribution and shape statistics;
 //! - [`projectile`]: the ogive-nosed projectile with its internal cavity (mass properties solid − cavity);
-//! - [`materials`]: Table 1's contact parameters and the parameters the paper does not state;
+//! - [`config`]: the experiment's parameters as data (Table 1 and what the paper does not state), the laws;
 //! - [`packing`]: the container, deposition under gravity, compaction by a moving top wall, hold, bed file;
 //! - [`penetration`]: the impact run and its monitors (velocity, resistance, deflection, disturbed zone);
+//! - [`experiment`]: generation → packing (or a saved bed) → penetration;
 //! - [`cli`]: the `polydem rockfill` subcommand.
 
+pub mod cli;
+pub mod config;
+pub mod experiment;
 pub mod generation;
 pub mod grading;
+pub mod packing;
+pub mod penetration;
 pub mod projectile;
 pub mod seeds;
 pub mod statistics;
