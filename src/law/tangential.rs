@@ -48,6 +48,15 @@ pub enum TangentialLaw {
     Spring { stiffness: Real, friction: Real },
     /// Mindlin no-slip stiffness k_t = coefficient · δ^(1/2) (coefficient = 8 G* √R*, N/m^1.5), friction μ.
     Mindlin { coefficient: Real, friction: Real },
+    /// The Mindlin spring with a tangential dashpot while sticking, as LIGGGHTS' `model hertz tangential
+    /// history` (`tangential_damping on`): F_t = −k_t u − c_t v_t with c_t = damping · √(m* k_t) (the
+    /// dimensionless `damping` is 2√(5/6) β for LIGGGHTS, β = −ln e/√(π² + ln² e)); when |k_t u| exceeds
+    /// μ F_n the force is capped at μ F_n along −u and the dashpot is off for that step.
+    DampedMindlin {
+        coefficient: Real,
+        friction: Real,
+        damping: Real,
+    },
 }
 
 impl TangentialLaw {
@@ -79,6 +88,11 @@ impl TangentialLaw {
             Self::Mindlin {
                 coefficient,
                 friction,
+            }
+            | Self::DampedMindlin {
+                coefficient,
+                friction,
+                ..
             } => (coefficient * overlap.max(0.0).sqrt(), friction),
         }
     }
@@ -95,6 +109,8 @@ pub struct TangentialResponse {
     pub friction_dissipation: Real,
     /// Spring energy ½ k_t |u|² after the step (J).
     pub spring_energy: Real,
+    /// Power dissipated by the tangential dashpot, c_t |v_t|² (W, ≥ 0; zero without one or when sliding).
+    pub damping_power: Real,
 }
 
 /// Rotates the displacement `u` expressed against `old_normal` into the plane perpendicular to `new_normal`
@@ -136,6 +152,33 @@ pub fn incremental_spring(
     dt: Real,
     history: &mut TangentialHistory,
 ) -> TangentialResponse {
+    incremental_spring_damped(
+        stiffness,
+        friction,
+        0.0,
+        normal,
+        normal_force,
+        tangential_velocity,
+        dt,
+        history,
+    )
+}
+
+/// [`incremental_spring`] with a tangential dashpot c_t (N s/m) that acts while the contact sticks:
+/// F_t = −k_t u − c_t v_t when k_t |u| ≤ μ F_n; otherwise the spring force is capped as without the dashpot
+/// (the LIGGGHTS `tangential history` order). The dashpot's power c_t |v_t|² is reported in
+/// [`TangentialResponse::damping_power`].
+#[allow(clippy::too_many_arguments)]
+pub fn incremental_spring_damped(
+    stiffness: Real,
+    friction: Real,
+    damping: Real,
+    normal: &Vector,
+    normal_force: Real,
+    tangential_velocity: &Vector,
+    dt: Real,
+    history: &mut TangentialHistory,
+) -> TangentialResponse {
     let mut u = rotate_into_tangent_plane(&history.displacement, &history.normal, normal);
     u += tangential_velocity * dt;
     let mut force = -stiffness * u;
@@ -158,6 +201,11 @@ pub fn incremental_spring(
         friction_dissipation = cap * (u - u_capped).norm();
         u = u_capped;
     }
+    let mut damping_power = 0.0;
+    if !sliding && damping > 0.0 {
+        force -= damping * tangential_velocity;
+        damping_power = damping * tangential_velocity.norm_squared();
+    }
     history.displacement = u;
     history.normal = *normal;
     TangentialResponse {
@@ -165,6 +213,7 @@ pub fn incremental_spring(
         sliding,
         friction_dissipation,
         spring_energy: 0.5 * stiffness * u.norm_squared(),
+        damping_power,
     }
 }
 
