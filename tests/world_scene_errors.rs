@@ -276,7 +276,11 @@ fn load_with_csv(
     case: &str,
     scene: &str,
     csv: &str,
-) -> (PathBuf, PathBuf, Result<polydem::scene::Simulation, SceneError>) {
+) -> (
+    PathBuf,
+    PathBuf,
+    Result<polydem::scene::Simulation, SceneError>,
+) {
     let dir = std::env::temp_dir().join(format!("polydem-scene-errors-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let csv_name = format!("{case}.csv");
@@ -293,11 +297,7 @@ fn sphere_scene_with_box_and_body_file_loads() {
     let sim = result.expect("valid sphere scene");
     assert_eq!(sim.world.bodies.len(), 2);
     assert_eq!(sim.world.names, vec!["g1".to_owned(), "g2".to_owned()]);
-    assert_eq!(
-        sim.world.walls.len(),
-        5,
-        "an open-top box has five walls"
-    );
+    assert_eq!(sim.world.walls.len(), 5, "an open-top box has five walls");
     assert_eq!(sim.world.bodies[1].velocity.z, -0.5);
     // Walls face inwards: the x+ face's normal is −x and its plane passes through max.
     let xp = sim
@@ -306,7 +306,10 @@ fn sphere_scene_with_box_and_body_file_loads() {
         .iter()
         .find(|w| w.name == "bin.x+")
         .expect("wall bin.x+");
-    assert_eq!(xp.normal_world(), polydem::math::Vector::new(-1.0, 0.0, 0.0));
+    assert_eq!(
+        xp.normal_world(),
+        polydem::math::Vector::new(-1.0, 0.0, 0.0)
+    );
     assert!(xp.signed_distance(&polydem::math::Point::new(0.005, 0.0, 0.0)) > 0.0);
 }
 
@@ -342,12 +345,21 @@ fn hertz_mindlin_needs_elastic_constants_and_refuses_stiffness() {
     let text = SPHERES.replace("young_modulus = 1.0e9\npoisson_ratio = 0.2\n", "");
     let (path, _, result) = load_with_csv("hm_no_young", &text, GOOD_CSV);
     let message = result.expect_err("missing E accepted").to_string();
-    let line = text.lines().position(|l| l.starts_with("name = \"glass\"")).unwrap() + 1;
+    let line = text
+        .lines()
+        .position(|l| l.starts_with("name = \"glass\""))
+        .unwrap()
+        + 1;
     assert_names(&message, &path, line, "material[0].young_modulus");
 
-    let text = SPHERES.replace("law = \"hertz_mindlin\"", "law = \"hertz_mindlin\"\nnormal_stiffness = 1.0e6");
+    let text = SPHERES.replace(
+        "law = \"hertz_mindlin\"",
+        "law = \"hertz_mindlin\"\nnormal_stiffness = 1.0e6",
+    );
     let (path, _, result) = load_with_csv("hm_stiffness", &text, GOOD_CSV);
-    let message = result.expect_err("stiffness for hertz_mindlin accepted").to_string();
+    let message = result
+        .expect_err("stiffness for hertz_mindlin accepted")
+        .to_string();
     assert_names(
         &message,
         &path,
@@ -380,8 +392,15 @@ fn box_with_unknown_face_or_inverted_corners_is_refused() {
 
     let text = SPHERES.replace("open = [\"z+\"]", "open = [\"z+\"]\nmoving_face = \"z-\"");
     let (path, _, result) = load_with_csv("box_moving", &text, GOOD_CSV);
-    let message = result.expect_err("moving face without velocity accepted").to_string();
-    assert_names(&message, &path, line_of(&text, "moving_face"), "box[0].velocity");
+    let message = result
+        .expect_err("moving face without velocity accepted")
+        .to_string();
+    assert_names(
+        &message,
+        &path,
+        line_of(&text, "moving_face"),
+        "box[0].velocity",
+    );
 }
 
 #[test]

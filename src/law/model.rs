@@ -93,37 +93,42 @@ impl ContactModel {
         }
         let normal_force = elastic + damping;
 
-        let (tangential_force, tangential_potential, friction_dissipation, sliding, tangential_power) =
-            match self.tangential {
-                TangentialLaw::None => (Vector::zeros(), 0.0, 0.0, false, 0.0),
-                law => {
-                    let (stiffness, friction) = law.stiffness_and_friction(overlap);
-                    let dashpot = match law {
-                        TangentialLaw::DampedMindlin { damping, .. } => {
-                            damping * (kinematics.effective_mass * stiffness).sqrt()
-                        }
-                        _ => 0.0,
-                    };
-                    let v_t = v - n * v.dot(&n);
-                    let r = incremental_spring_damped(
-                        stiffness,
-                        friction,
-                        dashpot,
-                        &n,
-                        normal_force,
-                        &v_t,
-                        kinematics.dt,
-                        history,
-                    );
-                    (
-                        r.force,
-                        r.spring_energy,
-                        r.friction_dissipation,
-                        r.sliding,
-                        r.damping_power,
-                    )
-                }
-            };
+        let (
+            tangential_force,
+            tangential_potential,
+            friction_dissipation,
+            sliding,
+            tangential_power,
+        ) = match self.tangential {
+            TangentialLaw::None => (Vector::zeros(), 0.0, 0.0, false, 0.0),
+            law => {
+                let (stiffness, friction) = law.stiffness_and_friction(overlap);
+                let dashpot = match law {
+                    TangentialLaw::DampedMindlin { damping, .. } => {
+                        damping * (kinematics.effective_mass * stiffness).sqrt()
+                    }
+                    _ => 0.0,
+                };
+                let v_t = v - n * v.dot(&n);
+                let r = incremental_spring_damped(
+                    stiffness,
+                    friction,
+                    dashpot,
+                    &n,
+                    normal_force,
+                    &v_t,
+                    kinematics.dt,
+                    history,
+                );
+                (
+                    r.force,
+                    r.spring_energy,
+                    r.friction_dissipation,
+                    r.sliding,
+                    r.damping_power,
+                )
+            }
+        };
         let force_on_b = n * normal_force + tangential_force;
         let point = geometry.point;
         ContactResponse {
@@ -194,7 +199,8 @@ mod tests {
     /// the force limit the bodies part when the force reaches zero, so e = −x' there.
     fn clamped_restitution_oracle(exponent: Real, coefficient: Real) -> Real {
         let a = 0.5 * (exponent - 1.0);
-        let force = |x: Real, v: Real| x.max(0.0).powf(exponent) + coefficient * x.max(0.0).powf(a) * v;
+        let force =
+            |x: Real, v: Real| x.max(0.0).powf(exponent) + coefficient * x.max(0.0).powf(a) * v;
         let acc = |x: Real, v: Real| -force(x, v).max(0.0);
         let (mut x, mut v): (Real, Real) = (0.0, 1.0);
         let h = 1e-5;

@@ -98,8 +98,8 @@ mod tests {
     use super::*;
     use crate::law::hertz_mindlin::{hertz_mindlin, ElasticMaterial, SpherePair};
     use crate::law::hertz_mindlin::{material_hertz_mindlin, HertzMindlinOptions};
-    use crate::shape::{ConvexPolyhedron, Plane, Sphere};
     use crate::math::{Point, Vector};
+    use crate::shape::{ConvexPolyhedron, Plane, Sphere};
 
     #[test]
     fn scaled_model_equals_the_model_built_for_the_two_radii() {
@@ -132,12 +132,18 @@ mod tests {
         );
         let (kt_s, _) = scaled.tangential.stiffness_and_friction(1e-5);
         let (kt_d, _) = direct.tangential.stiffness_and_friction(1e-5);
-        assert!(rel(kt_s, kt_d) < 1e-14, "k_t scaled {kt_s} vs direct {kt_d}");
+        assert!(
+            rel(kt_s, kt_d) < 1e-14,
+            "k_t scaled {kt_s} vs direct {kt_d}"
+        );
         // Against a wall: R* = R (LIGGGHTS convention).
         let wall = Shape::Plane(Plane::new(Vector::z(), 0.0).unwrap());
         let on_wall = per_root.for_shapes(Some(&wall), &a);
         assert!(
-            rel(on_wall.normal.stiffness, per_root.normal.stiffness * ra.sqrt()) < 1e-15,
+            rel(
+                on_wall.normal.stiffness,
+                per_root.normal.stiffness * ra.sqrt()
+            ) < 1e-15,
             "wall contact k_n {}, expected (4/3)E*√R",
             on_wall.normal.stiffness
         );

@@ -149,7 +149,11 @@ pub fn read_sphere_table(path: &Path) -> Result<Vec<SphereRow>, BodyFileError> {
         });
     }
     if rows.is_empty() {
-        return Err(invalid(header_line, "row", "the file has no rows".to_owned()));
+        return Err(invalid(
+            header_line,
+            "row",
+            "the file has no rows".to_owned(),
+        ));
     }
     Ok(rows)
 }

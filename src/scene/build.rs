@@ -245,10 +245,19 @@ fn build(ctx: &Ctx, file: &SceneFile) -> Result<Simulation, SceneError> {
         let model = match law {
             "hertz_mindlin" => {
                 let foreign = [
-                    ("normal_stiffness", it.normal_stiffness.as_ref().map(|v| v.span())),
+                    (
+                        "normal_stiffness",
+                        it.normal_stiffness.as_ref().map(|v| v.span()),
+                    ),
                     ("exponent", it.exponent.as_ref().map(|v| v.span())),
-                    ("tangential_stiffness", it.tangential_stiffness.as_ref().map(|v| v.span())),
-                    ("normal_damping", it.normal_damping.as_ref().map(|v| v.span())),
+                    (
+                        "tangential_stiffness",
+                        it.tangential_stiffness.as_ref().map(|v| v.span()),
+                    ),
+                    (
+                        "normal_damping",
+                        it.normal_damping.as_ref().map(|v| v.span()),
+                    ),
                 ];
                 for (field, span) in foreign {
                     if let Some(span) = span {
@@ -256,7 +265,11 @@ fn build(ctx: &Ctx, file: &SceneFile) -> Result<Simulation, SceneError> {
                     }
                 }
                 let restitution = it.restitution.as_ref().ok_or_else(|| {
-                    ctx.invalid(it.law.span(), f("restitution"), "the hertz_mindlin law needs a restitution e (0 < e ≤ 1)")
+                    ctx.invalid(
+                        it.law.span(),
+                        f("restitution"),
+                        "the hertz_mindlin law needs a restitution e (0 < e ≤ 1)",
+                    )
                 })?;
                 let constants = |id: u32| {
                     elastic[id as usize].ok_or_else(|| {
@@ -272,15 +285,29 @@ fn build(ctx: &Ctx, file: &SceneFile) -> Result<Simulation, SceneError> {
                     tangential_damping: it.tangential_damping.as_ref().is_none_or(|b| *b.get_ref()),
                     limit_force,
                 };
-                material_hertz_mindlin(&constants(ia)?, &constants(ib)?, *restitution.get_ref(), mu, options)
-                    .map_err(|e| ctx.law(restitution.span(), &f("restitution"), e))?
+                material_hertz_mindlin(
+                    &constants(ia)?,
+                    &constants(ib)?,
+                    *restitution.get_ref(),
+                    mu,
+                    options,
+                )
+                .map_err(|e| ctx.law(restitution.span(), &f("restitution"), e))?
             }
             "linear" | "power" => {
                 if let Some(td) = &it.tangential_damping {
-                    return Err(ctx.invalid(td.span(), f("tangential_damping"), format!("the {law} law has no tangential dashpot (only hertz_mindlin)")));
+                    return Err(ctx.invalid(
+                        td.span(),
+                        f("tangential_damping"),
+                        format!("the {law} law has no tangential dashpot (only hertz_mindlin)"),
+                    ));
                 }
                 let k_n_value = it.normal_stiffness.as_ref().ok_or_else(|| {
-                    ctx.invalid(it.law.span(), f("normal_stiffness"), format!("the {law} law needs normal_stiffness"))
+                    ctx.invalid(
+                        it.law.span(),
+                        f("normal_stiffness"),
+                        format!("the {law} law needs normal_stiffness"),
+                    )
                 })?;
                 let k_n = ctx.positive(k_n_value, &f("normal_stiffness"))?;
                 let exponent = match (law, &it.exponent) {
@@ -348,13 +375,13 @@ fn build(ctx: &Ctx, file: &SceneFile) -> Result<Simulation, SceneError> {
                     tangential,
                 }
             }
-            other => {
-                return Err(ctx.invalid(
-                    it.law.span(),
-                    f("law"),
-                    format!("unknown law '{other}' (expected \"linear\", \"power\" or \"hertz_mindlin\")"),
-                ))
-            }
+            other => return Err(ctx.invalid(
+                it.law.span(),
+                f("law"),
+                format!(
+                    "unknown law '{other}' (expected \"linear\", \"power\" or \"hertz_mindlin\")"
+                ),
+            )),
         };
         materials.set_model(ia, ib, model);
     }
@@ -603,10 +630,13 @@ fn build(ctx: &Ctx, file: &SceneFile) -> Result<Simulation, SceneError> {
             Some(dir) if relative.is_relative() => dir.join(relative),
             _ => relative.to_owned(),
         };
-        let rows = read_sphere_table(&csv_path).map_err(|e| {
-            ctx.invalid(bf.path.span(), f("path"), e.to_string())
-        })?;
-        let use_file_velocities = match bf.velocities.as_ref().map(|v| (v.get_ref().as_str(), v.span())) {
+        let rows = read_sphere_table(&csv_path)
+            .map_err(|e| ctx.invalid(bf.path.span(), f("path"), e.to_string()))?;
+        let use_file_velocities = match bf
+            .velocities
+            .as_ref()
+            .map(|v| (v.get_ref().as_str(), v.span()))
+        {
             None | Some(("file", _)) => true,
             Some(("zero", _)) => false,
             Some((other, span)) => {
@@ -638,18 +668,30 @@ fn build(ctx: &Ctx, file: &SceneFile) -> Result<Simulation, SceneError> {
                 ));
             }
             let sphere = Sphere::new(row.radius).map_err(|e| {
-                ctx.invalid(bf.path.span(), f("path"), format!("{}: body '{name}': {e}", csv_path.display()))
+                ctx.invalid(
+                    bf.path.span(),
+                    f("path"),
+                    format!("{}: body '{name}': {e}", csv_path.display()),
+                )
             })?;
             let props = sphere.mass_properties();
             let inertia = PrincipalInertia::new(props.principal_moments * density)
                 .map_err(|e| ctx.invalid(bf.material.span(), f("material"), e.to_string()))?;
-            let mut body = RigidBody::new_dynamic(Point::from(row.position), props.volume * density, inertia)
-                .map_err(|e| ctx.invalid(bf.material.span(), f("material"), e.to_string()))?;
+            let mut body =
+                RigidBody::new_dynamic(Point::from(row.position), props.volume * density, inertia)
+                    .map_err(|e| ctx.invalid(bf.material.span(), f("material"), e.to_string()))?;
             if use_file_velocities {
                 body.velocity = row.velocity.unwrap_or_else(Vector::zeros);
             }
             shapes.push((Shape::Sphere(sphere), Pose::identity()));
-            world_bodies.push((name, shapes.len() - 1, mat, body, Pose::identity(), bf.track.unwrap_or(false)));
+            world_bodies.push((
+                name,
+                shapes.len() - 1,
+                mat,
+                body,
+                Pose::identity(),
+                bf.track.unwrap_or(false),
+            ));
             origins.push((bf.material.span(), f("material")));
         }
     }
@@ -691,7 +733,11 @@ fn build(ctx: &Ctx, file: &SceneFile) -> Result<Simulation, SceneError> {
             return Err(ctx.invalid(
                 bx.max.span(),
                 f("max"),
-                format!("must exceed min in every coordinate, got min {:?}, max {:?}", bx.min.get_ref(), bx.max.get_ref()),
+                format!(
+                    "must exceed min in every coordinate, got min {:?}, max {:?}",
+                    bx.min.get_ref(),
+                    bx.max.get_ref()
+                ),
             ));
         }
         const FACES: [&str; 6] = ["x-", "x+", "y-", "y+", "z-", "z+"];
@@ -699,7 +745,11 @@ fn build(ctx: &Ctx, file: &SceneFile) -> Result<Simulation, SceneError> {
             if FACES.contains(&name) {
                 Ok(())
             } else {
-                Err(ctx.invalid(span, field, format!("unknown face '{name}' (expected one of {FACES:?})")))
+                Err(ctx.invalid(
+                    span,
+                    field,
+                    format!("unknown face '{name}' (expected one of {FACES:?})"),
+                ))
             }
         };
         let open: Vec<String> = match &bx.open {
@@ -716,15 +766,27 @@ fn build(ctx: &Ctx, file: &SceneFile) -> Result<Simulation, SceneError> {
             (Some(face), Some(v)) => {
                 check_face(face.get_ref(), face.span(), f("moving_face"))?;
                 if open.contains(face.get_ref()) {
-                    return Err(ctx.invalid(face.span(), f("moving_face"), format!("face '{}' is open", face.get_ref())));
+                    return Err(ctx.invalid(
+                        face.span(),
+                        f("moving_face"),
+                        format!("face '{}' is open", face.get_ref()),
+                    ));
                 }
                 Some((face.get_ref().clone(), ctx.vector(v, &f("velocity"))?))
             }
             (Some(face), None) => {
-                return Err(ctx.invalid(face.span(), f("velocity"), "a moving_face needs a velocity (m/s)"))
+                return Err(ctx.invalid(
+                    face.span(),
+                    f("velocity"),
+                    "a moving_face needs a velocity (m/s)",
+                ))
             }
             (None, Some(v)) => {
-                return Err(ctx.invalid(v.span(), f("moving_face"), "a velocity needs the moving_face it belongs to"))
+                return Err(ctx.invalid(
+                    v.span(),
+                    f("moving_face"),
+                    "a velocity needs the moving_face it belongs to",
+                ))
             }
         };
         for (j, face) in FACES.iter().enumerate() {
