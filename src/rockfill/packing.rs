@@ -309,7 +309,7 @@ pub fn pack(
         run(world, &mut report)?;
         report.deposition_steps += 1;
         let t = world.time;
-        if report.deposition_steps % check_every == 0 {
+        if report.deposition_steps.is_multiple_of(check_every) {
             progress("deposition", t, bed_top(world));
             if (t >= fall_time && max_speed(world) < p.settle_speed) || t >= p.max_deposition_time {
                 break;
@@ -336,7 +336,7 @@ pub fn pack(
             world.walls[TOP_WALL].velocity = Vector::new(0.0, 0.0, -p.compaction_speed * fraction);
             run(world, &mut report)?;
             report.compaction_steps += 1;
-            if report.compaction_steps % check_every == 0 {
+            if report.compaction_steps.is_multiple_of(check_every) {
                 progress("compaction", world.time, top_wall_height(world));
             }
             if fraction < STALL_FRACTION {
@@ -358,7 +358,7 @@ pub fn pack(
     while world.time < hold_end {
         run(world, &mut report)?;
         report.hold_steps += 1;
-        if report.hold_steps % check_every == 0 {
+        if report.hold_steps.is_multiple_of(check_every) {
             progress("hold", world.time, bed_top(world));
         }
     }

@@ -240,7 +240,7 @@ pub fn penetrate(
             contacts,
         };
         rows.push(row);
-        if steps % 100 == 0 {
+        if steps.is_multiple_of(100) {
             progress(&row);
         }
         let base_x = (tip - axis * length).x;

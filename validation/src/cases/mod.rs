@@ -9,6 +9,7 @@ pub mod friction;
 pub mod perf;
 pub mod precession;
 pub mod restitution;
+pub mod rockfill;
 pub mod single_contact_energy;
 
 /// Every case of the suite, in the order they run.
@@ -20,6 +21,7 @@ pub fn registry() -> Vec<&'static dyn Case> {
         &restitution::Restitution,
         &chung_ooi::ChungOoi,
         &friction::Friction,
+        &rockfill::Rockfill,
         &perf::Perf,
     ]
 }
