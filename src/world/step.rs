@@ -17,24 +17,26 @@
 //! step (7) and open the next (1). The velocity-dependent parts (damping, tangential increment) see the
 //! half-step velocities, as [`crate::dynamics::integrator`] documents.
 //!
-//! Every stage runs serially in the candidate order, which is a function of the state only (the broad
-//! phase's sorted pairs, then body–wall pairs by body and wall). A parallel narrow phase and law stage can
-//! produce per-candidate results in any order as long as stage 6 sums them in this order, which keeps runs
-//! bit-identical for any thread count.
+//! The candidate order is a function of the state only (the broad phase's sorted pairs, then body–wall
+//! pairs by body and wall). Stages 4 and 5 (one query and one law evaluation per candidate) and the
+//! integration (1–2, 7; one body at a time) run on rayon's current thread pool when the scene is large
+//! enough ([`Parallelism`]); each computes a result per item into that item's own slot, and stage 6 sums
+//! the per-candidate results serially in candidate order, so a run is bit-identical for any number of
+//! threads (see [`super::parallel`]; `tests/world_parallel.rs`).
 
 use std::time::{Duration, Instant};
 
 use crate::contact::{
-    query_with, ContactError, ContactGeometry, ContactKind, ContactTolerances, EpaScratch,
-    QueryCounters,
+    query_with, ContactError, ContactGeometry, ContactKind, ContactTolerances, QueryCounters,
 };
 use crate::dynamics::{Integrator, Motion, RotationScheme, TranslationParams, ViscousDamping};
 use crate::law::{ContactKinematics, ContactResponse};
 use crate::math::{Point, Real, Vector};
 use crate::shape::Shape;
 
-use super::contact_store::ContactKey;
+use super::contact_store::{ContactKey, ContactState};
 use super::energy::viscous_power;
+use super::parallel::{for_each_chunked, for_each_item, Parallelism, Worker};
 use super::world::World;
 
 /// Default of [`StepParams::overlap_warning_fraction`]: 0.05. A DEM run with a stiffness that represents
@@ -56,6 +58,8 @@ pub struct StepParams {
     /// A contact whose overlap exceeds this fraction of the smaller particle's length scale (bounding
     /// diameter) is reported in [`StepReport::overlap_warnings`].
     pub overlap_warning_fraction: Real,
+    /// From which sizes the stages run on several threads (results are identical either way).
+    pub parallel: Parallelism,
 }
 
 impl StepParams {
@@ -68,6 +72,7 @@ impl StepParams {
             damping: ViscousDamping::None,
             tolerances: ContactTolerances::default(),
             overlap_warning_fraction: DEFAULT_OVERLAP_WARNING_FRACTION,
+            parallel: Parallelism::default(),
         }
     }
 }
@@ -75,11 +80,11 @@ impl StepParams {
 /// Buffers reused between steps; nothing in them matters after a step.
 #[derive(Clone, Debug, Default)]
 pub struct StepScratch {
-    epa: EpaScratch,
     centres: Vec<Point>,
     candidates: Vec<ContactKey>,
-    geometries: Vec<ContactGeometry>,
-    responses: Vec<ContactResponse>,
+    evaluated: Vec<Evaluated>,
+    /// One per chunk of the parallel stages (see [`super::parallel`]).
+    workers: Vec<Worker>,
 }
 
 /// Stage timers and counters of one or more steps (merge them with [`StepCounters::merge`]).
@@ -239,10 +244,12 @@ pub fn step(
 
     // 1–2. First half kick with the kept loads, drift.
     let t = Instant::now();
-    for (i, body) in world.bodies.iter_mut().enumerate() {
-        integrator.first_half_kick(body, &world.loads.forces[i], &world.loads.torques[i], dt);
+    let parallel_bodies = world.bodies.len() >= params.parallel.min_bodies;
+    let loads = &world.loads;
+    for_each_item(parallel_bodies, &mut world.bodies, |i, body| {
+        integrator.first_half_kick(body, &loads.forces[i], &loads.torques[i], dt);
         integrator.drift(body, dt);
-    }
+    });
     for wall in &mut world.walls {
         wall.pose.translation.vector += dt * wall.velocity;
     }
@@ -253,9 +260,10 @@ pub fn step(
 
     // 7. Second half kick.
     let t = Instant::now();
-    for (i, body) in world.bodies.iter_mut().enumerate() {
-        integrator.second_half_kick(body, &world.loads.forces[i], &world.loads.torques[i], dt);
-    }
+    let loads = &world.loads;
+    for_each_item(parallel_bodies, &mut world.bodies, |i, body| {
+        integrator.second_half_kick(body, &loads.forces[i], &loads.torques[i], dt);
+    });
     report.counters.integrate += t.elapsed();
 
     // 8. Checks.
@@ -322,7 +330,7 @@ fn evaluate_loads(
     }
     counters.broad += t.elapsed();
 
-    // 4. Narrow phase.
+    // 4. Narrow phase: one query per candidate, in parallel, each writing its own store entry.
     let t = Instant::now();
     // The store is taken out of the world for stages 4–5 so that the queries can read the bodies while
     // writing the per-pair state; it is put back before any return.
@@ -330,133 +338,68 @@ fn evaluate_loads(
     let sync = contacts.sync(&scratch.candidates, step_index);
     counters.contacts_created += sync.created as u64;
     counters.contacts_dropped += sync.dropped as u64;
-    scratch.geometries.clear();
-    for (key, state) in scratch
-        .candidates
-        .iter()
-        .zip(contacts.states_mut().iter_mut())
-    {
-        let (pose_a, shape_a, pose_b, shape_b);
-        let wall_shape;
-        match *key {
-            ContactKey::Body { a, b } => {
-                pose_a = world.pose(a as usize);
-                shape_a = world.shape(a as usize);
-                pose_b = world.pose(b as usize);
-                shape_b = world.shape(b as usize);
-            }
-            ContactKey::Wall { body, wall } => {
-                let wall = &world.walls[wall as usize];
-                wall_shape = Shape::Plane(wall.plane);
-                pose_a = wall.pose;
-                shape_a = &wall_shape;
-                pose_b = world.pose(body as usize);
-                shape_b = world.shape(body as usize);
-            }
-        }
-        let g = match query_with(
-            &pose_a,
-            shape_a,
-            &pose_b,
-            shape_b,
-            &params.tolerances,
-            &mut state.cache,
-            &mut scratch.epa,
-            &mut counters.query,
-        ) {
-            Ok(g) => g,
-            Err(source) => {
-                world.contacts = contacts;
-                return Err(StepError::Contact {
-                    step: step_index,
-                    source,
-                });
-            }
-        };
-        state.geometry = g;
-        scratch.geometries.push(g);
+    let n_candidates = scratch.candidates.len();
+    let parallel = n_candidates >= params.parallel.min_candidates;
+    scratch.evaluated.clear();
+    scratch.evaluated.resize(n_candidates, Evaluated::default());
+    let world_ref: &World = world;
+    let candidates = &scratch.candidates;
+    let narrow = for_each_chunked(
+        parallel,
+        contacts.states_mut(),
+        &mut scratch.evaluated,
+        &mut scratch.workers,
+        |i, state, _, worker| {
+            state.geometry = narrow_phase(params, world_ref, candidates[i], state, worker)?;
+            Ok(())
+        },
+    );
+    for worker in &mut scratch.workers {
+        counters.query.merge(&worker.query);
+        worker.query = QueryCounters::default();
+    }
+    if let Err(source) = narrow {
+        world.contacts = contacts;
+        return Err(StepError::Contact {
+            step: step_index,
+            source,
+        });
     }
     counters.narrow += t.elapsed();
 
-    // 5. Laws.
+    // 5. Laws: one evaluation per candidate, in parallel, each writing its own store entry and result slot.
     let t = Instant::now();
-    scratch.responses.clear();
+    let laws = for_each_chunked(
+        parallel,
+        contacts.states_mut(),
+        &mut scratch.evaluated,
+        &mut scratch.workers,
+        |i, state, out, _| {
+            *out = contact_law(world_ref, candidates[i], state, dt, step_index)?;
+            Ok(())
+        },
+    );
+    world.contacts = contacts;
+    laws?;
     // The report describes the state at the end of the step: an initial evaluation's findings are
-    // replaced by those of the step's own evaluation.
+    // replaced by those of the step's own evaluation. Collected in candidate order.
     report.contacts = 0;
     report.max_overlap_ratio = 0.0;
     report.overlap_warnings.clear();
-    for ((key, g), state) in scratch
-        .candidates
-        .iter()
-        .zip(&scratch.geometries)
-        .zip(contacts.states_mut().iter_mut())
-    {
-        let (a_body, a_velocity_at, mat_a, b) = match *key {
-            ContactKey::Body { a, b } => (Some(a as usize), None, world.material_of[a as usize], b),
-            ContactKey::Wall { body, wall } => {
-                let w = &world.walls[wall as usize];
-                (None, Some(w.velocity), w.material, body)
-            }
-        };
-        let b = b as usize;
-        let mat_b = world.material_of[b];
-        let Some(model) = world.materials.model(mat_a, mat_b) else {
-            world.contacts = contacts;
-            return Err(StepError::MissingLaw {
-                step: step_index,
-                a: mat_a,
-                b: mat_b,
-            });
-        };
-        if g.kind != ContactKind::Overlap {
-            // The law resets the history of a pair that does not overlap.
-            state.history = Default::default();
-            state.force_on_b = Vector::zeros();
-            scratch.responses.push(ContactResponse::default());
+    for (key, e) in scratch.candidates.iter().zip(&scratch.evaluated) {
+        if !e.overlapping {
             continue;
         }
-        let body_b = &world.bodies[b];
-        let (velocity_a, center_a, effective_mass, scale) = match a_body {
-            Some(a) => {
-                let body_a = &world.bodies[a];
-                let m = match (body_a.is_dynamic(), body_b.is_dynamic()) {
-                    (true, true) => body_a.mass * body_b.mass / (body_a.mass + body_b.mass),
-                    (true, false) => body_a.mass,
-                    _ => body_b.mass,
-                };
-                let scale = world.length_scale(a).min(world.length_scale(b));
-                (body_a.velocity_at(&g.point), body_a.position, m, scale)
-            }
-            None => (
-                a_velocity_at.unwrap_or_else(Vector::zeros),
-                g.point_a,
-                body_b.mass,
-                world.length_scale(b),
-            ),
-        };
-        let kinematics = ContactKinematics {
-            relative_velocity: body_b.velocity_at(&g.point) - velocity_a,
-            effective_mass,
-            center_a,
-            center_b: body_b.position,
-            dt,
-        };
-        let response = model.evaluate(g, &kinematics, &mut state.history);
-        state.force_on_b = response.force_on_b;
-        scratch.responses.push(response);
         report.contacts += 1;
-        let ratio = g.depth / scale;
-        report.max_overlap_ratio = report.max_overlap_ratio.max(ratio);
-        if ratio > params.overlap_warning_fraction {
+        report.max_overlap_ratio = report.max_overlap_ratio.max(e.overlap_ratio);
+        if e.overlap_ratio > params.overlap_warning_fraction {
             report.overlap_warnings.push(OverlapWarning {
                 key: *key,
-                depth: g.depth,
-                ratio,
+                depth: e.depth,
+                ratio: e.overlap_ratio,
             });
         }
     }
-    world.contacts = contacts;
     counters.contacts += report.contacts as u64;
     counters.laws += t.elapsed();
 
@@ -473,7 +416,8 @@ fn evaluate_loads(
     loads.elastic_potential = 0.0;
     loads.damping_power = 0.0;
     loads.friction_dissipation = 0.0;
-    for (key, r) in scratch.candidates.iter().zip(&scratch.responses) {
+    for (key, e) in scratch.candidates.iter().zip(&scratch.evaluated) {
+        let r = &e.response;
         match *key {
             ContactKey::Body { a, b } => {
                 loads.forces[a as usize] -= r.force_on_b;
@@ -506,6 +450,124 @@ fn evaluate_loads(
     loads.current = true;
     counters.accumulate += t.elapsed();
     Ok(())
+}
+
+/// The result of stage 5 for one candidate.
+#[derive(Clone, Copy, Debug, Default)]
+struct Evaluated {
+    response: ContactResponse,
+    /// Whether the shapes overlap (the law produced a force).
+    overlapping: bool,
+    /// Overlap δ_M (m) and δ_M divided by the smaller particle's length scale.
+    depth: Real,
+    overlap_ratio: Real,
+}
+
+/// Stage 4 for one candidate: the contact query between its two shapes (A = body a or the wall, B = body b).
+fn narrow_phase(
+    params: &StepParams,
+    world: &World,
+    key: ContactKey,
+    state: &mut ContactState,
+    worker: &mut Worker,
+) -> Result<ContactGeometry, ContactError> {
+    let (pose_a, shape_a, pose_b, shape_b);
+    let wall_shape;
+    match key {
+        ContactKey::Body { a, b } => {
+            pose_a = world.pose(a as usize);
+            shape_a = world.shape(a as usize);
+            pose_b = world.pose(b as usize);
+            shape_b = world.shape(b as usize);
+        }
+        ContactKey::Wall { body, wall } => {
+            let wall = &world.walls[wall as usize];
+            wall_shape = Shape::Plane(wall.plane);
+            pose_a = wall.pose;
+            shape_a = &wall_shape;
+            pose_b = world.pose(body as usize);
+            shape_b = world.shape(body as usize);
+        }
+    }
+    query_with(
+        &pose_a,
+        shape_a,
+        &pose_b,
+        shape_b,
+        &params.tolerances,
+        &mut state.cache,
+        &mut worker.epa,
+        &mut worker.query,
+    )
+}
+
+/// Stage 5 for one candidate: the pair's contact model on the geometry of stage 4 (stored in `state`),
+/// updating the tangential history and the stored force.
+fn contact_law(
+    world: &World,
+    key: ContactKey,
+    state: &mut ContactState,
+    dt: Real,
+    step_index: u64,
+) -> Result<Evaluated, StepError> {
+    let (a_body, a_velocity_at, mat_a, b) = match key {
+        ContactKey::Body { a, b } => (Some(a as usize), None, world.material_of[a as usize], b),
+        ContactKey::Wall { body, wall } => {
+            let w = &world.walls[wall as usize];
+            (None, Some(w.velocity), w.material, body)
+        }
+    };
+    let b = b as usize;
+    let mat_b = world.material_of[b];
+    let Some(model) = world.materials.model(mat_a, mat_b) else {
+        return Err(StepError::MissingLaw {
+            step: step_index,
+            a: mat_a,
+            b: mat_b,
+        });
+    };
+    let g = &state.geometry;
+    if g.kind != ContactKind::Overlap {
+        // The law resets the history of a pair that does not overlap.
+        state.history = Default::default();
+        state.force_on_b = Vector::zeros();
+        return Ok(Evaluated::default());
+    }
+    let body_b = &world.bodies[b];
+    let (velocity_a, center_a, effective_mass, scale) = match a_body {
+        Some(a) => {
+            let body_a = &world.bodies[a];
+            let m = match (body_a.is_dynamic(), body_b.is_dynamic()) {
+                (true, true) => body_a.mass * body_b.mass / (body_a.mass + body_b.mass),
+                (true, false) => body_a.mass,
+                _ => body_b.mass,
+            };
+            let scale = world.length_scale(a).min(world.length_scale(b));
+            (body_a.velocity_at(&g.point), body_a.position, m, scale)
+        }
+        None => (
+            a_velocity_at.unwrap_or_else(Vector::zeros),
+            g.point_a,
+            body_b.mass,
+            world.length_scale(b),
+        ),
+    };
+    let kinematics = ContactKinematics {
+        relative_velocity: body_b.velocity_at(&g.point) - velocity_a,
+        effective_mass,
+        center_a,
+        center_b: body_b.position,
+        dt,
+    };
+    let g = *g;
+    let response = model.evaluate(&g, &kinematics, &mut state.history);
+    state.force_on_b = response.force_on_b;
+    Ok(Evaluated {
+        response,
+        overlapping: true,
+        depth: g.depth,
+        overlap_ratio: g.depth / scale,
+    })
 }
 
 /// Stage 8: every dynamic body's state and loads are finite.
