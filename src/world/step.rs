@@ -9,8 +9,10 @@
 //!   4. narrow phase      contact store synced to the candidate list; one contact query per candidate
 //!   5. laws              ContactModel::evaluate per overlapping candidate (tangential history in the store)
 //!   6. accumulate        per-body sums of forces and torques in candidate order (fixed, deterministic)
+//!  6b. (sleeping on) wake the sleeping islands touched by moving bodies or walls
 //!   7. second half kick  v, L ← v, L + ½Δt (F_{n+1}, p_{n+1})
 //!   8. checks            non-finite state → StepError naming body and step; deep overlaps → StepReport
+//!  8b. (sleeping on) calm counters, islands, bodies falling asleep (see [`super::sleeping`])
 //!   9. ledger, counters
 //! ```
 //! Forces are evaluated once per step, at the new positions x_{n+1} (stages 3–6); the same loads close this
@@ -29,14 +31,17 @@ use std::time::{Duration, Instant};
 use crate::contact::{
     query_with, ContactError, ContactGeometry, ContactKind, ContactTolerances, QueryCounters,
 };
+use crate::dynamics::translation::drift_position;
 use crate::dynamics::{Integrator, Motion, RotationScheme, TranslationParams, ViscousDamping};
-use crate::law::{ContactKinematics, ContactResponse};
+use crate::law::{ContactKinematics, ContactModel, ContactResponse, DampingLaw, TangentialLaw};
 use crate::math::{Point, Real, Vector};
 use crate::shape::Shape;
 
 use super::contact_store::{ContactKey, ContactState};
 use super::energy::viscous_power;
 use super::parallel::{for_each_chunked, for_each_item, Parallelism, Worker};
+use super::skips::{self, Skips};
+use super::sleeping::{self, SleepParams};
 use super::world::World;
 
 /// Default of [`StepParams::overlap_warning_fraction`]: 0.05. A DEM run with a stiffness that represents
@@ -60,6 +65,10 @@ pub struct StepParams {
     pub overlap_warning_fraction: Real,
     /// From which sizes the stages run on several threads (results are identical either way).
     pub parallel: Parallelism,
+    /// Work skipped because the scene does not need it (all on by default; see [`super::skips`]).
+    pub skips: Skips,
+    /// Freezing of bodies at rest (off by default; see [`super::sleeping`]).
+    pub sleeping: SleepParams,
 }
 
 impl StepParams {
@@ -73,6 +82,8 @@ impl StepParams {
             tolerances: ContactTolerances::default(),
             overlap_warning_fraction: DEFAULT_OVERLAP_WARNING_FRACTION,
             parallel: Parallelism::default(),
+            skips: Skips::default(),
+            sleeping: SleepParams::default(),
         }
     }
 }
@@ -85,6 +96,9 @@ pub struct StepScratch {
     evaluated: Vec<Evaluated>,
     /// One per chunk of the parallel stages (see [`super::parallel`]).
     workers: Vec<Worker>,
+    /// Union–find and island flags of the sleeping update.
+    islands: Vec<u32>,
+    ready: Vec<bool>,
 }
 
 /// Stage timers and counters of one or more steps (merge them with [`StepCounters::merge`]).
@@ -109,6 +123,12 @@ pub struct StepCounters {
     /// Contact-store entries created and dropped.
     pub contacts_created: u64,
     pub contacts_dropped: u64,
+    /// Candidates not re-evaluated because frozen (both sides asleep or fixed; see [`super::sleeping`]).
+    pub frozen_pairs: u64,
+    /// Bodies that fell asleep and that were woken; sleeping bodies summed over the steps.
+    pub fell_asleep: u64,
+    pub woken: u64,
+    pub sleeping_body_steps: u64,
     /// Narrow-phase counters (queries by kind, GJK/EPA iterations, fallbacks).
     pub query: QueryCounters,
 }
@@ -129,6 +149,10 @@ impl StepCounters {
         self.contacts += other.contacts;
         self.contacts_created += other.contacts_created;
         self.contacts_dropped += other.contacts_dropped;
+        self.frozen_pairs += other.frozen_pairs;
+        self.fell_asleep += other.fell_asleep;
+        self.woken += other.woken;
+        self.sleeping_body_steps += other.sleeping_body_steps;
         self.query.merge(&other.query);
     }
 
@@ -163,6 +187,13 @@ impl std::fmt::Display for StepCounters {
             self.contacts_created,
             self.contacts_dropped
         )?;
+        if self.frozen_pairs + self.fell_asleep + self.sleeping_body_steps > 0 {
+            writeln!(
+                f,
+                "sleeping: frozen pairs {}, bodies fell asleep {}, woken {}, sleeping body-steps {}",
+                self.frozen_pairs, self.fell_asleep, self.woken, self.sleeping_body_steps
+            )?;
+        }
         write!(f, "{}", self.query)
     }
 }
@@ -224,6 +255,13 @@ pub fn step(
         });
     }
     let mut report = StepReport::default();
+    world.sleep.resize(world.bodies.len());
+    if !params.sleeping.enabled && world.sleep.sleeping > 0 {
+        // Sleeping switched off: every body wakes.
+        report.counters.woken += world.sleep.sleeping as u64;
+        world.sleep = Default::default();
+        world.sleep.resize(world.bodies.len());
+    }
     let integrator = Integrator {
         translation: TranslationParams {
             gravity: world.gravity,
@@ -245,10 +283,24 @@ pub fn step(
     // 1–2. First half kick with the kept loads, drift.
     let t = Instant::now();
     let parallel_bodies = world.bodies.len() >= params.parallel.min_bodies;
-    let loads = &world.loads;
+    let (loads, asleep) = (&world.loads, &world.sleep);
+    let skip = params.skips;
+    let splitting = matches!(params.rotation, RotationScheme::Splitting { .. });
     for_each_item(parallel_bodies, &mut world.bodies, |i, body| {
+        if asleep.is_asleep(i) || (skip.non_dynamic_pairs && is_at_rest_fixed(body)) {
+            return;
+        }
         integrator.first_half_kick(body, &loads.forces[i], &loads.torques[i], dt);
-        integrator.drift(body, dt);
+        if skip.still_rotation
+            && splitting
+            && body.is_dynamic()
+            && body.angular_momentum == Vector::zeros()
+        {
+            // Zero angular momentum: the rotation sub-flows are identities (see `skips`).
+            drift_position(body, dt);
+        } else {
+            integrator.drift(body, dt);
+        }
     });
     for wall in &mut world.walls {
         wall.pose.translation.vector += dt * wall.velocity;
@@ -258,10 +310,19 @@ pub fn step(
     // 3–6. Loads at the new positions.
     evaluate_loads(params, world, scratch, &mut report, dt)?;
 
+    // 6b. Sleeping islands touched by something that moves wake before the second half kick.
+    if params.sleeping.enabled {
+        report.counters.woken +=
+            sleeping::wake_touched(world, &mut scratch.islands, &mut scratch.ready);
+    }
+
     // 7. Second half kick.
     let t = Instant::now();
-    let loads = &world.loads;
+    let (loads, asleep) = (&world.loads, &world.sleep);
     for_each_item(parallel_bodies, &mut world.bodies, |i, body| {
+        if asleep.is_asleep(i) || (skip.non_dynamic_pairs && is_at_rest_fixed(body)) {
+            return;
+        }
         integrator.second_half_kick(body, &loads.forces[i], &loads.torques[i], dt);
     });
     report.counters.integrate += t.elapsed();
@@ -270,6 +331,19 @@ pub fn step(
     let t = Instant::now();
     check_finite(world)?;
     report.counters.checks += t.elapsed();
+
+    // 8b. Sleeping: calm counters, islands, falling asleep and waking (serial, in body order).
+    if params.sleeping.enabled {
+        let counts = sleeping::update(
+            &params.sleeping,
+            world,
+            &mut scratch.islands,
+            &mut scratch.ready,
+        );
+        report.counters.fell_asleep += counts.fell_asleep;
+        report.counters.woken += counts.woken;
+    }
+    report.counters.sleeping_body_steps += world.sleep.sleeping as u64;
 
     // 9. Ledger and counters.
     let viscous_end = viscous_power(world, |m| params.damping.coefficient(m));
@@ -301,12 +375,19 @@ fn evaluate_loads(
     scratch
         .centres
         .extend(world.bodies.iter().map(|b| b.position));
-    if world.broad_phase.update(&scratch.centres, &world.radii) {
+    if !params.skips.verlet_skin {
+        world.broad_phase.rebuild(&scratch.centres, &world.radii);
+        counters.broad_rebuilds += 1;
+    } else if world.broad_phase.update(&scratch.centres, &world.radii) {
         counters.broad_rebuilds += 1;
     }
     scratch.candidates.clear();
+    let skip_non_dynamic = params.skips.non_dynamic_pairs;
     for &(a, b) in world.broad_phase.pairs() {
-        if world.bodies[a as usize].is_dynamic() || world.bodies[b as usize].is_dynamic() {
+        if !skip_non_dynamic
+            || world.bodies[a as usize].is_dynamic()
+            || world.bodies[b as usize].is_dynamic()
+        {
             scratch.candidates.push(ContactKey::Body { a, b });
         }
     }
@@ -349,7 +430,11 @@ fn evaluate_loads(
         contacts.states_mut(),
         &mut scratch.evaluated,
         &mut scratch.workers,
-        |i, state, _, worker| {
+        |i, state, out, worker| {
+            if sleeping::is_frozen(world_ref, candidates[i]) {
+                out.frozen = true;
+                return Ok(());
+            }
             state.geometry = narrow_phase(params, world_ref, candidates[i], state, worker)?;
             Ok(())
         },
@@ -375,7 +460,11 @@ fn evaluate_loads(
         &mut scratch.evaluated,
         &mut scratch.workers,
         |i, state, out, _| {
-            *out = contact_law(world_ref, candidates[i], state, dt, step_index)?;
+            *out = if out.frozen {
+                frozen_response(world_ref, candidates[i], state, step_index)?
+            } else {
+                contact_law(params, world_ref, candidates[i], state, dt, step_index)?
+            };
             Ok(())
         },
     );
@@ -387,6 +476,7 @@ fn evaluate_loads(
     report.max_overlap_ratio = 0.0;
     report.overlap_warnings.clear();
     for (key, e) in scratch.candidates.iter().zip(&scratch.evaluated) {
+        counters.frozen_pairs += e.frozen as u64;
         if !e.overlapping {
             continue;
         }
@@ -458,6 +548,8 @@ struct Evaluated {
     response: ContactResponse,
     /// Whether the shapes overlap (the law produced a force).
     overlapping: bool,
+    /// Whether the pair is frozen (kept from its last evaluation; see [`super::sleeping`]).
+    frozen: bool,
     /// Overlap δ_M (m) and δ_M divided by the smaller particle's length scale.
     depth: Real,
     overlap_ratio: Real,
@@ -475,10 +567,43 @@ fn narrow_phase(
     let wall_shape;
     match key {
         ContactKey::Body { a, b } => {
-            pose_a = world.pose(a as usize);
-            shape_a = world.shape(a as usize);
-            pose_b = world.pose(b as usize);
-            shape_b = world.shape(b as usize);
+            let (a, b) = (a as usize, b as usize);
+            shape_a = world.shape(a);
+            shape_b = world.shape(b);
+            if params.skips.bounding_spheres {
+                let scale = shape_a
+                    .length_scale()
+                    .unwrap_or(0.0)
+                    .max(shape_b.length_scale().unwrap_or(0.0));
+                if let Some(g) = skips::reject_by_bounding_spheres(
+                    &world.bodies[a].position,
+                    world.radii[a],
+                    &world.bodies[b].position,
+                    world.radii[b],
+                    scale,
+                    &params.tolerances,
+                    &mut worker.query,
+                ) {
+                    return Ok(g);
+                }
+            }
+            pose_a = world.pose(a);
+            pose_b = world.pose(b);
+            if params.skips.cached_axis {
+                if let Some((pa, pb)) = skips::polyhedra(shape_a, shape_b) {
+                    if let Some(g) = skips::reject_by_cached_axis(
+                        &pose_a,
+                        pa,
+                        &pose_b,
+                        pb,
+                        &params.tolerances,
+                        &mut state.cache,
+                        &mut worker.query,
+                    ) {
+                        return Ok(g);
+                    }
+                }
+            }
         }
         ContactKey::Wall { body, wall } => {
             let wall = &world.walls[wall as usize];
@@ -504,6 +629,7 @@ fn narrow_phase(
 /// Stage 5 for one candidate: the pair's contact model on the geometry of stage 4 (stored in `state`),
 /// updating the tangential history and the stored force.
 fn contact_law(
+    params: &StepParams,
     world: &World,
     key: ContactKey,
     state: &mut ContactState,
@@ -560,11 +686,95 @@ fn contact_law(
         dt,
     };
     let g = *g;
+    let model = effective_model(model, &params.skips);
     let response = model.evaluate(&g, &kinematics, &mut state.history);
     state.force_on_b = response.force_on_b;
     Ok(Evaluated {
         response,
         overlapping: true,
+        frozen: false,
+        depth: g.depth,
+        overlap_ratio: g.depth / scale,
+    })
+}
+
+/// The model with the slots the skips make free: no tangential spring when μ = 0, no damping term when its
+/// coefficient is 0 (see [`super::skips`]).
+fn effective_model(model: &ContactModel, skips: &Skips) -> ContactModel {
+    let mut m = *model;
+    if skips.frictionless_history && m.tangential.stiffness_and_friction(0.0).1 == 0.0 {
+        m.tangential = TangentialLaw::None;
+    }
+    if skips.undamped_contacts {
+        if let DampingLaw::Viscous { coefficient } = m.damping {
+            if coefficient == 0.0 {
+                m.damping = DampingLaw::None;
+            }
+        }
+    }
+    m
+}
+
+/// A fixed body whose velocities are already zero: integrating it changes nothing.
+fn is_at_rest_fixed(body: &crate::dynamics::RigidBody) -> bool {
+    matches!(body.motion, Motion::Fixed)
+        && body.velocity == Vector::zeros()
+        && body.angular_momentum == Vector::zeros()
+}
+
+/// Stage 5 for a frozen candidate: the kept geometry and force of its last evaluation, the torques about
+/// the unmoved centres and the elastic energy at the kept overlap (see [`super::sleeping`]).
+fn frozen_response(
+    world: &World,
+    key: ContactKey,
+    state: &ContactState,
+    step_index: u64,
+) -> Result<Evaluated, StepError> {
+    let g = &state.geometry;
+    if g.kind != ContactKind::Overlap {
+        return Ok(Evaluated {
+            frozen: true,
+            ..Evaluated::default()
+        });
+    }
+    let (center_a, mat_a, b) = match key {
+        ContactKey::Body { a, b } => (
+            world.bodies[a as usize].position,
+            world.material_of[a as usize],
+            b,
+        ),
+        ContactKey::Wall { body, wall } => (g.point_a, world.walls[wall as usize].material, body),
+    };
+    let b = b as usize;
+    let mat_b = world.material_of[b];
+    let Some(model) = world.materials.model(mat_a, mat_b) else {
+        return Err(StepError::MissingLaw {
+            step: step_index,
+            a: mat_a,
+            b: mat_b,
+        });
+    };
+    let force = state.force_on_b;
+    let (k_t, _) = model.tangential.stiffness_and_friction(g.depth);
+    let scale = match key {
+        ContactKey::Body { a, .. } => world.length_scale(a as usize).min(world.length_scale(b)),
+        ContactKey::Wall { .. } => world.length_scale(b),
+    };
+    Ok(Evaluated {
+        response: ContactResponse {
+            force_on_b: force,
+            torque_on_a: (g.point - center_a).cross(&(-force)),
+            torque_on_b: (g.point - world.bodies[b].position).cross(&force),
+            normal_force: force.dot(&g.normal),
+            tangential_force: force - g.normal * force.dot(&g.normal),
+            normal_potential: model.normal.potential(g.depth),
+            tangential_potential: 0.5 * k_t * state.history.displacement.norm_squared(),
+            damping_power: 0.0,
+            friction_dissipation: 0.0,
+            sliding: false,
+        },
+        overlapping: true,
+        frozen: true,
         depth: g.depth,
         overlap_ratio: g.depth / scale,
     })
