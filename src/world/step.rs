@@ -686,7 +686,8 @@ fn contact_law(
         dt,
     };
     let g = *g;
-    let model = effective_model(model, &params.skips);
+    let model = model.for_shapes(a_body.map(|a| world.shape(a)), world.shape(b));
+    let model = effective_model(&model, &params.skips);
     let response = model.evaluate(&g, &kinematics, &mut state.history);
     state.force_on_b = response.force_on_b;
     Ok(Evaluated {
@@ -706,7 +707,8 @@ fn effective_model(model: &ContactModel, skips: &Skips) -> ContactModel {
         m.tangential = TangentialLaw::None;
     }
     if skips.undamped_contacts {
-        if let DampingLaw::Viscous { coefficient } = m.damping {
+        if let DampingLaw::Viscous { coefficient } | DampingLaw::Dashpot { coefficient } = m.damping
+        {
             if coefficient == 0.0 {
                 m.damping = DampingLaw::None;
             }
@@ -754,6 +756,11 @@ fn frozen_response(
             b: mat_b,
         });
     };
+    let shape_a = match key {
+        ContactKey::Body { a, .. } => Some(world.shape(a as usize)),
+        ContactKey::Wall { .. } => None,
+    };
+    let model = model.for_shapes(shape_a, world.shape(b));
     let force = state.force_on_b;
     let (k_t, _) = model.tangential.stiffness_and_friction(g.depth);
     let scale = match key {
