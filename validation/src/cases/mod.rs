@@ -11,6 +11,7 @@ pub mod precession;
 pub mod restitution;
 pub mod rockfill;
 pub mod single_contact_energy;
+pub mod sphere_bed;
 
 /// Every case of the suite, in the order they run.
 pub fn registry() -> Vec<&'static dyn Case> {
@@ -22,6 +23,7 @@ pub fn registry() -> Vec<&'static dyn Case> {
         &chung_ooi::ChungOoi,
         &friction::Friction,
         &rockfill::Rockfill,
+        &sphere_bed::SphereBed,
         &perf::Perf,
     ]
 }
