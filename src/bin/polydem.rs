@@ -126,10 +126,11 @@ fn run(scene: &std::path::Path, out_dir: &std::path::Path) -> Result<()> {
                 csv_output::write_walls_rows(&mut walls, s)?;
                 csv_output::write_energy_row(&mut energy, s)
             },
-            |n| {
+            |_, n| {
                 if n % 256 == 0 {
                     bar.set_position(n);
                 }
+                Ok(())
             },
         )
         .with_context(|| format!("running scene {}", scene.display()))?;

@@ -2,6 +2,8 @@
 //!
 //! - [`pairs_jsonl`]: the `polydem contact` pair format (JSON Lines in, JSON Lines out).
 //! - [`csv_output`]: the CSV time series of `polydem run` (tracked bodies, energy ledger).
+//! - [`checkpoint`]: the versioned binary checkpoint of a whole simulation, for restarts.
 
+pub mod checkpoint;
 pub mod csv_output;
 pub mod pairs_jsonl;
