@@ -48,10 +48,29 @@ enum Command {
     Run(RunArgs),
 }
 
-fn main() -> Result<()> {
-    match Cli::parse().command {
+fn main() -> std::process::ExitCode {
+    let result = match Cli::parse().command {
         Command::Contact { pairs, out } => contact(&pairs, out.as_deref()),
         Command::Run(args) => run(&args),
+    };
+    match result {
+        Ok(()) => std::process::ExitCode::SUCCESS,
+        Err(e) => {
+            // The whole chain on one line ("what failed: why"), without a backtrace: these are user errors.
+            // A cause that its parent's message already quotes is not repeated.
+            let mut line = String::new();
+            for cause in e.chain() {
+                let text = cause.to_string();
+                if !line.contains(&text) {
+                    if !line.is_empty() {
+                        line.push_str(": ");
+                    }
+                    line.push_str(&text);
+                }
+            }
+            eprintln!("error: {line}");
+            std::process::ExitCode::FAILURE
+        }
     }
 }
 
@@ -93,13 +112,13 @@ struct RunArgs {
     #[arg(long, value_name = "FILE")]
     restart: Option<PathBuf>,
     /// Simulated end time (s), replacing the scene's or the checkpoint's.
-    #[arg(long, value_name = "T")]
+    #[arg(long, value_name = "T", allow_negative_numbers = true)]
     end_time: Option<f64>,
     /// Write VTK frames every T seconds of simulated time (and at the start and the end).
-    #[arg(long, value_name = "T")]
+    #[arg(long, value_name = "T", allow_negative_numbers = true)]
     vtk_interval: Option<f64>,
     /// Write a checkpoint every T seconds of simulated time (and at the end).
-    #[arg(long, value_name = "T")]
+    #[arg(long, value_name = "T", allow_negative_numbers = true)]
     checkpoint_interval: Option<f64>,
     /// No progress bar and no messages on standard error (errors excepted).
     #[arg(long, short)]
