@@ -10,6 +10,7 @@ pub mod perf;
 pub mod precession;
 pub mod restitution;
 pub mod single_contact_energy;
+pub mod sphere_bed;
 
 /// Every case of the suite, in the order they run.
 pub fn registry() -> Vec<&'static dyn Case> {
@@ -20,6 +21,7 @@ pub fn registry() -> Vec<&'static dyn Case> {
         &restitution::Restitution,
         &chung_ooi::ChungOoi,
         &friction::Friction,
+        &sphere_bed::SphereBed,
         &perf::Perf,
     ]
 }
