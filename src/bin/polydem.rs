@@ -11,6 +11,7 @@
 //!   and `docs/checkpoint-format.md`). A progress bar with rates and ETA is drawn on standard error when it is
 //!   a terminal, unless `--quiet`.
 //! - `polydem run --restart FILE --out DIR [--end-time T] ...`: continues a checkpoint bit for bit.
+//! - `polydem rockfill [--full] [--out DIR] …`: the paper's rockfill experiment (`polydem::rockfill::cli`).
 
 use std::fs::File;
 use std::io::{self, BufReader, BufWriter, Write};
@@ -46,12 +47,15 @@ enum Command {
     /// Run a scene file (or continue a checkpoint) and write CSV time series, optional VTK frames and
     /// checkpoints, and a run summary.
     Run(RunArgs),
+    /// The paper's rockfill penetration experiment (quick variant by default; see `--help`).
+    Rockfill(polydem::rockfill::cli::RockfillArgs),
 }
 
 fn main() -> std::process::ExitCode {
     let result = match Cli::parse().command {
         Command::Contact { pairs, out } => contact(&pairs, out.as_deref()),
         Command::Run(args) => run(&args),
+        Command::Rockfill(args) => polydem::rockfill::cli::run(&args),
     };
     match result {
         Ok(()) => std::process::ExitCode::SUCCESS,
