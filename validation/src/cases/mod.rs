@@ -9,7 +9,9 @@ pub mod friction;
 pub mod perf;
 pub mod precession;
 pub mod restitution;
+pub mod rockfill;
 pub mod single_contact_energy;
+pub mod sphere_bed;
 
 /// Every case of the suite, in the order they run.
 pub fn registry() -> Vec<&'static dyn Case> {
@@ -20,6 +22,8 @@ pub fn registry() -> Vec<&'static dyn Case> {
         &restitution::Restitution,
         &chung_ooi::ChungOoi,
         &friction::Friction,
+        &rockfill::Rockfill,
+        &sphere_bed::SphereBed,
         &perf::Perf,
     ]
 }
