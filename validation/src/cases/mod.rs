@@ -9,6 +9,7 @@ pub mod friction;
 pub mod perf;
 pub mod precession;
 pub mod restitution;
+pub mod rockfill;
 pub mod single_contact_energy;
 pub mod sphere_bed;
 
@@ -21,6 +22,7 @@ pub fn registry() -> Vec<&'static dyn Case> {
         &restitution::Restitution,
         &chung_ooi::ChungOoi,
         &friction::Friction,
+        &rockfill::Rockfill,
         &sphere_bed::SphereBed,
         &perf::Perf,
     ]
