@@ -207,10 +207,11 @@ fn run_polydem(variant: &Variant, ctx: &mut CaseContext) -> Result<Run, SuiteErr
                     .push(s.world.loads.forces.get(projectile).map_or(0.0, |f| f.z));
                 Ok(())
             },
-            |n| {
+            |_, n| {
                 if n % 500 == 0 {
                     progress.inc(500);
                 }
+                Ok(())
             },
         );
         let wall = start.elapsed().as_secs_f64();
