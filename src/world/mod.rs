@@ -10,6 +10,7 @@ pub mod broad_phase;
 pub mod contact_store;
 pub mod energy;
 pub mod step;
+pub mod tunnelling;
 #[allow(clippy::module_inception)]
 pub mod world;
 

@@ -10,6 +10,9 @@ pub mod perf;
 pub mod precession;
 pub mod restitution;
 pub mod single_contact_energy;
+pub mod stress_impact;
+pub mod stress_long_run;
+pub mod stress_util;
 
 /// Every case of the suite, in the order they run.
 pub fn registry() -> Vec<&'static dyn Case> {
@@ -20,6 +23,8 @@ pub fn registry() -> Vec<&'static dyn Case> {
         &restitution::Restitution,
         &chung_ooi::ChungOoi,
         &friction::Friction,
+        &stress_long_run::StressLongRun,
+        &stress_impact::StressImpact,
         &perf::Perf,
     ]
 }
