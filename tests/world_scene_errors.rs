@@ -236,3 +236,182 @@ fn the_documented_example_loads() {
     assert_eq!(sim.world.bodies.len(), 2);
     assert_eq!(sim.tracked.len(), 2);
 }
+
+/// A scene with the sphere-bed features: Hertz–Mindlin from material constants, a box and a CSV body file.
+const SPHERES: &str = r#"[simulation]
+gravity = [0.0, 0.0, -9.81]
+end_time = 0.001
+output_interval = 0.0001
+time_step = 1.0e-6
+characteristic_speed = 1.0
+
+[[material]]
+name = "glass"
+density = 2500.0
+young_modulus = 1.0e9
+poisson_ratio = 0.2
+
+[[interaction]]
+materials = ["glass", "glass"]
+law = "hertz_mindlin"
+restitution = 0.5
+friction = 0.3
+limit_force = true
+
+[[box]]
+name = "bin"
+material = "glass"
+min = [0.0, 0.0, 0.0]
+max = [0.01, 0.01, 0.01]
+open = ["z+"]
+
+[[body_file]]
+path = "SPHERES_CSV"
+material = "glass"
+name_prefix = "g"
+"#;
+
+/// Writes `csv` next to the scene and loads the scene with `path = <csv file name>`.
+fn load_with_csv(
+    case: &str,
+    scene: &str,
+    csv: &str,
+) -> (
+    PathBuf,
+    PathBuf,
+    Result<polydem::scene::Simulation, SceneError>,
+) {
+    let dir = std::env::temp_dir().join(format!("polydem-scene-errors-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let csv_name = format!("{case}.csv");
+    std::fs::write(dir.join(&csv_name), csv).unwrap();
+    let (path, result) = load(case, &scene.replace("SPHERES_CSV", &csv_name));
+    (path, dir.join(csv_name), result)
+}
+
+const GOOD_CSV: &str = "# two glass beads\nid,x,y,z,radius,vx,vy,vz\n1,0.003,0.005,0.002,0.001,0,0,0\n2,0.007,0.005,0.002,0.001,0,0,-0.5\n";
+
+#[test]
+fn sphere_scene_with_box_and_body_file_loads() {
+    let (_, _, result) = load_with_csv("spheres_ok", SPHERES, GOOD_CSV);
+    let sim = result.expect("valid sphere scene");
+    assert_eq!(sim.world.bodies.len(), 2);
+    assert_eq!(sim.world.names, vec!["g1".to_owned(), "g2".to_owned()]);
+    assert_eq!(sim.world.walls.len(), 5, "an open-top box has five walls");
+    assert_eq!(sim.world.bodies[1].velocity.z, -0.5);
+    // Walls face inwards: the x+ face's normal is −x and its plane passes through max.
+    let xp = sim
+        .world
+        .walls
+        .iter()
+        .find(|w| w.name == "bin.x+")
+        .expect("wall bin.x+");
+    assert_eq!(
+        xp.normal_world(),
+        polydem::math::Vector::new(-1.0, 0.0, 0.0)
+    );
+    assert!(xp.signed_distance(&polydem::math::Point::new(0.005, 0.0, 0.0)) > 0.0);
+}
+
+#[test]
+fn bad_csv_row_names_the_csv_file_line_and_column() {
+    let csv = GOOD_CSV.replace("2,0.007,0.005,0.002,0.001", "2,0.007,oops,0.002,0.001");
+    let (path, csv_path, result) = load_with_csv("spheres_bad_row", SPHERES, &csv);
+    let message = result.expect_err("bad CSV accepted").to_string();
+    let csv_line = csv.lines().position(|l| l.contains("oops")).unwrap() + 1;
+    let csv_location = format!("{}:{csv_line}: y:", csv_path.display());
+    assert!(
+        message.contains(&csv_location),
+        "message {message:?} does not name the CSV file, line and column {csv_location:?}"
+    );
+    let scene_line = SPHERES.lines().position(|l| l.starts_with("path")).unwrap() + 1;
+    assert_names(&message, &path, scene_line, "body_file[0].path");
+}
+
+#[test]
+fn missing_csv_file_is_named_with_the_scene_line() {
+    let (path, result) = load(
+        "spheres_no_csv",
+        &SPHERES.replace("SPHERES_CSV", "no-such-beads.csv"),
+    );
+    let message = result.expect_err("missing CSV accepted").to_string();
+    let line = SPHERES.lines().position(|l| l.starts_with("path")).unwrap() + 1;
+    assert_names(&message, &path, line, "body_file[0].path");
+    assert!(message.contains("no-such-beads.csv"), "{message}");
+}
+
+#[test]
+fn hertz_mindlin_needs_elastic_constants_and_refuses_stiffness() {
+    let text = SPHERES.replace("young_modulus = 1.0e9\npoisson_ratio = 0.2\n", "");
+    let (path, _, result) = load_with_csv("hm_no_young", &text, GOOD_CSV);
+    let message = result.expect_err("missing E accepted").to_string();
+    let line = text
+        .lines()
+        .position(|l| l.starts_with("name = \"glass\""))
+        .unwrap()
+        + 1;
+    assert_names(&message, &path, line, "material[0].young_modulus");
+
+    let text = SPHERES.replace(
+        "law = \"hertz_mindlin\"",
+        "law = \"hertz_mindlin\"\nnormal_stiffness = 1.0e6",
+    );
+    let (path, _, result) = load_with_csv("hm_stiffness", &text, GOOD_CSV);
+    let message = result
+        .expect_err("stiffness for hertz_mindlin accepted")
+        .to_string();
+    assert_names(
+        &message,
+        &path,
+        line_of(&text, "normal_stiffness"),
+        "interaction[0].normal_stiffness",
+    );
+
+    let text = SPHERES.replace("poisson_ratio = 0.2", "poisson_ratio = 0.7");
+    let (path, _, result) = load_with_csv("hm_poisson", &text, GOOD_CSV);
+    let message = result.expect_err("ν = 0.7 accepted").to_string();
+    assert_names(
+        &message,
+        &path,
+        line_of(&text, "poisson_ratio"),
+        "material[0].poisson_ratio",
+    );
+}
+
+#[test]
+fn box_with_unknown_face_or_inverted_corners_is_refused() {
+    let text = SPHERES.replace("open = [\"z+\"]", "open = [\"top\"]");
+    let (path, _, result) = load_with_csv("box_face", &text, GOOD_CSV);
+    let message = result.expect_err("unknown face accepted").to_string();
+    assert_names(&message, &path, line_of(&text, "open"), "box[0].open");
+
+    let text = SPHERES.replace("max = [0.01, 0.01, 0.01]", "max = [0.01, -0.01, 0.01]");
+    let (path, _, result) = load_with_csv("box_corners", &text, GOOD_CSV);
+    let message = result.expect_err("inverted box accepted").to_string();
+    assert_names(&message, &path, line_of(&text, "max"), "box[0].max");
+
+    let text = SPHERES.replace("open = [\"z+\"]", "open = [\"z+\"]\nmoving_face = \"z-\"");
+    let (path, _, result) = load_with_csv("box_moving", &text, GOOD_CSV);
+    let message = result
+        .expect_err("moving face without velocity accepted")
+        .to_string();
+    assert_names(
+        &message,
+        &path,
+        line_of(&text, "moving_face"),
+        "box[0].velocity",
+    );
+}
+
+#[test]
+fn linear_law_takes_restitution_or_dashpot_not_both() {
+    let text = edit("restitution", "restitution = 0.5\nnormal_damping = 2.0");
+    let (path, result) = load("both_dampings", &text);
+    let message = result.expect_err("both dampings accepted").to_string();
+    assert_names(
+        &message,
+        &path,
+        line_of(&text, "normal_damping"),
+        "interaction[0].normal_damping",
+    );
+}

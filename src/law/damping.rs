@@ -40,9 +40,26 @@ pub enum DampingLaw {
     None,
     /// f_d = coefficient · √(m* k_n) · δ^((n−1)/2) · δ̇, with the dimensionless coefficient ζ̂ ≥ 0.
     Viscous { coefficient: Real },
+    /// A dashpot of constant coefficient c (N s/m): f_d = c δ̇ whatever the masses and overlap — LIGGGHTS'
+    /// `absolute_damping on` (`gamman_abs`) and YADE's `ViscElMat` `cn`. The restitution then depends on
+    /// the masses of the pair: e = exp(−π ζ/√(1 − ζ²)), ζ = c/(2√(m* k_n)), for the linear law.
+    Dashpot { coefficient: Real },
 }
 
 impl DampingLaw {
+    /// A constant dashpot c ≥ 0 (N s/m).
+    pub fn dashpot(coefficient: Real) -> Result<Self, LawError> {
+        check_range(
+            "damping coefficient c_n",
+            coefficient,
+            0.0,
+            Real::MAX,
+            false,
+            "[0, ∞)",
+        )?;
+        Ok(Self::Dashpot { coefficient })
+    }
+
     /// The damping that gives the restitution `restitution` for a normal law of exponent `exponent`.
     pub fn from_restitution(exponent: Real, restitution: Real) -> Result<Self, LawError> {
         let coefficient = damping_for_restitution(exponent, restitution)?;
@@ -69,10 +86,18 @@ impl DampingLaw {
                 if overlap <= 0.0 {
                     return 0.0;
                 }
-                coefficient
-                    * (mass * stiffness).sqrt()
-                    * overlap.powf(0.5 * (exponent - 1.0))
-                    * overlap_rate
+                let shape = if exponent == 1.0 {
+                    1.0
+                } else {
+                    overlap.powf(0.5 * (exponent - 1.0))
+                };
+                coefficient * (mass * stiffness).sqrt() * shape * overlap_rate
+            }
+            Self::Dashpot { coefficient } => {
+                if overlap <= 0.0 {
+                    return 0.0;
+                }
+                coefficient * overlap_rate
             }
         }
     }

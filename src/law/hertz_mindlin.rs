@@ -17,10 +17,11 @@
 //! damping exact from e.
 
 use super::damping::DampingLaw;
-use super::normal::NormalLaw;
+use super::normal::{NormalLaw, RadiusScaling};
 use super::tangential::TangentialLaw;
 use super::{check_range, ContactModel, LawError};
 use crate::math::Real;
+use std::f64::consts::PI;
 
 /// Elastic constants of a material.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -131,6 +132,87 @@ pub fn linear_spring_dashpot(
         normal: NormalLaw::linear(normal_stiffness)?,
         damping: DampingLaw::from_restitution(1.0, restitution)?,
         tangential: TangentialLaw::spring(tangential_stiffness, friction)?,
+    })
+}
+
+/// Options of the Hertz–Mindlin law that differ between the reference codes' settings.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct HertzMindlinOptions {
+    /// Tangential dashpot c_t = 2√(5/6) β √(m* k_t) while sticking (LIGGGHTS `tangential_damping`, on by
+    /// default there; YADE's `betas`).
+    pub tangential_damping: bool,
+    /// Total normal force never attractive (LIGGGHTS `limitForce on`; off by default there).
+    pub limit_force: bool,
+}
+
+/// Hertz–Mindlin of a material pair from E, ν of each material, the pair's restitution e and friction μ,
+/// per √m of R* (scaled by each contact's √R*, see [`crate::law::pair`]): k_n = (4/3) E*, k_t coefficient
+/// 8 G*, normal damping √5 ζ (= LIGGGHTS' 2√(5/6) β √(S_n m*) with S_n = 2E*√(R*δ)), tangential damping
+/// 2√(5/6) ζ on √(m* k_t) when enabled, ζ = −ln e/√(π² + ln² e).
+pub fn material_hertz_mindlin(
+    a: &ElasticMaterial,
+    b: &ElasticMaterial,
+    restitution: Real,
+    friction: Real,
+    options: HertzMindlinOptions,
+) -> Result<ContactModel, LawError> {
+    check_range("friction μ", friction, 0.0, Real::MAX, false, "[0, ∞)")?;
+    let young = effective_young_modulus(a, b);
+    let shear = effective_shear_modulus(a, b);
+    let damping = DampingLaw::from_restitution(1.5, restitution)?;
+    let mut normal = NormalLaw::hertz(4.0 / 3.0 * young)?;
+    normal.radius_scaling = RadiusScaling::SqrtEffectiveRadius;
+    if options.limit_force {
+        normal = normal.with_force_limit();
+    }
+    let coefficient = 8.0 * shear;
+    let tangential = if friction == 0.0 {
+        TangentialLaw::None
+    } else if options.tangential_damping {
+        let log_e = restitution.ln();
+        let zeta = -log_e / (PI * PI + log_e * log_e).sqrt();
+        TangentialLaw::DampedMindlin {
+            coefficient,
+            friction,
+            damping: 2.0 * (5.0_f64 / 6.0).sqrt() * zeta,
+        }
+    } else {
+        TangentialLaw::Mindlin {
+            coefficient,
+            friction,
+        }
+    };
+    Ok(ContactModel {
+        normal,
+        damping,
+        tangential,
+    })
+}
+
+/// The linear spring–dashpot with a constant dashpot c_n (N s/m) instead of a restitution, as LIGGGHTS'
+/// `hooke/stiffness absolute_damping on tangential_damping off` (`gamman_abs`) and YADE's `ViscElMat`:
+/// f_n = k_n δ + c_n δ̇; tangential spring k_t with Coulomb cap μ; `limit_force` clamps f_n at zero.
+pub fn linear_dashpot(
+    normal_stiffness: Real,
+    tangential_stiffness: Real,
+    normal_damping: Real,
+    friction: Real,
+    limit_force: bool,
+) -> Result<ContactModel, LawError> {
+    let mut normal = NormalLaw::linear(normal_stiffness)?;
+    if limit_force {
+        normal = normal.with_force_limit();
+    }
+    let tangential = if friction == 0.0 {
+        TangentialLaw::None
+    } else {
+        TangentialLaw::spring(tangential_stiffness, friction)?
+    };
+    Ok(ContactModel {
+        normal,
+        damping: DampingLaw::dashpot(normal_damping)?,
+        tangential,
     })
 }
 

@@ -20,11 +20,12 @@ pub mod damping;
 pub mod hertz_mindlin;
 pub mod model;
 pub mod normal;
+pub mod pair;
 pub mod tangential;
 
 pub use damping::DampingLaw;
 pub use model::{ContactKinematics, ContactModel, ContactResponse};
-pub use normal::NormalLaw;
+pub use normal::{NormalLaw, RadiusScaling};
 pub use tangential::{TangentialHistory, TangentialLaw};
 
 /// Invalid law parameters.

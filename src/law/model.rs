@@ -7,7 +7,7 @@
 
 use super::damping::DampingLaw;
 use super::normal::NormalLaw;
-use super::tangential::{incremental_spring, TangentialHistory, TangentialLaw};
+use super::tangential::{incremental_spring_damped, TangentialHistory, TangentialLaw};
 use crate::contact::{ContactGeometry, ContactKind};
 use crate::math::{Point, Real, Vector};
 
@@ -52,7 +52,8 @@ pub struct ContactResponse {
     pub normal_potential: Real,
     /// Tangential spring energy ½ k_t |u|² (J).
     pub tangential_potential: Real,
-    /// Power dissipated by the normal damping, f_d δ̇ ≥ 0 (W).
+    /// Power dissipated by the normal damping, f_d δ̇ (W, ≥ 0 unless the force limit clamps it), plus that
+    /// of a tangential dashpot.
     pub damping_power: Real,
     /// Friction work dissipated during this step (J, ≥ 0).
     pub friction_dissipation: Real,
@@ -79,33 +80,55 @@ impl ContactModel {
         let overlap_rate = -v.dot(&n);
         let (k, exponent) = (self.normal.stiffness, self.normal.exponent);
         let elastic = self.normal.force(overlap);
-        let damping = self.damping.force(
+        let mut damping = self.damping.force(
             k,
             exponent,
             kinematics.effective_mass,
             overlap,
             overlap_rate,
         );
+        if self.normal.never_attractive && elastic + damping < 0.0 {
+            // The clamp removes the part of the damping force that would pull: what acts is −elastic.
+            damping = -elastic;
+        }
         let normal_force = elastic + damping;
 
-        let (tangential_force, tangential_potential, friction_dissipation, sliding) =
-            match self.tangential {
-                TangentialLaw::None => (Vector::zeros(), 0.0, 0.0, false),
-                law => {
-                    let (stiffness, friction) = law.stiffness_and_friction(overlap);
-                    let v_t = v - n * v.dot(&n);
-                    let r = incremental_spring(
-                        stiffness,
-                        friction,
-                        &n,
-                        normal_force,
-                        &v_t,
-                        kinematics.dt,
-                        history,
-                    );
-                    (r.force, r.spring_energy, r.friction_dissipation, r.sliding)
-                }
-            };
+        let (
+            tangential_force,
+            tangential_potential,
+            friction_dissipation,
+            sliding,
+            tangential_power,
+        ) = match self.tangential {
+            TangentialLaw::None => (Vector::zeros(), 0.0, 0.0, false, 0.0),
+            law => {
+                let (stiffness, friction) = law.stiffness_and_friction(overlap);
+                let dashpot = match law {
+                    TangentialLaw::DampedMindlin { damping, .. } => {
+                        damping * (kinematics.effective_mass * stiffness).sqrt()
+                    }
+                    _ => 0.0,
+                };
+                let v_t = v - n * v.dot(&n);
+                let r = incremental_spring_damped(
+                    stiffness,
+                    friction,
+                    dashpot,
+                    &n,
+                    normal_force,
+                    &v_t,
+                    kinematics.dt,
+                    history,
+                );
+                (
+                    r.force,
+                    r.spring_energy,
+                    r.friction_dissipation,
+                    r.sliding,
+                    r.damping_power,
+                )
+            }
+        };
         let force_on_b = n * normal_force + tangential_force;
         let point = geometry.point;
         ContactResponse {
@@ -116,9 +139,110 @@ impl ContactModel {
             tangential_force,
             normal_potential: self.normal.potential(overlap),
             tangential_potential,
-            damping_power: damping * overlap_rate,
+            damping_power: damping * overlap_rate + tangential_power,
             friction_dissipation,
             sliding,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::contact::SolverStatus;
+    use crate::law::{DampingLaw, NormalLaw};
+
+    /// Head-on impact of a point mass m* on the model at speed v₀, by velocity Verlet with `steps_per_unit`
+    /// steps per δ₀/v₀; returns the rebound speed / v₀.
+    fn simulated_restitution(model: &ContactModel, mass: Real, speed: Real) -> Real {
+        let n = model.normal.exponent;
+        let scale = (mass * speed * speed / model.normal.stiffness).powf(1.0 / (n + 1.0));
+        let dt = scale / speed * 2e-5;
+        let (mut x, mut v) = (0.0, speed); // x = overlap, v = overlap rate
+        let mut history = TangentialHistory::default();
+        let force = |x: Real, v: Real, h: &mut TangentialHistory| {
+            let g = ContactGeometry::from_points(
+                ContactKind::Overlap,
+                x,
+                -x,
+                Vector::z(),
+                Point::origin(),
+                Point::origin(),
+                SolverStatus::Converged,
+            );
+            let k = ContactKinematics {
+                relative_velocity: Vector::z() * -v,
+                effective_mass: mass,
+                center_a: Point::new(0.0, 0.0, -1.0),
+                center_b: Point::new(0.0, 0.0, 1.0),
+                dt,
+            };
+            if x <= 0.0 {
+                0.0
+            } else {
+                model.evaluate(&g, &k, h).normal_force
+            }
+        };
+        let mut f = 0.0;
+        loop {
+            let v_half = v - 0.5 * dt * f / mass;
+            x += dt * v_half;
+            if x <= 0.0 {
+                return -v_half / speed;
+            }
+            f = force(x, v_half, &mut history);
+            v = v_half - 0.5 * dt * f / mass;
+        }
+    }
+
+    /// The oracle: the dimensionless impact x'' = −max(x^n + ζ̂ x^a x', 0) by small explicit RK4 steps; with
+    /// the force limit the bodies part when the force reaches zero, so e = −x' there.
+    fn clamped_restitution_oracle(exponent: Real, coefficient: Real) -> Real {
+        let a = 0.5 * (exponent - 1.0);
+        let force =
+            |x: Real, v: Real| x.max(0.0).powf(exponent) + coefficient * x.max(0.0).powf(a) * v;
+        let acc = |x: Real, v: Real| -force(x, v).max(0.0);
+        let (mut x, mut v): (Real, Real) = (0.0, 1.0);
+        let h = 1e-5;
+        loop {
+            let (k1x, k1v) = (v, acc(x, v));
+            let (k2x, k2v) = (v + 0.5 * h * k1v, acc(x + 0.5 * h * k1x, v + 0.5 * h * k1v));
+            let (k3x, k3v) = (v + 0.5 * h * k2v, acc(x + 0.5 * h * k2x, v + 0.5 * h * k2v));
+            let (k4x, k4v) = (v + h * k3v, acc(x + h * k3x, v + h * k3v));
+            x += h / 6.0 * (k1x + 2.0 * k2x + 2.0 * k3x + k4x);
+            v += h / 6.0 * (k1v + 2.0 * k2v + 2.0 * k3v + k4v);
+            if v < 0.0 && (force(x, v) <= 0.0 || x <= 0.0) {
+                return -v;
+            }
+        }
+    }
+
+    #[test]
+    fn force_limit_ends_the_contact_when_the_force_vanishes() {
+        for (exponent, e) in [(1.5, 0.5), (1.5, 0.4), (1.0, 0.5)] {
+            let base = ContactModel {
+                normal: NormalLaw::new(2e8, exponent).unwrap(),
+                damping: DampingLaw::from_restitution(exponent, e).unwrap(),
+                tangential: TangentialLaw::None,
+            };
+            let free = simulated_restitution(&base, 1e-4, 5.0);
+            assert!(
+                (free - e).abs() < 2e-4,
+                "n = {exponent}, e = {e}: without the limit the rebound is e = {free}, expected {e} (tolerance 2e-4)"
+            );
+            let limited = ContactModel {
+                normal: base.normal.with_force_limit(),
+                ..base
+            };
+            let measured = simulated_restitution(&limited, 1e-4, 5.0);
+            let DampingLaw::Viscous { coefficient } = base.damping else {
+                panic!("damped law expected")
+            };
+            let oracle = clamped_restitution_oracle(exponent, coefficient);
+            assert!(
+                (measured - oracle).abs() < 2e-4 && measured > e,
+                "n = {exponent}, e = {e}: with the force limit the rebound is {measured}, oracle {oracle} (tolerance 2e-4)"
+            );
         }
     }
 }

@@ -12,11 +12,14 @@ use std::sync::Arc;
 use toml::Spanned;
 
 use crate::dynamics::{Motion, PrincipalInertia, RigidBody, ViscousDamping};
-use crate::law::{ContactModel, DampingLaw, LawError, NormalLaw, TangentialLaw};
+use crate::law::hertz_mindlin::{material_hertz_mindlin, ElasticMaterial, HertzMindlinOptions};
+use crate::law::pair::contact_radius;
+use crate::law::{ContactModel, DampingLaw, LawError, NormalLaw, RadiusScaling, TangentialLaw};
 use crate::math::{Point, Pose, Real, Rotation, Vector};
 use crate::shape::{ConvexPolyhedron, Plane, Shape, Sphere};
 use crate::world::{MaterialTable, StepParams, Wall, World};
 
+use super::body_file::read_sphere_table;
 use super::schema::{SceneFile, Vec3};
 use super::time_step::{contact_time_and_limit, PairEstimate, TimeStepInfo, TimeStepIssue};
 
@@ -160,6 +163,7 @@ fn build(ctx: &Ctx, file: &SceneFile) -> Result<Simulation, SceneError> {
     let mut materials = MaterialTable::default();
     let mut material_ids: HashMap<&str, u32> = HashMap::new();
     let mut densities = Vec::new();
+    let mut elastic: Vec<Option<ElasticMaterial>> = Vec::new();
     for (k, m) in file.materials.iter().enumerate() {
         let name = m.name.get_ref().as_str();
         if material_ids.contains_key(name) {
@@ -170,6 +174,29 @@ fn build(ctx: &Ctx, file: &SceneFile) -> Result<Simulation, SceneError> {
             ));
         }
         densities.push(ctx.positive(&m.density, &format!("material[{k}].density"))?);
+        elastic.push(match (&m.young_modulus, &m.poisson_ratio) {
+            (None, None) => None,
+            (Some(young), Some(poisson)) => {
+                let e = ctx.positive(young, &format!("material[{k}].young_modulus"))?;
+                Some(ElasticMaterial::new(e, *poisson.get_ref()).map_err(|err| {
+                    ctx.law(poisson.span(), &format!("material[{k}].poisson_ratio"), err)
+                })?)
+            }
+            (Some(young), None) => {
+                return Err(ctx.invalid(
+                    young.span(),
+                    format!("material[{k}].poisson_ratio"),
+                    "young_modulus needs poisson_ratio as well",
+                ))
+            }
+            (None, Some(poisson)) => {
+                return Err(ctx.invalid(
+                    poisson.span(),
+                    format!("material[{k}].young_modulus"),
+                    "poisson_ratio needs young_modulus as well",
+                ))
+            }
+        });
         material_ids.insert(name, materials.add_material(name));
     }
     let material = |name: &Spanned<String>, field: String| {
@@ -205,37 +232,6 @@ fn build(ctx: &Ctx, file: &SceneFile) -> Result<Simulation, SceneError> {
                 format!("a law for ('{a}', '{b}') is already given"),
             ));
         }
-        let k_n = ctx.positive(&it.normal_stiffness, &f("normal_stiffness"))?;
-        let exponent = match (it.law.get_ref().as_str(), &it.exponent) {
-            ("linear", None) => 1.0,
-            ("linear", Some(e)) => {
-                return Err(ctx.invalid(
-                    e.span(),
-                    f("exponent"),
-                    "the linear law has no exponent (use law = \"power\")",
-                ))
-            }
-            ("power", Some(e)) => *e.get_ref(),
-            ("power", None) => {
-                return Err(ctx.invalid(
-                    it.law.span(),
-                    f("exponent"),
-                    "the power law needs an exponent n (1 ≤ n ≤ 3)",
-                ))
-            }
-            (other, _) => {
-                return Err(ctx.invalid(
-                    it.law.span(),
-                    f("law"),
-                    format!("unknown law '{other}' (expected \"linear\" or \"power\")"),
-                ))
-            }
-        };
-        let exponent_span = it.exponent.as_ref().map_or(it.law.span(), |e| e.span());
-        let normal =
-            NormalLaw::new(k_n, exponent).map_err(|e| ctx.law(exponent_span, &f("exponent"), e))?;
-        let damping = DampingLaw::from_restitution(exponent, *it.restitution.get_ref())
-            .map_err(|e| ctx.law(it.restitution.span(), &f("restitution"), e))?;
         let mu = *it.friction.get_ref();
         if !(mu.is_finite() && mu >= 0.0) {
             return Err(ctx.invalid(
@@ -244,35 +240,150 @@ fn build(ctx: &Ctx, file: &SceneFile) -> Result<Simulation, SceneError> {
                 format!("must be finite and ≥ 0, got {mu}"),
             ));
         }
-        // No tangential history at all when μ = 0: the spring could carry no force.
-        let tangential = match (&it.tangential_stiffness, mu > 0.0) {
-            (None, false) => TangentialLaw::None,
-            (Some(k_t), _) => {
-                let k_t_value = ctx.positive(k_t, &f("tangential_stiffness"))?;
-                if mu > 0.0 {
-                    TangentialLaw::spring(k_t_value, mu)
-                        .map_err(|e| ctx.law(k_t.span(), &f("tangential_stiffness"), e))?
-                } else {
-                    TangentialLaw::None
+        let limit_force = it.limit_force.as_ref().is_some_and(|b| *b.get_ref());
+        let law = it.law.get_ref().as_str();
+        let model = match law {
+            "hertz_mindlin" => {
+                let foreign = [
+                    (
+                        "normal_stiffness",
+                        it.normal_stiffness.as_ref().map(|v| v.span()),
+                    ),
+                    ("exponent", it.exponent.as_ref().map(|v| v.span())),
+                    (
+                        "tangential_stiffness",
+                        it.tangential_stiffness.as_ref().map(|v| v.span()),
+                    ),
+                    (
+                        "normal_damping",
+                        it.normal_damping.as_ref().map(|v| v.span()),
+                    ),
+                ];
+                for (field, span) in foreign {
+                    if let Some(span) = span {
+                        return Err(ctx.invalid(span, f(field), format!("the hertz_mindlin law takes no {field}: its stiffnesses follow from the materials' young_modulus and poisson_ratio and each contact's R*, its damping from the restitution")));
+                    }
+                }
+                let restitution = it.restitution.as_ref().ok_or_else(|| {
+                    ctx.invalid(
+                        it.law.span(),
+                        f("restitution"),
+                        "the hertz_mindlin law needs a restitution e (0 < e ≤ 1)",
+                    )
+                })?;
+                let constants = |id: u32| {
+                    elastic[id as usize].ok_or_else(|| {
+                        let m = &file.materials[id as usize];
+                        ctx.invalid(
+                            m.name.span(),
+                            format!("material[{id}].young_modulus"),
+                            format!("material '{}' needs young_modulus and poisson_ratio: interaction[{k}] uses the hertz_mindlin law", m.name.get_ref()),
+                        )
+                    })
+                };
+                let options = HertzMindlinOptions {
+                    tangential_damping: it.tangential_damping.as_ref().is_none_or(|b| *b.get_ref()),
+                    limit_force,
+                };
+                material_hertz_mindlin(
+                    &constants(ia)?,
+                    &constants(ib)?,
+                    *restitution.get_ref(),
+                    mu,
+                    options,
+                )
+                .map_err(|e| ctx.law(restitution.span(), &f("restitution"), e))?
+            }
+            "linear" | "power" => {
+                if let Some(td) = &it.tangential_damping {
+                    return Err(ctx.invalid(
+                        td.span(),
+                        f("tangential_damping"),
+                        format!("the {law} law has no tangential dashpot (only hertz_mindlin)"),
+                    ));
+                }
+                let k_n_value = it.normal_stiffness.as_ref().ok_or_else(|| {
+                    ctx.invalid(
+                        it.law.span(),
+                        f("normal_stiffness"),
+                        format!("the {law} law needs normal_stiffness"),
+                    )
+                })?;
+                let k_n = ctx.positive(k_n_value, &f("normal_stiffness"))?;
+                let exponent = match (law, &it.exponent) {
+                    ("linear", None) => 1.0,
+                    ("linear", Some(e)) => {
+                        return Err(ctx.invalid(
+                            e.span(),
+                            f("exponent"),
+                            "the linear law has no exponent (use law = \"power\")",
+                        ))
+                    }
+                    (_, Some(e)) => *e.get_ref(),
+                    (_, None) => {
+                        return Err(ctx.invalid(
+                            it.law.span(),
+                            f("exponent"),
+                            "the power law needs an exponent n (1 ≤ n ≤ 3)",
+                        ))
+                    }
+                };
+                let exponent_span = it.exponent.as_ref().map_or(it.law.span(), |e| e.span());
+                let mut normal = NormalLaw::new(k_n, exponent)
+                    .map_err(|e| ctx.law(exponent_span, &f("exponent"), e))?;
+                if limit_force {
+                    normal = normal.with_force_limit();
+                }
+                let damping = match (&it.restitution, &it.normal_damping) {
+                    (Some(e), None) => DampingLaw::from_restitution(exponent, *e.get_ref())
+                        .map_err(|err| ctx.law(e.span(), &f("restitution"), err))?,
+                    (None, Some(c)) if law == "linear" => DampingLaw::dashpot(*c.get_ref())
+                        .map_err(|err| ctx.law(c.span(), &f("normal_damping"), err))?,
+                    (None, Some(c)) => {
+                        return Err(ctx.invalid(c.span(), f("normal_damping"), "a constant dashpot is available for the linear law only; give a restitution"))
+                    }
+                    (Some(_), Some(c)) => {
+                        return Err(ctx.invalid(c.span(), f("normal_damping"), "give either restitution or normal_damping, not both"))
+                    }
+                    (None, None) => {
+                        return Err(ctx.invalid(it.law.span(), f("restitution"), "give a restitution e (0 < e ≤ 1) or, for the linear law, a normal_damping c_n (N s/m)"))
+                    }
+                };
+                // No tangential history at all when μ = 0: the spring could carry no force.
+                let tangential = match (&it.tangential_stiffness, mu > 0.0) {
+                    (None, false) => TangentialLaw::None,
+                    (Some(k_t), _) => {
+                        let k_t_value = ctx.positive(k_t, &f("tangential_stiffness"))?;
+                        if mu > 0.0 {
+                            TangentialLaw::spring(k_t_value, mu)
+                                .map_err(|e| ctx.law(k_t.span(), &f("tangential_stiffness"), e))?
+                        } else {
+                            TangentialLaw::None
+                        }
+                    }
+                    (None, true) => {
+                        return Err(ctx.invalid(
+                            it.friction.span(),
+                            f("tangential_stiffness"),
+                            "friction > 0 needs a tangential_stiffness",
+                        ))
+                    }
+                };
+                ContactModel {
+                    normal,
+                    damping,
+                    tangential,
                 }
             }
-            (None, true) => {
-                return Err(ctx.invalid(
-                    it.friction.span(),
-                    f("tangential_stiffness"),
-                    "friction > 0 needs a tangential_stiffness",
-                ))
-            }
+            other => return Err(ctx.invalid(
+                it.law.span(),
+                f("law"),
+                format!(
+                    "unknown law '{other}' (expected \"linear\", \"power\" or \"hertz_mindlin\")"
+                ),
+            )),
         };
-        materials.set_model(
-            ia,
-            ib,
-            ContactModel {
-                normal,
-                damping,
-                tangential,
-            },
-        );
+        materials.set_model(ia, ib, model);
     }
 
     // Shapes.
@@ -398,14 +509,16 @@ fn build(ctx: &Ctx, file: &SceneFile) -> Result<Simulation, SceneError> {
 
     // Bodies.
     let mut world_bodies = Vec::new();
-    let mut names: HashMap<&str, ()> = HashMap::new();
+    // Where each body was given: the span and field an error about it names.
+    let mut origins: Vec<(Range<usize>, String)> = Vec::new();
+    let mut names: HashMap<String, ()> = HashMap::new();
     for (k, b) in file.bodies.iter().enumerate() {
         let f = |x: &str| format!("body[{k}].{x}");
         let name = b.name.get_ref().as_str();
         if name.is_empty() || name.contains([',', '"', '\n', '\r']) {
             return Err(ctx.invalid(b.name.span(), f("name"), format!("'{name}' must be non-empty without commas, quotes or line breaks (it is the id column of bodies.csv)")));
         }
-        if names.insert(name, ()).is_some() {
+        if names.insert(name.to_owned(), ()).is_some() {
             return Err(ctx.invalid(b.name.span(), f("name"), format!("duplicate body '{name}'")));
         }
         let shape_index = *shape_ids.get(b.shape.get_ref().as_str()).ok_or_else(|| {
@@ -498,13 +611,89 @@ fn build(ctx: &Ctx, file: &SceneFile) -> Result<Simulation, SceneError> {
             body.set_angular_velocity(&omega);
         }
         world_bodies.push((
-            name,
+            name.to_owned(),
             shape_index,
             mat,
             body,
             *frame,
             b.track.unwrap_or(false),
         ));
+        origins.push((b.material.span(), f("material")));
+    }
+
+    // Bodies from CSV files.
+    for (k, bf) in file.body_files.iter().enumerate() {
+        let f = |x: &str| format!("body_file[{k}].{x}");
+        let mat = material(&bf.material, f("material"))?;
+        let relative = Path::new(bf.path.get_ref());
+        let csv_path = match ctx.path.parent() {
+            Some(dir) if relative.is_relative() => dir.join(relative),
+            _ => relative.to_owned(),
+        };
+        let rows = read_sphere_table(&csv_path)
+            .map_err(|e| ctx.invalid(bf.path.span(), f("path"), e.to_string()))?;
+        let use_file_velocities = match bf
+            .velocities
+            .as_ref()
+            .map(|v| (v.get_ref().as_str(), v.span()))
+        {
+            None | Some(("file", _)) => true,
+            Some(("zero", _)) => false,
+            Some((other, span)) => {
+                return Err(ctx.invalid(
+                    span,
+                    f("velocities"),
+                    format!("unknown choice '{other}' (expected \"file\" or \"zero\")"),
+                ))
+            }
+        };
+        if let (Some(v), None) = (&bf.velocities, &rows[0].velocity) {
+            if v.get_ref() == "file" {
+                return Err(ctx.invalid(
+                    v.span(),
+                    f("velocities"),
+                    format!("{} has no vx, vy, vz columns", csv_path.display()),
+                ));
+            }
+        }
+        let prefix = bf.name_prefix.get_ref();
+        let density = densities[mat as usize];
+        for row in rows {
+            let name = format!("{prefix}{}", row.id);
+            if names.insert(name.clone(), ()).is_some() {
+                return Err(ctx.invalid(
+                    bf.name_prefix.span(),
+                    f("name_prefix"),
+                    format!("duplicate body '{name}' (from {})", csv_path.display()),
+                ));
+            }
+            let sphere = Sphere::new(row.radius).map_err(|e| {
+                ctx.invalid(
+                    bf.path.span(),
+                    f("path"),
+                    format!("{}: body '{name}': {e}", csv_path.display()),
+                )
+            })?;
+            let props = sphere.mass_properties();
+            let inertia = PrincipalInertia::new(props.principal_moments * density)
+                .map_err(|e| ctx.invalid(bf.material.span(), f("material"), e.to_string()))?;
+            let mut body =
+                RigidBody::new_dynamic(Point::from(row.position), props.volume * density, inertia)
+                    .map_err(|e| ctx.invalid(bf.material.span(), f("material"), e.to_string()))?;
+            if use_file_velocities {
+                body.velocity = row.velocity.unwrap_or_else(Vector::zeros);
+            }
+            shapes.push((Shape::Sphere(sphere), Pose::identity()));
+            world_bodies.push((
+                name,
+                shapes.len() - 1,
+                mat,
+                body,
+                Pose::identity(),
+                bf.track.unwrap_or(false),
+            ));
+            origins.push((bf.material.span(), f("material")));
+        }
     }
 
     // Walls.
@@ -534,6 +723,100 @@ fn build(ctx: &Ctx, file: &SceneFile) -> Result<Simulation, SceneError> {
         ));
     }
 
+    // Boxes: one inward-facing wall per closed face.
+    for (k, bx) in file.boxes.iter().enumerate() {
+        let f = |x: &str| format!("box[{k}].{x}");
+        let mat = material(&bx.material, f("material"))?;
+        let lo = ctx.vector(&bx.min, &f("min"))?;
+        let hi = ctx.vector(&bx.max, &f("max"))?;
+        if (0..3).any(|i| hi[i] <= lo[i]) {
+            return Err(ctx.invalid(
+                bx.max.span(),
+                f("max"),
+                format!(
+                    "must exceed min in every coordinate, got min {:?}, max {:?}",
+                    bx.min.get_ref(),
+                    bx.max.get_ref()
+                ),
+            ));
+        }
+        const FACES: [&str; 6] = ["x-", "x+", "y-", "y+", "z-", "z+"];
+        let check_face = |name: &str, span: Range<usize>, field: String| {
+            if FACES.contains(&name) {
+                Ok(())
+            } else {
+                Err(ctx.invalid(
+                    span,
+                    field,
+                    format!("unknown face '{name}' (expected one of {FACES:?})"),
+                ))
+            }
+        };
+        let open: Vec<String> = match &bx.open {
+            Some(o) => {
+                for face in o.get_ref() {
+                    check_face(face, o.span(), f("open"))?;
+                }
+                o.get_ref().clone()
+            }
+            None => Vec::new(),
+        };
+        let moving = match (&bx.moving_face, &bx.velocity) {
+            (None, None) => None,
+            (Some(face), Some(v)) => {
+                check_face(face.get_ref(), face.span(), f("moving_face"))?;
+                if open.contains(face.get_ref()) {
+                    return Err(ctx.invalid(
+                        face.span(),
+                        f("moving_face"),
+                        format!("face '{}' is open", face.get_ref()),
+                    ));
+                }
+                Some((face.get_ref().clone(), ctx.vector(v, &f("velocity"))?))
+            }
+            (Some(face), None) => {
+                return Err(ctx.invalid(
+                    face.span(),
+                    f("velocity"),
+                    "a moving_face needs a velocity (m/s)",
+                ))
+            }
+            (None, Some(v)) => {
+                return Err(ctx.invalid(
+                    v.span(),
+                    f("moving_face"),
+                    "a velocity needs the moving_face it belongs to",
+                ))
+            }
+        };
+        for (j, face) in FACES.iter().enumerate() {
+            if open.iter().any(|o| o == face) {
+                continue;
+            }
+            let axis = j / 2;
+            let upper = j % 2 == 1;
+            let mut normal = Vector::zeros();
+            normal[axis] = if upper { -1.0 } else { 1.0 };
+            let point = if upper { hi } else { lo };
+            let plane = Plane::new(normal, 0.0)
+                .map_err(|e| ctx.invalid(bx.min.span(), f("min"), e.to_string()))?;
+            let velocity = match &moving {
+                Some((m, v)) if m == face => *v,
+                _ => Vector::zeros(),
+            };
+            walls.push((
+                bx.name.span(),
+                Wall {
+                    name: format!("{}.{face}", bx.name.get_ref()),
+                    plane,
+                    pose: Pose::from_parts(point.into(), Rotation::identity()),
+                    velocity,
+                    material: mat,
+                },
+            ));
+        }
+    }
+
     // The time step.
     let speed = sim
         .characteristic_speed
@@ -542,11 +825,17 @@ fn build(ctx: &Ctx, file: &SceneFile) -> Result<Simulation, SceneError> {
         .transpose()?;
     let n_mat = materials.len();
     let mut lightest = vec![Real::INFINITY; n_mat];
+    // Contact radius of the lightest body of each material (for laws that scale with R*).
+    let mut lightest_radius = vec![Real::INFINITY; n_mat];
     let mut has_obstacle = vec![false; n_mat];
     let mut kappa: Real = 1.0;
     for (_, shape_index, mat, body, _, _) in &world_bodies {
         if body.is_dynamic() {
-            lightest[*mat as usize] = lightest[*mat as usize].min(body.mass);
+            if body.mass < lightest[*mat as usize] {
+                lightest[*mat as usize] = body.mass;
+                lightest_radius[*mat as usize] =
+                    contact_radius(&shapes[*shape_index].0).unwrap_or(Real::INFINITY);
+            }
             let r = match &shapes[*shape_index].0 {
                 Shape::Polyhedron(p) => p.bounding_radius(),
                 Shape::Sphere(s) => s.radius(),
@@ -568,19 +857,26 @@ fn build(ctx: &Ctx, file: &SceneFile) -> Result<Simulation, SceneError> {
                 continue;
             };
             let (ma, mb) = (lightest[a], lightest[b]);
+            let (ra, rb) = (lightest_radius[a], lightest_radius[b]);
+            // (m*, R*) of each way the pair can meet; a wall or fixed body counts as flat (R* = R, the
+            // stiffest Hertz contact of that body).
             let mut candidates = Vec::new();
             if ma.is_finite() && mb.is_finite() {
-                candidates.push(ma * mb / (ma + mb));
+                candidates.push((ma * mb / (ma + mb), ra * rb / (ra + rb)));
             }
             if ma.is_finite() && has_obstacle[b] {
-                candidates.push(ma);
+                candidates.push((ma, ra));
             }
             if mb.is_finite() && has_obstacle[a] {
-                candidates.push(mb);
+                candidates.push((mb, rb));
             }
-            if let Some(m) = candidates.into_iter().reduce(Real::min) {
+            for (m, r) in candidates {
+                let model = match model.normal.radius_scaling {
+                    RadiusScaling::Constant => *model,
+                    RadiusScaling::SqrtEffectiveRadius => model.with_root_radius(r.sqrt()),
+                };
                 estimates.push(PairEstimate {
-                    model: *model,
+                    model,
                     effective_mass: m,
                 });
             }
@@ -667,13 +963,10 @@ fn build(ctx: &Ctx, file: &SceneFile) -> Result<Simulation, SceneError> {
     let mut frames = Vec::new();
     for (k, (name, shape_index, mat, body, frame, track)) in world_bodies.into_iter().enumerate() {
         let i = world
-            .add_body(name, shape_index_in_world[shape_index], mat, body)
+            .add_body(&name, shape_index_in_world[shape_index], mat, body)
             .map_err(|e| {
-                ctx.invalid(
-                    file.bodies[k].material.span(),
-                    format!("body[{k}].material"),
-                    e.to_string(),
-                )
+                let (span, field) = origins[k].clone();
+                ctx.invalid(span, field, e.to_string())
             })?;
         frames.push(frame);
         if track {

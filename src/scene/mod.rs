@@ -6,6 +6,7 @@
 //!
 //! Every error names the file, the line and the field ([`SceneError`]); reading a scene never panics.
 
+pub mod body_file;
 pub mod build;
 pub mod run;
 pub mod schema;

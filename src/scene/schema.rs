@@ -26,6 +26,10 @@ pub struct SceneFile {
     pub bodies: Vec<BodySection>,
     #[serde(default, rename = "wall")]
     pub walls: Vec<WallSection>,
+    #[serde(default, rename = "box")]
+    pub boxes: Vec<BoxSection>,
+    #[serde(default, rename = "body_file")]
+    pub body_files: Vec<BodyFileSection>,
 }
 
 /// `[simulation]`: time stepping, gravity, output.
@@ -58,6 +62,10 @@ pub struct MaterialSection {
     pub name: Spanned<String>,
     /// Density (kg/m³).
     pub density: Spanned<f64>,
+    /// Young's modulus E (Pa); required by the `hertz_mindlin` law.
+    pub young_modulus: Option<Spanned<f64>>,
+    /// Poisson's ratio ν (−1 < ν ≤ 0.5); required by the `hertz_mindlin` law.
+    pub poisson_ratio: Option<Spanned<f64>>,
 }
 
 /// `[[interaction]]`: the contact law of a pair of materials.
@@ -65,18 +73,24 @@ pub struct MaterialSection {
 #[serde(deny_unknown_fields)]
 pub struct InteractionSection {
     pub materials: Spanned<[String; 2]>,
-    /// `"linear"` (f_n = k_n δ) or `"power"` (f_n = k_n δ^n).
+    /// `"linear"` (f_n = k_n δ), `"power"` (f_n = k_n δ^n) or `"hertz_mindlin"` (from the materials' E, ν).
     pub law: Spanned<String>,
-    /// k_n (N/m^n).
-    pub normal_stiffness: Spanned<f64>,
+    /// k_n (N/m^n); linear and power laws only.
+    pub normal_stiffness: Option<Spanned<f64>>,
     /// n (power law only; 1 ≤ n ≤ 3).
     pub exponent: Option<Spanned<f64>>,
-    /// Coefficient of restitution e, 0 < e ≤ 1.
-    pub restitution: Spanned<f64>,
-    /// k_t (N/m); required when `friction` > 0.
+    /// Coefficient of restitution e, 0 < e ≤ 1; exclusive with `normal_damping`.
+    pub restitution: Option<Spanned<f64>>,
+    /// A constant normal dashpot c_n (N s/m), linear law only; exclusive with `restitution`.
+    pub normal_damping: Option<Spanned<f64>>,
+    /// k_t (N/m); linear and power laws, required when `friction` > 0.
     pub tangential_stiffness: Option<Spanned<f64>>,
     /// Coulomb friction coefficient μ ≥ 0.
     pub friction: Spanned<f64>,
+    /// `hertz_mindlin` only: tangential dashpot while sticking; absent = true (LIGGGHTS' default).
+    pub tangential_damping: Option<Spanned<bool>>,
+    /// The total normal force is never attractive; absent = false (LIGGGHTS' default).
+    pub limit_force: Option<Spanned<bool>>,
 }
 
 /// `[[shape]]`.
@@ -130,4 +144,37 @@ pub struct WallSection {
     pub normal: Spanned<Vec3>,
     /// Prescribed velocity (m/s); absent = fixed.
     pub velocity: Option<Spanned<Vec3>>,
+}
+
+/// `[[box]]`: an axis-aligned box of walls facing inwards, one wall per closed face.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BoxSection {
+    pub name: Spanned<String>,
+    pub material: Spanned<String>,
+    /// The lower corner (m).
+    pub min: Spanned<Vec3>,
+    /// The upper corner (m).
+    pub max: Spanned<Vec3>,
+    /// Faces without a wall, among `"x-"`, `"x+"`, `"y-"`, `"y+"`, `"z-"`, `"z+"`; absent = none.
+    pub open: Option<Spanned<Vec<String>>>,
+    /// One face that moves with `velocity`; absent = every face fixed.
+    pub moving_face: Option<Spanned<String>>,
+    /// Prescribed velocity of `moving_face` (m/s).
+    pub velocity: Option<Spanned<Vec3>>,
+}
+
+/// `[[body_file]]`: spherical bodies from a CSV file.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BodyFileSection {
+    /// The CSV file, relative to the scene file's directory.
+    pub path: Spanned<String>,
+    pub material: Spanned<String>,
+    /// Body names are this prefix followed by the `id` column (or the row number).
+    pub name_prefix: Spanned<String>,
+    /// `"file"` (the vx, vy, vz columns) or `"zero"`; absent = `"file"` when the columns exist.
+    pub velocities: Option<Spanned<String>>,
+    /// Write these bodies to `bodies.csv`; absent = false.
+    pub track: Option<bool>,
 }

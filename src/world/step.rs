@@ -442,6 +442,7 @@ fn evaluate_loads(
             center_b: body_b.position,
             dt,
         };
+        let model = model.for_shapes(a_body.map(|a| world.shape(a)), world.shape(b));
         let response = model.evaluate(g, &kinematics, &mut state.history);
         state.force_on_b = response.force_on_b;
         scratch.responses.push(response);
