@@ -375,13 +375,15 @@ fn build(ctx: &Ctx, file: &SceneFile) -> Result<Simulation, SceneError> {
                     tangential,
                 }
             }
-            other => return Err(ctx.invalid(
-                it.law.span(),
-                f("law"),
-                format!(
+            other => {
+                return Err(ctx.invalid(
+                    it.law.span(),
+                    f("law"),
+                    format!(
                     "unknown law '{other}' (expected \"linear\", \"power\" or \"hertz_mindlin\")"
                 ),
-            )),
+                ))
+            }
         };
         materials.set_model(ia, ib, model);
     }

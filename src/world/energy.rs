@@ -8,6 +8,8 @@
 //!   half-step velocities, as the integrator docs explain, so this is a first-order quadrature);
 //! - `dissipated_friction`: the Coulomb slip work the tangential law reports, μ F_n |Δu_slip|;
 //! - `dissipated_viscous`: global viscous damping c|v|², trapezoidal over the step;
+//! - `removed_by_sleeping`: the kinetic energy of bodies when they fell asleep (their velocities are then
+//!   set to zero, see [`super::sleeping`]); part of the balance, not a column of [`EnergyReport`];
 //! - `external_work`: the work done on the system by walls and non-dynamic bodies with a prescribed
 //!   velocity, trapezoidal over the step (P = −F_on_wall·v_wall).
 //!
@@ -28,6 +30,9 @@ pub struct EnergyLedger {
     pub dissipated_friction: Real,
     pub dissipated_viscous: Real,
     pub external_work: Real,
+    /// Kinetic energy removed when bodies fell asleep (J).
+    #[serde(default)]
+    pub removed_by_sleeping: Real,
 }
 
 /// Every term of the ledger at one instant (J).
@@ -42,7 +47,7 @@ pub struct EnergyReport {
     pub dissipated_friction: Real,
     pub dissipated_viscous: Real,
     pub external_work: Real,
-    /// E(t) + dissipated − external − E(0): zero for exact dynamics.
+    /// E(t) + dissipated (+ removed by sleeping) − external − E(0): zero for exact dynamics.
     pub balance: Real,
 }
 
@@ -121,6 +126,7 @@ impl World {
             + l.dissipated_damping
             + l.dissipated_friction
             + l.dissipated_viscous
+            + l.removed_by_sleeping
             - l.external_work
             - initial;
         report

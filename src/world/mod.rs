@@ -5,10 +5,16 @@
 //! - [`contact_store`]: per-pair state (warm start, tangential history) keyed by the ordered pair.
 //! - [`step`](mod@step): one time step, stage by stage, with timers and counters.
 //! - [`energy`]: the energy ledger that audits a run.
+//! - [`skips`]: the work a scene does not need, each skip switchable.
+//! - [`sleeping`]: freezing bodies at rest, islands, waking.
+//! - [`parallel`]: deterministic per-item parallelism of the step's stages (rayon).
 
 pub mod broad_phase;
 pub mod contact_store;
 pub mod energy;
+pub mod parallel;
+pub mod skips;
+pub mod sleeping;
 pub mod step;
 pub mod tunnelling;
 #[allow(clippy::module_inception)]
@@ -16,5 +22,8 @@ pub mod world;
 
 pub use contact_store::{ContactKey, ContactState, ContactStore};
 pub use energy::{EnergyLedger, EnergyReport};
+pub use parallel::Parallelism;
+pub use skips::Skips;
+pub use sleeping::{SleepParams, SleepState};
 pub use step::{step, StepCounters, StepError, StepParams, StepReport, StepScratch};
 pub use world::{Loads, MaterialTable, Wall, World, WorldError};

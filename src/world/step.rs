@@ -9,32 +9,39 @@
 //!   4. narrow phase      contact store synced to the candidate list; one contact query per candidate
 //!   5. laws              ContactModel::evaluate per overlapping candidate (tangential history in the store)
 //!   6. accumulate        per-body sums of forces and torques in candidate order (fixed, deterministic)
+//!  6b. (sleeping on) wake the sleeping islands touched by moving bodies or walls
 //!   7. second half kick  v, L ← v, L + ½Δt (F_{n+1}, p_{n+1})
 //!   8. checks            non-finite state → StepError naming body and step; deep overlaps → StepReport
+//!  8b. (sleeping on) calm counters, islands, bodies falling asleep (see [`super::sleeping`])
 //!   9. ledger, counters
 //! ```
 //! Forces are evaluated once per step, at the new positions x_{n+1} (stages 3–6); the same loads close this
 //! step (7) and open the next (1). The velocity-dependent parts (damping, tangential increment) see the
 //! half-step velocities, as [`crate::dynamics::integrator`] documents.
 //!
-//! Every stage runs serially in the candidate order, which is a function of the state only (the broad
-//! phase's sorted pairs, then body–wall pairs by body and wall). A parallel narrow phase and law stage can
-//! produce per-candidate results in any order as long as stage 6 sums them in this order, which keeps runs
-//! bit-identical for any thread count.
+//! The candidate order is a function of the state only (the broad phase's sorted pairs, then body–wall
+//! pairs by body and wall). Stages 4 and 5 (one query and one law evaluation per candidate) and the
+//! integration (1–2, 7; one body at a time) run on rayon's current thread pool when the scene is large
+//! enough ([`Parallelism`]); each computes a result per item into that item's own slot, and stage 6 sums
+//! the per-candidate results serially in candidate order, so a run is bit-identical for any number of
+//! threads (see [`super::parallel`]; `tests/world_parallel.rs`).
 
 use std::time::{Duration, Instant};
 
 use crate::contact::{
-    query_with, ContactError, ContactGeometry, ContactKind, ContactTolerances, EpaScratch,
-    QueryCounters,
+    query_with, ContactError, ContactGeometry, ContactKind, ContactTolerances, QueryCounters,
 };
+use crate::dynamics::translation::drift_position;
 use crate::dynamics::{Integrator, Motion, RotationScheme, TranslationParams, ViscousDamping};
-use crate::law::{ContactKinematics, ContactResponse};
+use crate::law::{ContactKinematics, ContactModel, ContactResponse, DampingLaw, TangentialLaw};
 use crate::math::{Point, Real, Vector};
 use crate::shape::Shape;
 
-use super::contact_store::ContactKey;
+use super::contact_store::{ContactKey, ContactState};
 use super::energy::viscous_power;
+use super::parallel::{for_each_chunked, for_each_item, Parallelism, Worker};
+use super::skips::{self, Skips};
+use super::sleeping::{self, SleepParams};
 use super::world::World;
 
 /// Default of [`StepParams::overlap_warning_fraction`]: 0.05. A DEM run with a stiffness that represents
@@ -56,6 +63,12 @@ pub struct StepParams {
     /// A contact whose overlap exceeds this fraction of the smaller particle's length scale (bounding
     /// diameter) is reported in [`StepReport::overlap_warnings`].
     pub overlap_warning_fraction: Real,
+    /// From which sizes the stages run on several threads (results are identical either way).
+    pub parallel: Parallelism,
+    /// Work skipped because the scene does not need it (all on by default; see [`super::skips`]).
+    pub skips: Skips,
+    /// Freezing of bodies at rest (off by default; see [`super::sleeping`]).
+    pub sleeping: SleepParams,
 }
 
 impl StepParams {
@@ -68,6 +81,9 @@ impl StepParams {
             damping: ViscousDamping::None,
             tolerances: ContactTolerances::default(),
             overlap_warning_fraction: DEFAULT_OVERLAP_WARNING_FRACTION,
+            parallel: Parallelism::default(),
+            skips: Skips::default(),
+            sleeping: SleepParams::default(),
         }
     }
 }
@@ -75,11 +91,14 @@ impl StepParams {
 /// Buffers reused between steps; nothing in them matters after a step.
 #[derive(Clone, Debug, Default)]
 pub struct StepScratch {
-    epa: EpaScratch,
     centres: Vec<Point>,
     candidates: Vec<ContactKey>,
-    geometries: Vec<ContactGeometry>,
-    responses: Vec<ContactResponse>,
+    evaluated: Vec<Evaluated>,
+    /// One per chunk of the parallel stages (see [`super::parallel`]).
+    workers: Vec<Worker>,
+    /// Union–find and island flags of the sleeping update.
+    islands: Vec<u32>,
+    ready: Vec<bool>,
 }
 
 /// Stage timers and counters of one or more steps (merge them with [`StepCounters::merge`]).
@@ -104,6 +123,12 @@ pub struct StepCounters {
     /// Contact-store entries created and dropped.
     pub contacts_created: u64,
     pub contacts_dropped: u64,
+    /// Candidates not re-evaluated because frozen (both sides asleep or fixed; see [`super::sleeping`]).
+    pub frozen_pairs: u64,
+    /// Bodies that fell asleep and that were woken; sleeping bodies summed over the steps.
+    pub fell_asleep: u64,
+    pub woken: u64,
+    pub sleeping_body_steps: u64,
     /// Narrow-phase counters (queries by kind, GJK/EPA iterations, fallbacks).
     pub query: QueryCounters,
 }
@@ -124,6 +149,10 @@ impl StepCounters {
         self.contacts += other.contacts;
         self.contacts_created += other.contacts_created;
         self.contacts_dropped += other.contacts_dropped;
+        self.frozen_pairs += other.frozen_pairs;
+        self.fell_asleep += other.fell_asleep;
+        self.woken += other.woken;
+        self.sleeping_body_steps += other.sleeping_body_steps;
         self.query.merge(&other.query);
     }
 
@@ -158,6 +187,13 @@ impl std::fmt::Display for StepCounters {
             self.contacts_created,
             self.contacts_dropped
         )?;
+        if self.frozen_pairs + self.fell_asleep + self.sleeping_body_steps > 0 {
+            writeln!(
+                f,
+                "sleeping: frozen pairs {}, bodies fell asleep {}, woken {}, sleeping body-steps {}",
+                self.frozen_pairs, self.fell_asleep, self.woken, self.sleeping_body_steps
+            )?;
+        }
         write!(f, "{}", self.query)
     }
 }
@@ -219,6 +255,13 @@ pub fn step(
         });
     }
     let mut report = StepReport::default();
+    world.sleep.resize(world.bodies.len());
+    if !params.sleeping.enabled && world.sleep.sleeping > 0 {
+        // Sleeping switched off: every body wakes.
+        report.counters.woken += world.sleep.sleeping as u64;
+        world.sleep = Default::default();
+        world.sleep.resize(world.bodies.len());
+    }
     let integrator = Integrator {
         translation: TranslationParams {
             gravity: world.gravity,
@@ -239,10 +282,26 @@ pub fn step(
 
     // 1–2. First half kick with the kept loads, drift.
     let t = Instant::now();
-    for (i, body) in world.bodies.iter_mut().enumerate() {
-        integrator.first_half_kick(body, &world.loads.forces[i], &world.loads.torques[i], dt);
-        integrator.drift(body, dt);
-    }
+    let parallel_bodies = world.bodies.len() >= params.parallel.min_bodies;
+    let (loads, asleep) = (&world.loads, &world.sleep);
+    let skip = params.skips;
+    let splitting = matches!(params.rotation, RotationScheme::Splitting { .. });
+    for_each_item(parallel_bodies, &mut world.bodies, |i, body| {
+        if asleep.is_asleep(i) || (skip.non_dynamic_pairs && is_at_rest_fixed(body)) {
+            return;
+        }
+        integrator.first_half_kick(body, &loads.forces[i], &loads.torques[i], dt);
+        if skip.still_rotation
+            && splitting
+            && body.is_dynamic()
+            && body.angular_momentum == Vector::zeros()
+        {
+            // Zero angular momentum: the rotation sub-flows are identities (see `skips`).
+            drift_position(body, dt);
+        } else {
+            integrator.drift(body, dt);
+        }
+    });
     for wall in &mut world.walls {
         wall.pose.translation.vector += dt * wall.velocity;
     }
@@ -251,17 +310,40 @@ pub fn step(
     // 3–6. Loads at the new positions.
     evaluate_loads(params, world, scratch, &mut report, dt)?;
 
+    // 6b. Sleeping islands touched by something that moves wake before the second half kick.
+    if params.sleeping.enabled {
+        report.counters.woken +=
+            sleeping::wake_touched(world, &mut scratch.islands, &mut scratch.ready);
+    }
+
     // 7. Second half kick.
     let t = Instant::now();
-    for (i, body) in world.bodies.iter_mut().enumerate() {
-        integrator.second_half_kick(body, &world.loads.forces[i], &world.loads.torques[i], dt);
-    }
+    let (loads, asleep) = (&world.loads, &world.sleep);
+    for_each_item(parallel_bodies, &mut world.bodies, |i, body| {
+        if asleep.is_asleep(i) || (skip.non_dynamic_pairs && is_at_rest_fixed(body)) {
+            return;
+        }
+        integrator.second_half_kick(body, &loads.forces[i], &loads.torques[i], dt);
+    });
     report.counters.integrate += t.elapsed();
 
     // 8. Checks.
     let t = Instant::now();
     check_finite(world)?;
     report.counters.checks += t.elapsed();
+
+    // 8b. Sleeping: calm counters, islands, falling asleep and waking (serial, in body order).
+    if params.sleeping.enabled {
+        let counts = sleeping::update(
+            &params.sleeping,
+            world,
+            &mut scratch.islands,
+            &mut scratch.ready,
+        );
+        report.counters.fell_asleep += counts.fell_asleep;
+        report.counters.woken += counts.woken;
+    }
+    report.counters.sleeping_body_steps += world.sleep.sleeping as u64;
 
     // 9. Ledger and counters.
     let viscous_end = viscous_power(world, |m| params.damping.coefficient(m));
@@ -293,12 +375,19 @@ fn evaluate_loads(
     scratch
         .centres
         .extend(world.bodies.iter().map(|b| b.position));
-    if world.broad_phase.update(&scratch.centres, &world.radii) {
+    if !params.skips.verlet_skin {
+        world.broad_phase.rebuild(&scratch.centres, &world.radii);
+        counters.broad_rebuilds += 1;
+    } else if world.broad_phase.update(&scratch.centres, &world.radii) {
         counters.broad_rebuilds += 1;
     }
     scratch.candidates.clear();
+    let skip_non_dynamic = params.skips.non_dynamic_pairs;
     for &(a, b) in world.broad_phase.pairs() {
-        if world.bodies[a as usize].is_dynamic() || world.bodies[b as usize].is_dynamic() {
+        if !skip_non_dynamic
+            || world.bodies[a as usize].is_dynamic()
+            || world.bodies[b as usize].is_dynamic()
+        {
             scratch.candidates.push(ContactKey::Body { a, b });
         }
     }
@@ -322,7 +411,7 @@ fn evaluate_loads(
     }
     counters.broad += t.elapsed();
 
-    // 4. Narrow phase.
+    // 4. Narrow phase: one query per candidate, in parallel, each writing its own store entry.
     let t = Instant::now();
     // The store is taken out of the world for stages 4–5 so that the queries can read the bodies while
     // writing the per-pair state; it is put back before any return.
@@ -330,134 +419,77 @@ fn evaluate_loads(
     let sync = contacts.sync(&scratch.candidates, step_index);
     counters.contacts_created += sync.created as u64;
     counters.contacts_dropped += sync.dropped as u64;
-    scratch.geometries.clear();
-    for (key, state) in scratch
-        .candidates
-        .iter()
-        .zip(contacts.states_mut().iter_mut())
-    {
-        let (pose_a, shape_a, pose_b, shape_b);
-        let wall_shape;
-        match *key {
-            ContactKey::Body { a, b } => {
-                pose_a = world.pose(a as usize);
-                shape_a = world.shape(a as usize);
-                pose_b = world.pose(b as usize);
-                shape_b = world.shape(b as usize);
+    let n_candidates = scratch.candidates.len();
+    let parallel = n_candidates >= params.parallel.min_candidates;
+    scratch.evaluated.clear();
+    scratch.evaluated.resize(n_candidates, Evaluated::default());
+    let world_ref: &World = world;
+    let candidates = &scratch.candidates;
+    let narrow = for_each_chunked(
+        parallel,
+        contacts.states_mut(),
+        &mut scratch.evaluated,
+        &mut scratch.workers,
+        |i, state, out, worker| {
+            if sleeping::is_frozen(world_ref, candidates[i]) {
+                out.frozen = true;
+                return Ok(());
             }
-            ContactKey::Wall { body, wall } => {
-                let wall = &world.walls[wall as usize];
-                wall_shape = Shape::Plane(wall.plane);
-                pose_a = wall.pose;
-                shape_a = &wall_shape;
-                pose_b = world.pose(body as usize);
-                shape_b = world.shape(body as usize);
-            }
-        }
-        let g = match query_with(
-            &pose_a,
-            shape_a,
-            &pose_b,
-            shape_b,
-            &params.tolerances,
-            &mut state.cache,
-            &mut scratch.epa,
-            &mut counters.query,
-        ) {
-            Ok(g) => g,
-            Err(source) => {
-                world.contacts = contacts;
-                return Err(StepError::Contact {
-                    step: step_index,
-                    source,
-                });
-            }
-        };
-        state.geometry = g;
-        scratch.geometries.push(g);
+            state.geometry = narrow_phase(params, world_ref, candidates[i], state, worker)?;
+            Ok(())
+        },
+    );
+    for worker in &mut scratch.workers {
+        counters.query.merge(&worker.query);
+        worker.query = QueryCounters::default();
+    }
+    if let Err(source) = narrow {
+        world.contacts = contacts;
+        return Err(StepError::Contact {
+            step: step_index,
+            source,
+        });
     }
     counters.narrow += t.elapsed();
 
-    // 5. Laws.
+    // 5. Laws: one evaluation per candidate, in parallel, each writing its own store entry and result slot.
     let t = Instant::now();
-    scratch.responses.clear();
+    let laws = for_each_chunked(
+        parallel,
+        contacts.states_mut(),
+        &mut scratch.evaluated,
+        &mut scratch.workers,
+        |i, state, out, _| {
+            *out = if out.frozen {
+                frozen_response(world_ref, candidates[i], state, step_index)?
+            } else {
+                contact_law(params, world_ref, candidates[i], state, dt, step_index)?
+            };
+            Ok(())
+        },
+    );
+    world.contacts = contacts;
+    laws?;
     // The report describes the state at the end of the step: an initial evaluation's findings are
-    // replaced by those of the step's own evaluation.
+    // replaced by those of the step's own evaluation. Collected in candidate order.
     report.contacts = 0;
     report.max_overlap_ratio = 0.0;
     report.overlap_warnings.clear();
-    for ((key, g), state) in scratch
-        .candidates
-        .iter()
-        .zip(&scratch.geometries)
-        .zip(contacts.states_mut().iter_mut())
-    {
-        let (a_body, a_velocity_at, mat_a, b) = match *key {
-            ContactKey::Body { a, b } => (Some(a as usize), None, world.material_of[a as usize], b),
-            ContactKey::Wall { body, wall } => {
-                let w = &world.walls[wall as usize];
-                (None, Some(w.velocity), w.material, body)
-            }
-        };
-        let b = b as usize;
-        let mat_b = world.material_of[b];
-        let Some(model) = world.materials.model(mat_a, mat_b) else {
-            world.contacts = contacts;
-            return Err(StepError::MissingLaw {
-                step: step_index,
-                a: mat_a,
-                b: mat_b,
-            });
-        };
-        if g.kind != ContactKind::Overlap {
-            // The law resets the history of a pair that does not overlap.
-            state.history = Default::default();
-            state.force_on_b = Vector::zeros();
-            scratch.responses.push(ContactResponse::default());
+    for (key, e) in scratch.candidates.iter().zip(&scratch.evaluated) {
+        counters.frozen_pairs += e.frozen as u64;
+        if !e.overlapping {
             continue;
         }
-        let body_b = &world.bodies[b];
-        let (velocity_a, center_a, effective_mass, scale) = match a_body {
-            Some(a) => {
-                let body_a = &world.bodies[a];
-                let m = match (body_a.is_dynamic(), body_b.is_dynamic()) {
-                    (true, true) => body_a.mass * body_b.mass / (body_a.mass + body_b.mass),
-                    (true, false) => body_a.mass,
-                    _ => body_b.mass,
-                };
-                let scale = world.length_scale(a).min(world.length_scale(b));
-                (body_a.velocity_at(&g.point), body_a.position, m, scale)
-            }
-            None => (
-                a_velocity_at.unwrap_or_else(Vector::zeros),
-                g.point_a,
-                body_b.mass,
-                world.length_scale(b),
-            ),
-        };
-        let kinematics = ContactKinematics {
-            relative_velocity: body_b.velocity_at(&g.point) - velocity_a,
-            effective_mass,
-            center_a,
-            center_b: body_b.position,
-            dt,
-        };
-        let model = model.for_shapes(a_body.map(|a| world.shape(a)), world.shape(b));
-        let response = model.evaluate(g, &kinematics, &mut state.history);
-        state.force_on_b = response.force_on_b;
-        scratch.responses.push(response);
         report.contacts += 1;
-        let ratio = g.depth / scale;
-        report.max_overlap_ratio = report.max_overlap_ratio.max(ratio);
-        if ratio > params.overlap_warning_fraction {
+        report.max_overlap_ratio = report.max_overlap_ratio.max(e.overlap_ratio);
+        if e.overlap_ratio > params.overlap_warning_fraction {
             report.overlap_warnings.push(OverlapWarning {
                 key: *key,
-                depth: g.depth,
-                ratio,
+                depth: e.depth,
+                ratio: e.overlap_ratio,
             });
         }
     }
-    world.contacts = contacts;
     counters.contacts += report.contacts as u64;
     counters.laws += t.elapsed();
 
@@ -474,7 +506,8 @@ fn evaluate_loads(
     loads.elastic_potential = 0.0;
     loads.damping_power = 0.0;
     loads.friction_dissipation = 0.0;
-    for (key, r) in scratch.candidates.iter().zip(&scratch.responses) {
+    for (key, e) in scratch.candidates.iter().zip(&scratch.evaluated) {
+        let r = &e.response;
         match *key {
             ContactKey::Body { a, b } => {
                 loads.forces[a as usize] -= r.force_on_b;
@@ -507,6 +540,251 @@ fn evaluate_loads(
     loads.current = true;
     counters.accumulate += t.elapsed();
     Ok(())
+}
+
+/// The result of stage 5 for one candidate.
+#[derive(Clone, Copy, Debug, Default)]
+struct Evaluated {
+    response: ContactResponse,
+    /// Whether the shapes overlap (the law produced a force).
+    overlapping: bool,
+    /// Whether the pair is frozen (kept from its last evaluation; see [`super::sleeping`]).
+    frozen: bool,
+    /// Overlap δ_M (m) and δ_M divided by the smaller particle's length scale.
+    depth: Real,
+    overlap_ratio: Real,
+}
+
+/// Stage 4 for one candidate: the contact query between its two shapes (A = body a or the wall, B = body b).
+fn narrow_phase(
+    params: &StepParams,
+    world: &World,
+    key: ContactKey,
+    state: &mut ContactState,
+    worker: &mut Worker,
+) -> Result<ContactGeometry, ContactError> {
+    let (pose_a, shape_a, pose_b, shape_b);
+    let wall_shape;
+    match key {
+        ContactKey::Body { a, b } => {
+            let (a, b) = (a as usize, b as usize);
+            shape_a = world.shape(a);
+            shape_b = world.shape(b);
+            if params.skips.bounding_spheres {
+                let scale = shape_a
+                    .length_scale()
+                    .unwrap_or(0.0)
+                    .max(shape_b.length_scale().unwrap_or(0.0));
+                if let Some(g) = skips::reject_by_bounding_spheres(
+                    &world.bodies[a].position,
+                    world.radii[a],
+                    &world.bodies[b].position,
+                    world.radii[b],
+                    scale,
+                    &params.tolerances,
+                    &mut worker.query,
+                ) {
+                    return Ok(g);
+                }
+            }
+            pose_a = world.pose(a);
+            pose_b = world.pose(b);
+            if params.skips.cached_axis {
+                if let Some((pa, pb)) = skips::polyhedra(shape_a, shape_b) {
+                    if let Some(g) = skips::reject_by_cached_axis(
+                        &pose_a,
+                        pa,
+                        &pose_b,
+                        pb,
+                        &params.tolerances,
+                        &mut state.cache,
+                        &mut worker.query,
+                    ) {
+                        return Ok(g);
+                    }
+                }
+            }
+        }
+        ContactKey::Wall { body, wall } => {
+            let wall = &world.walls[wall as usize];
+            wall_shape = Shape::Plane(wall.plane);
+            pose_a = wall.pose;
+            shape_a = &wall_shape;
+            pose_b = world.pose(body as usize);
+            shape_b = world.shape(body as usize);
+        }
+    }
+    query_with(
+        &pose_a,
+        shape_a,
+        &pose_b,
+        shape_b,
+        &params.tolerances,
+        &mut state.cache,
+        &mut worker.epa,
+        &mut worker.query,
+    )
+}
+
+/// Stage 5 for one candidate: the pair's contact model on the geometry of stage 4 (stored in `state`),
+/// updating the tangential history and the stored force.
+fn contact_law(
+    params: &StepParams,
+    world: &World,
+    key: ContactKey,
+    state: &mut ContactState,
+    dt: Real,
+    step_index: u64,
+) -> Result<Evaluated, StepError> {
+    let (a_body, a_velocity_at, mat_a, b) = match key {
+        ContactKey::Body { a, b } => (Some(a as usize), None, world.material_of[a as usize], b),
+        ContactKey::Wall { body, wall } => {
+            let w = &world.walls[wall as usize];
+            (None, Some(w.velocity), w.material, body)
+        }
+    };
+    let b = b as usize;
+    let mat_b = world.material_of[b];
+    let Some(model) = world.materials.model(mat_a, mat_b) else {
+        return Err(StepError::MissingLaw {
+            step: step_index,
+            a: mat_a,
+            b: mat_b,
+        });
+    };
+    let g = &state.geometry;
+    if g.kind != ContactKind::Overlap {
+        // The law resets the history of a pair that does not overlap.
+        state.history = Default::default();
+        state.force_on_b = Vector::zeros();
+        return Ok(Evaluated::default());
+    }
+    let body_b = &world.bodies[b];
+    let (velocity_a, center_a, effective_mass, scale) = match a_body {
+        Some(a) => {
+            let body_a = &world.bodies[a];
+            let m = match (body_a.is_dynamic(), body_b.is_dynamic()) {
+                (true, true) => body_a.mass * body_b.mass / (body_a.mass + body_b.mass),
+                (true, false) => body_a.mass,
+                _ => body_b.mass,
+            };
+            let scale = world.length_scale(a).min(world.length_scale(b));
+            (body_a.velocity_at(&g.point), body_a.position, m, scale)
+        }
+        None => (
+            a_velocity_at.unwrap_or_else(Vector::zeros),
+            g.point_a,
+            body_b.mass,
+            world.length_scale(b),
+        ),
+    };
+    let kinematics = ContactKinematics {
+        relative_velocity: body_b.velocity_at(&g.point) - velocity_a,
+        effective_mass,
+        center_a,
+        center_b: body_b.position,
+        dt,
+    };
+    let g = *g;
+    let model = model.for_shapes(a_body.map(|a| world.shape(a)), world.shape(b));
+    let model = effective_model(&model, &params.skips);
+    let response = model.evaluate(&g, &kinematics, &mut state.history);
+    state.force_on_b = response.force_on_b;
+    Ok(Evaluated {
+        response,
+        overlapping: true,
+        frozen: false,
+        depth: g.depth,
+        overlap_ratio: g.depth / scale,
+    })
+}
+
+/// The model with the slots the skips make free: no tangential spring when μ = 0, no damping term when its
+/// coefficient is 0 (see [`super::skips`]).
+fn effective_model(model: &ContactModel, skips: &Skips) -> ContactModel {
+    let mut m = *model;
+    if skips.frictionless_history && m.tangential.stiffness_and_friction(0.0).1 == 0.0 {
+        m.tangential = TangentialLaw::None;
+    }
+    if skips.undamped_contacts {
+        if let DampingLaw::Viscous { coefficient } | DampingLaw::Dashpot { coefficient } = m.damping
+        {
+            if coefficient == 0.0 {
+                m.damping = DampingLaw::None;
+            }
+        }
+    }
+    m
+}
+
+/// A fixed body whose velocities are already zero: integrating it changes nothing.
+fn is_at_rest_fixed(body: &crate::dynamics::RigidBody) -> bool {
+    matches!(body.motion, Motion::Fixed)
+        && body.velocity == Vector::zeros()
+        && body.angular_momentum == Vector::zeros()
+}
+
+/// Stage 5 for a frozen candidate: the kept geometry and force of its last evaluation, the torques about
+/// the unmoved centres and the elastic energy at the kept overlap (see [`super::sleeping`]).
+fn frozen_response(
+    world: &World,
+    key: ContactKey,
+    state: &ContactState,
+    step_index: u64,
+) -> Result<Evaluated, StepError> {
+    let g = &state.geometry;
+    if g.kind != ContactKind::Overlap {
+        return Ok(Evaluated {
+            frozen: true,
+            ..Evaluated::default()
+        });
+    }
+    let (center_a, mat_a, b) = match key {
+        ContactKey::Body { a, b } => (
+            world.bodies[a as usize].position,
+            world.material_of[a as usize],
+            b,
+        ),
+        ContactKey::Wall { body, wall } => (g.point_a, world.walls[wall as usize].material, body),
+    };
+    let b = b as usize;
+    let mat_b = world.material_of[b];
+    let Some(model) = world.materials.model(mat_a, mat_b) else {
+        return Err(StepError::MissingLaw {
+            step: step_index,
+            a: mat_a,
+            b: mat_b,
+        });
+    };
+    let shape_a = match key {
+        ContactKey::Body { a, .. } => Some(world.shape(a as usize)),
+        ContactKey::Wall { .. } => None,
+    };
+    let model = model.for_shapes(shape_a, world.shape(b));
+    let force = state.force_on_b;
+    let (k_t, _) = model.tangential.stiffness_and_friction(g.depth);
+    let scale = match key {
+        ContactKey::Body { a, .. } => world.length_scale(a as usize).min(world.length_scale(b)),
+        ContactKey::Wall { .. } => world.length_scale(b),
+    };
+    Ok(Evaluated {
+        response: ContactResponse {
+            force_on_b: force,
+            torque_on_a: (g.point - center_a).cross(&(-force)),
+            torque_on_b: (g.point - world.bodies[b].position).cross(&force),
+            normal_force: force.dot(&g.normal),
+            tangential_force: force - g.normal * force.dot(&g.normal),
+            normal_potential: model.normal.potential(g.depth),
+            tangential_potential: 0.5 * k_t * state.history.displacement.norm_squared(),
+            damping_power: 0.0,
+            friction_dissipation: 0.0,
+            sliding: false,
+        },
+        overlapping: true,
+        frozen: true,
+        depth: g.depth,
+        overlap_ratio: g.depth / scale,
+    })
 }
 
 /// Stage 8: every dynamic body's state and loads are finite.

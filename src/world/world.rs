@@ -21,6 +21,7 @@ use crate::shape::{Plane, Shape};
 use super::broad_phase::BroadPhase;
 use super::contact_store::ContactStore;
 use super::energy::EnergyLedger;
+use super::sleeping::SleepState;
 
 /// Why a body, wall or material could not be added.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -165,6 +166,8 @@ pub struct World {
     pub broad_phase: BroadPhase,
     pub loads: Loads,
     pub ledger: EnergyLedger,
+    /// Which bodies are asleep (see [`super::sleeping`]); empty until the first step.
+    pub sleep: SleepState,
     /// Simulated time (s) and completed steps.
     pub time: Real,
     pub step_index: u64,
@@ -187,6 +190,7 @@ impl World {
             broad_phase: BroadPhase::new(skin),
             loads: Loads::default(),
             ledger: EnergyLedger::default(),
+            sleep: SleepState::default(),
             time: 0.0,
             step_index: 0,
         }
