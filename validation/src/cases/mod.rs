@@ -12,6 +12,8 @@ pub mod restitution;
 pub mod single_contact_energy;
 pub mod stress_impact;
 pub mod stress_long_run;
+pub mod stress_shapes;
+pub mod stress_time_step;
 pub mod stress_util;
 
 /// Every case of the suite, in the order they run.
@@ -25,6 +27,8 @@ pub fn registry() -> Vec<&'static dyn Case> {
         &friction::Friction,
         &stress_long_run::StressLongRun,
         &stress_impact::StressImpact,
+        &stress_shapes::StressShapes,
+        &stress_time_step::StressTimeStep,
         &perf::Perf,
     ]
 }
