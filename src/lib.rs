@@ -19,6 +19,7 @@ pub mod dynamics;
 pub mod io;
 pub mod law;
 pub mod math;
+pub mod rockfill;
 pub mod scene;
 pub mod shape;
 pub mod special_functions;

@@ -7,6 +7,7 @@
 //! - `polydem run SCENE --out DIR`: runs a scene file (format in `docs/scene-format.md`) and writes
 //!   `DIR/bodies.csv`, `DIR/energy.csv`, `DIR/walls.csv` and `DIR/summary.txt`; the summary is also printed. A progress bar
 //!   is drawn on standard error when it is a terminal.
+//! - `polydem rockfill [--full] [--out DIR] …`: the paper's rockfill experiment (`polydem::rockfill::cli`).
 
 use std::fs::File;
 use std::io::{self, BufReader, BufWriter, Write};
@@ -47,12 +48,15 @@ enum Command {
         #[arg(long)]
         out: PathBuf,
     },
+    /// The paper's rockfill penetration experiment (quick variant by default; see `--help`).
+    Rockfill(polydem::rockfill::cli::RockfillArgs),
 }
 
 fn main() -> Result<()> {
     match Cli::parse().command {
         Command::Contact { pairs, out } => contact(&pairs, out.as_deref()),
         Command::Run { scene, out } => run(&scene, &out),
+        Command::Rockfill(args) => polydem::rockfill::cli::run(&args),
     }
 }
 

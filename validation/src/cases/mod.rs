@@ -9,7 +9,9 @@ pub mod friction;
 pub mod perf;
 pub mod precession;
 pub mod restitution;
+pub mod rockfill;
 pub mod single_contact_energy;
+pub mod sphere_bed;
 pub mod stress_impact;
 pub mod stress_long_run;
 pub mod stress_shapes;
@@ -25,6 +27,8 @@ pub fn registry() -> Vec<&'static dyn Case> {
         &restitution::Restitution,
         &chung_ooi::ChungOoi,
         &friction::Friction,
+        &rockfill::Rockfill,
+        &sphere_bed::SphereBed,
         &stress_long_run::StressLongRun,
         &stress_impact::StressImpact,
         &stress_shapes::StressShapes,

@@ -1,0 +1,291 @@
+//! The experiment's parameters as data: Table 1's contact parameters, the rock, layer, packing, impact and
+//! projectile sections of a TOML file (`scenes/rockfill/paper.toml` is the full-scale experiment with the
+//! source of every value; `scenes/rockfill/quick.toml` the scaled quick variant). Every field is required
+//! (no silent defaults for physical constants) and unknown fields are refused.
+//!
+//! [`ExperimentConfig::contact_models`] turns Table 1 into the engine's slot-composed laws: linear normal
+//! law f_n = k_n δ, restitution damping for e_r (rock–rock, rock–wall) and e_b (rock–projectile), constant
+//! tangential spring k_s with Coulomb cap f.
+
+use std::path::Path;
+
+use super::projectile::ProjectileParams;
+use crate::law::{ContactModel, DampingLaw, LawError, NormalLaw, TangentialLaw};
+use crate::math::Real;
+
+/// Why a configuration was refused.
+#[derive(Debug, thiserror::Error)]
+pub enum ConfigError {
+    #[error("{path}: {source}")]
+    Io {
+        path: String,
+        #[source]
+        source: std::io::Error,
+    },
+    #[error("{path}: {message}")]
+    Parse { path: String, message: String },
+    #[error("{path}: {field} = {value} is invalid: {reason}")]
+    Invalid {
+        path: String,
+        field: &'static str,
+        value: Real,
+        reason: &'static str,
+    },
+    #[error("contact law: {0}")]
+    Law(#[from] LawError),
+}
+
+/// Table 1 of the paper.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Deserialize, serde::Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct ContactParams {
+    /// k_n (N/m), linear normal law.
+    pub normal_stiffness: Real,
+    /// k_s (N/m).
+    pub tangential_stiffness: Real,
+    /// Coefficient of friction f.
+    pub friction: Real,
+    /// e_r: rock–rock (and rock–wall).
+    pub restitution_rocks: Real,
+    /// e_b: rock–projectile.
+    pub restitution_projectile: Real,
+}
+
+/// The rocks.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Deserialize, serde::Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct RockParams {
+    /// kg/m³.
+    pub density: Real,
+    /// Mean size (m).
+    pub mean_size: Real,
+    pub sigma_fraction: Real,
+    pub range_fraction: Real,
+    pub seed: u64,
+}
+
+/// The layer: x along the flight path from the left face at x = 0, y across, z up from the floor.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Deserialize, serde::Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct LayerParams {
+    pub length: Real,
+    pub width: Real,
+    pub height: Real,
+}
+
+/// Deposition and compaction.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Deserialize, serde::Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct PackingParams {
+    /// Height of the region the rocks are generated in, over the layer height.
+    pub generation_height_factor: Real,
+    /// Δt = t_c,min / steps_per_contact.
+    pub steps_per_contact: Real,
+    /// Global mass-proportional damping rate α (1/s) during deposition and compaction.
+    pub viscous_rate: Real,
+    /// Deposition ends when every rock is slower than this (m/s).
+    pub settle_speed: Real,
+    pub max_deposition_time: Real,
+    /// Speed of the top wall during compaction (m/s).
+    pub compaction_speed: Real,
+    /// Pressure (Pa) at which the top wall's servo stops it (see [`super::packing`]).
+    pub compaction_pressure: Real,
+    /// Time with the top wall stopped after compaction (s).
+    pub hold_time: Real,
+}
+
+/// The impact.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Deserialize, serde::Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct ImpactParams {
+    /// m/s.
+    pub speed: Real,
+    /// Time at which the tip reaches the left face (s).
+    pub arrival_time: Real,
+    /// Run length limit (s).
+    pub max_time: Real,
+    /// Projectile travel per step over the mean rock size.
+    pub travel_per_step: Real,
+    /// A rock is disturbed when its displacement exceeds this fraction of the mean size.
+    pub disturbed_threshold: Real,
+}
+
+/// Everything the experiment needs.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Deserialize, serde::Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct ExperimentConfig {
+    pub contact: ContactParams,
+    pub rock: RockParams,
+    pub layer: LayerParams,
+    pub packing: PackingParams,
+    pub impact: ImpactParams,
+    pub projectile: ProjectileParams,
+}
+
+/// The full-scale experiment (the file `scenes/rockfill/paper.toml`, compiled in).
+pub const PAPER_TOML: &str = include_str!("../../scenes/rockfill/paper.toml");
+/// The quick variant (the file `scenes/rockfill/quick.toml`, compiled in).
+pub const QUICK_TOML: &str = include_str!("../../scenes/rockfill/quick.toml");
+
+/// The contact models of the experiment.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ContactModels {
+    /// Rock–rock, rock–wall (and projectile–wall, which does not occur in the run).
+    pub rocks: ContactModel,
+    /// Rock–projectile.
+    pub projectile: ContactModel,
+}
+
+impl ExperimentConfig {
+    /// Parses and checks a configuration; `path` names the source in errors.
+    pub fn parse(source: &str, path: &str) -> Result<Self, ConfigError> {
+        let config: Self = toml::from_str(source).map_err(|e| ConfigError::Parse {
+            path: path.to_owned(),
+            message: e.to_string(),
+        })?;
+        config.check(path)?;
+        Ok(config)
+    }
+
+    /// Reads a configuration file.
+    pub fn load(path: &Path) -> Result<Self, ConfigError> {
+        let name = path.display().to_string();
+        let source = std::fs::read_to_string(path).map_err(|source| ConfigError::Io {
+            path: name.clone(),
+            source,
+        })?;
+        Self::parse(&source, &name)
+    }
+
+    /// The compiled-in full-scale experiment.
+    pub fn paper() -> Self {
+        Self::parse(PAPER_TOML, "scenes/rockfill/paper.toml").expect("the shipped file is valid")
+    }
+
+    /// The compiled-in quick variant.
+    pub fn quick() -> Self {
+        Self::parse(QUICK_TOML, "scenes/rockfill/quick.toml").expect("the shipped file is valid")
+    }
+
+    fn check(&self, path: &str) -> Result<(), ConfigError> {
+        let positive = [
+            ("rock.density", self.rock.density),
+            ("rock.mean_size", self.rock.mean_size),
+            ("layer.length", self.layer.length),
+            ("layer.width", self.layer.width),
+            ("layer.height", self.layer.height),
+            (
+                "packing.generation_height_factor",
+                self.packing.generation_height_factor,
+            ),
+            ("packing.steps_per_contact", self.packing.steps_per_contact),
+            ("packing.settle_speed", self.packing.settle_speed),
+            (
+                "packing.max_deposition_time",
+                self.packing.max_deposition_time,
+            ),
+            ("packing.compaction_speed", self.packing.compaction_speed),
+            (
+                "packing.compaction_pressure",
+                self.packing.compaction_pressure,
+            ),
+            ("impact.speed", self.impact.speed),
+            ("impact.max_time", self.impact.max_time),
+            ("impact.travel_per_step", self.impact.travel_per_step),
+            (
+                "impact.disturbed_threshold",
+                self.impact.disturbed_threshold,
+            ),
+        ];
+        let non_negative = [
+            ("packing.viscous_rate", self.packing.viscous_rate),
+            ("packing.hold_time", self.packing.hold_time),
+            ("impact.arrival_time", self.impact.arrival_time),
+        ];
+        let invalid = |field, value, reason| ConfigError::Invalid {
+            path: path.to_owned(),
+            field,
+            value,
+            reason,
+        };
+        for (field, value) in positive {
+            if !(value.is_finite() && value > 0.0) {
+                return Err(invalid(field, value, "must be finite and positive"));
+            }
+        }
+        for (field, value) in non_negative {
+            if !(value.is_finite() && value >= 0.0) {
+                return Err(invalid(field, value, "must be finite and non-negative"));
+            }
+        }
+        if self.packing.generation_height_factor < 1.0 {
+            return Err(invalid(
+                "packing.generation_height_factor",
+                self.packing.generation_height_factor,
+                "must be at least 1 (rocks are generated above the layer and fall into it)",
+            ));
+        }
+        self.contact_models()?;
+        Ok(())
+    }
+
+    /// Table 1 as the engine's laws (see the module docs).
+    pub fn contact_models(&self) -> Result<ContactModels, ConfigError> {
+        let c = &self.contact;
+        let normal = NormalLaw::linear(c.normal_stiffness)?;
+        let tangential = TangentialLaw::spring(c.tangential_stiffness, c.friction)?;
+        Ok(ContactModels {
+            rocks: ContactModel {
+                normal,
+                damping: DampingLaw::from_restitution(1.0, c.restitution_rocks)?,
+                tangential,
+            },
+            projectile: ContactModel {
+                normal,
+                damping: DampingLaw::from_restitution(1.0, c.restitution_projectile)?,
+                tangential,
+            },
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn shipped_files_parse_and_carry_table_1() {
+        let p = ExperimentConfig::paper();
+        assert_eq!(
+            (
+                p.contact.normal_stiffness,
+                p.contact.tangential_stiffness,
+                p.contact.friction
+            ),
+            (2.0e7, 1.0e7, 0.2)
+        );
+        assert_eq!(
+            (
+                p.contact.restitution_rocks,
+                p.contact.restitution_projectile
+            ),
+            (0.4, 0.99)
+        );
+        let q = ExperimentConfig::quick();
+        assert_eq!(q.contact, p.contact, "the quick variant keeps Table 1");
+    }
+
+    #[test]
+    fn unknown_and_invalid_fields_are_refused() {
+        let bad = PAPER_TOML.replace("friction = 0.2", "friction = 0.2\nfriction_typo = 1");
+        assert!(matches!(
+            ExperimentConfig::parse(&bad, "x"),
+            Err(ConfigError::Parse { .. })
+        ));
+        let bad = PAPER_TOML.replace("density = 2650.0", "density = -1.0");
+        assert!(matches!(
+            ExperimentConfig::parse(&bad, "x"),
+            Err(ConfigError::Invalid { .. })
+        ));
+    }
+}

@@ -1,0 +1,154 @@
+//! The experiment end to end: generate the sample, pack it (or load a packed bed), run the impact.
+
+use std::path::Path;
+use std::time::Duration;
+
+use super::config::ExperimentConfig;
+use super::generation::{generate, GenerationError, GenerationParams, Sample};
+use super::packing::{load_bed, loose_world, pack, save_bed, PackingError, PackingReport};
+use super::penetration::{
+    add_projectile, penetrate, MonitorRow, PenetrationError, PenetrationReport,
+};
+use super::projectile::{Projectile, ProjectileError};
+use super::seeds::{Region, SeedError};
+use super::statistics::{sample_statistics, SampleStatistics};
+use crate::math::{Point, Real};
+
+/// Why the experiment failed.
+#[derive(Debug, thiserror::Error)]
+pub enum ExperimentError {
+    #[error(transparent)]
+    Seeds(#[from] SeedError),
+    #[error(transparent)]
+    Generation(#[from] GenerationError),
+    #[error(transparent)]
+    Projectile(#[from] ProjectileError),
+    #[error(transparent)]
+    Packing(#[from] PackingError),
+    #[error(transparent)]
+    Penetration(#[from] PenetrationError),
+}
+
+/// Where the bed comes from.
+#[derive(Clone, Copy, Debug)]
+pub enum BedSource<'a> {
+    /// Generate and pack; save the packed bed into the directory if one is given.
+    Generate { save: Option<&'a Path> },
+    /// Load a bed saved earlier.
+    Load(&'a Path),
+}
+
+/// Generation facts (absent when the bed was loaded).
+#[derive(Clone, Debug)]
+pub struct GenerationSummary {
+    pub seeds: usize,
+    pub rocks: usize,
+    pub dropped_small_cells: usize,
+    pub cell_radius: Real,
+    pub statistics: SampleStatistics,
+    /// Mean and standard deviation of the size law eq. 29 samples (m).
+    pub requested_mean: Real,
+    pub requested_std: Real,
+    pub wall_time: Duration,
+}
+
+/// Everything the experiment measured.
+#[derive(Clone, Debug)]
+pub struct ExperimentResult {
+    pub generation: Option<GenerationSummary>,
+    pub packing: Option<PackingReport>,
+    pub projectile: Projectile,
+    pub penetration: PenetrationReport,
+}
+
+/// Progress messages: (stage, text).
+pub type Progress<'a> = &'a mut dyn FnMut(&str, String);
+
+/// Generates the graded sample of `config` in the region above the layer (x ∈ [0, L], y ∈ [0, W],
+/// z ∈ [0, H · generation_height_factor]).
+pub fn generate_sample(config: &ExperimentConfig) -> Result<Sample, ExperimentError> {
+    let l = &config.layer;
+    let region = Region::new(
+        Point::origin(),
+        Point::new(
+            l.length,
+            l.width,
+            l.height * config.packing.generation_height_factor,
+        ),
+    )?;
+    let mut params = GenerationParams::new(region, config.rock.mean_size, config.rock.seed);
+    params.sigma_fraction = config.rock.sigma_fraction;
+    params.range_fraction = config.rock.range_fraction;
+    Ok(generate(&params)?)
+}
+
+/// Runs the experiment (see the module docs).
+pub fn run_experiment(
+    config: &ExperimentConfig,
+    bed: BedSource,
+    progress: Progress,
+) -> Result<ExperimentResult, ExperimentError> {
+    let projectile = Projectile::new(config.projectile)?;
+    let (mut world, generation, packing) = match bed {
+        BedSource::Load(dir) => (load_bed(config, dir)?, None, None),
+        BedSource::Generate { save } => {
+            let start = std::time::Instant::now();
+            let sample = generate_sample(config)?;
+            let (requested_mean, var) = sample.sizes.bin_mean_and_variance();
+            let generation = GenerationSummary {
+                seeds: sample.seeds,
+                rocks: sample.rocks.len(),
+                dropped_small_cells: sample.grading.dropped_small_cells,
+                cell_radius: sample.cell_radius,
+                statistics: sample_statistics(&sample.rocks),
+                requested_mean,
+                requested_std: var.sqrt(),
+                wall_time: start.elapsed(),
+            };
+            progress(
+                "generation",
+                format!(
+                    "{} seeds, {} rocks ({} cells too small), {:.2} s",
+                    generation.seeds,
+                    generation.rocks,
+                    generation.dropped_small_cells,
+                    generation.wall_time.as_secs_f64()
+                ),
+            );
+            let top = config.layer.height * config.packing.generation_height_factor;
+            let mut world = loose_world(config, &sample.rocks, top)?;
+            let packing = pack(config, &mut world, |stage, t, h| {
+                progress(stage, format!("t = {t:.3} s, height {h:.3} m"))
+            })?;
+            if let Some(dir) = save {
+                save_bed(&world, dir)?;
+            }
+            (world, Some(generation), Some(packing))
+        }
+    };
+    let index = add_projectile(config, &mut world, &projectile)?;
+    let penetration = penetrate(
+        config,
+        &mut world,
+        &projectile,
+        index,
+        |row: &MonitorRow| {
+            progress(
+                "penetration",
+                format!(
+                    "t = {:.3} ms, x = {:.3} m, v = {:.1} m/s, contacts {}",
+                    row.time * 1e3,
+                    row.position.x,
+                    row.velocity.norm(),
+                    row.contacts
+                ),
+            )
+        },
+    )?;
+    Ok(ExperimentResult {
+        generation,
+        packing,
+        projectile,
+        penetration,
+    })
+}

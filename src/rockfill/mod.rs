@@ -1,0 +1,29 @@
+//! The paper's experiment (Zhao, Feng et al. 2021, section 4): a graded Voronoi rockfill, packed under gravity
+//! and compacted, struck by an ogive-nosed projectile at 1200 m/s.
+//!
+//! One concept per file:
+//! - [`seeds`]: the seed count of eq. 28 and uniform random seeds in a box;
+//! - [`voronoi`]: the 3D Voronoi cells of the seeds (voro++ through `voro_rs`);
+//! - [`grading`]: eq. 29's shrinking of each cell toward its seed to a graded rock;
+//! - [`generation`]: the three above end to end;
+//! - [`statistics`]: realised size distribution and shape statistics;
+//! - [`projectile`]: the ogive-nosed projectile with its internal cavity (mass properties solid − cavity);
+//! - [`config`]: the experiment's parameters as data (Table 1 and what the paper does not state), the laws;
+//! - [`packing`]: the container, deposition under gravity, compaction by a moving top wall, hold, bed file;
+//! - [`penetration`]: the impact run and its monitors (velocity, resistance, deflection, disturbed zone);
+//! - [`experiment`]: generation → packing (or a saved bed) → penetration;
+//! - [`cli`]: the `polydem rockfill` subcommand.
+
+pub mod cli;
+pub mod config;
+pub mod experiment;
+pub mod generation;
+pub mod grading;
+pub mod packing;
+pub mod penetration;
+pub mod projectile;
+pub mod seeds;
+pub mod statistics;
+pub mod voronoi;
+
+pub use generation::{generate, GenerationError, GenerationParams, Sample};
