@@ -95,3 +95,244 @@ fn run_of_a_bad_scene_fails_naming_the_file() {
     );
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+fn polydem(args: &[&std::ffi::OsStr]) -> std::process::Output {
+    Command::new(env!("CARGO_BIN_EXE_polydem"))
+        .args(args)
+        .output()
+        .expect("polydem runs")
+}
+
+fn scene_path(name: &str) -> std::path::PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("scenes")
+        .join(name)
+}
+
+/// Runs `polydem run` with `args`, expects failure without a panic, returns standard error.
+fn fails(args: &[&std::ffi::OsStr]) -> String {
+    let output = polydem(args);
+    let stderr = String::from_utf8_lossy(&output.stderr).into_owned();
+    assert!(
+        !output.status.success(),
+        "polydem {args:?} succeeded; stderr: {stderr}"
+    );
+    assert!(
+        !stderr.contains("panicked"),
+        "polydem {args:?} panicked: {stderr}"
+    );
+    stderr
+}
+
+#[test]
+fn bad_input_fails_with_a_message_naming_what_is_wrong() {
+    let dir = out_dir("bad_input");
+    std::fs::create_dir_all(&dir).unwrap();
+    let os = |s: &str| std::ffi::OsString::from(s);
+    let scene = scene_path("cube_drop.toml");
+    let out = dir.join("out");
+
+    // A missing scene file.
+    let missing = dir.join("no_such_scene.toml");
+    let err = fails(&[
+        &os("run"),
+        missing.as_os_str(),
+        &os("--out"),
+        out.as_os_str(),
+    ]);
+    assert!(
+        err.contains(&missing.display().to_string()) && err.contains("cannot read the scene file"),
+        "{err}"
+    );
+
+    // An output directory that cannot be created (its parent is a regular file).
+    let file = dir.join("a_file");
+    std::fs::write(&file, "x").unwrap();
+    let bad_out = file.join("out");
+    let err = fails(&[
+        &os("run"),
+        scene.as_os_str(),
+        &os("--out"),
+        bad_out.as_os_str(),
+    ]);
+    assert!(
+        err.contains("cannot create output directory")
+            && err.contains(&bad_out.display().to_string()),
+        "{err}"
+    );
+
+    // Bad restart files: missing, foreign, truncated.
+    let err = fails(&[
+        &os("run"),
+        &os("--restart"),
+        missing.as_os_str(),
+        &os("--out"),
+        out.as_os_str(),
+    ]);
+    assert!(
+        err.contains("cannot restart from checkpoint") && err.contains("no_such_scene"),
+        "{err}"
+    );
+    let err = fails(&[
+        &os("run"),
+        &os("--restart"),
+        scene.as_os_str(),
+        &os("--out"),
+        out.as_os_str(),
+    ]);
+    assert!(err.contains("not a polydem checkpoint"), "{err}");
+    let sim = polydem::scene::load_scene(&scene).unwrap();
+    let bytes = polydem::io::checkpoint::encode(&sim).unwrap();
+    let cut = dir.join("cut.pdck");
+    std::fs::write(&cut, &bytes[..bytes.len() / 2]).unwrap();
+    let err = fails(&[
+        &os("run"),
+        &os("--restart"),
+        cut.as_os_str(),
+        &os("--out"),
+        out.as_os_str(),
+    ]);
+    assert!(
+        err.contains("truncated checkpoint") && err.contains("cut.pdck"),
+        "{err}"
+    );
+
+    // Non-positive or non-finite intervals and end times.
+    for (flag, value) in [
+        ("--vtk-interval", "0"),
+        ("--vtk-interval", "NaN"),
+        ("--checkpoint-interval", "-1"),
+        ("--end-time", "-2"),
+        ("--end-time", "inf"),
+    ] {
+        let err = fails(&[
+            &os("run"),
+            scene.as_os_str(),
+            &os("--out"),
+            out.as_os_str(),
+            &os(flag),
+            &os(value),
+        ]);
+        assert!(
+            err.contains(flag) || err.contains("end time"),
+            "{flag} {value}: {err}"
+        );
+    }
+    // A scene and --restart together, or neither.
+    let err = fails(&[
+        &os("run"),
+        scene.as_os_str(),
+        &os("--restart"),
+        cut.as_os_str(),
+        &os("--out"),
+        out.as_os_str(),
+    ]);
+    assert!(err.contains("--restart"), "{err}");
+    let err = fails(&[&os("run"), &os("--out"), out.as_os_str()]);
+    assert!(err.contains("SCENE") || err.contains("scene"), "{err}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// The CLI path of a restart: a run to t = 2T with a checkpoint at T, restarted from it, ends with the same
+/// last rows in bodies.csv and energy.csv as the straight run; summary.json says what happened.
+#[test]
+fn restart_through_the_cli_continues_to_the_same_final_rows() {
+    let dir = out_dir("restart");
+    let scene = scene_path("settling_box.toml");
+    let os = |s: &str| std::ffi::OsString::from(s);
+    let straight = dir.join("straight");
+    let first = dir.join("first");
+    let second = dir.join("second");
+    let run = |args: &[&std::ffi::OsStr]| {
+        let o = polydem(args);
+        assert!(
+            o.status.success(),
+            "{args:?}: {}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+        o
+    };
+    run(&[
+        &os("run"),
+        scene.as_os_str(),
+        &os("--out"),
+        straight.as_os_str(),
+        &os("--end-time"),
+        &os("0.2"),
+        &os("--quiet"),
+    ]);
+    run(&[
+        &os("run"),
+        scene.as_os_str(),
+        &os("--out"),
+        first.as_os_str(),
+        &os("--end-time"),
+        &os("0.1"),
+        &os("--checkpoint-interval"),
+        &os("0.1"),
+        &os("--vtk-interval"),
+        &os("0.05"),
+        &os("--quiet"),
+    ]);
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(first.join("summary.json")).unwrap())
+            .unwrap();
+    let checkpoints = summary["outputs"]["checkpoints"]
+        .as_array()
+        .expect("checkpoint list");
+    assert_eq!(checkpoints.len(), 1, "{summary}");
+    let file = first.join(checkpoints[0]["file"].as_str().unwrap());
+    assert!(first.join("polyhedra.pvd").exists() && first.join("walls.pvd").exists());
+    let output = run(&[
+        &os("run"),
+        &os("--restart"),
+        file.as_os_str(),
+        &os("--out"),
+        second.as_os_str(),
+        &os("--end-time"),
+        &os("0.2"),
+        &os("--quiet"),
+    ]);
+    assert!(
+        output.stderr.is_empty(),
+        "--quiet: {}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    for csv in ["bodies.csv", "energy.csv", "walls.csv"] {
+        let a = std::fs::read_to_string(straight.join(csv)).unwrap();
+        let b = std::fs::read_to_string(second.join(csv)).unwrap();
+        let tail = |s: &str, n: usize| {
+            s.lines()
+                .rev()
+                .take(n)
+                .map(str::to_owned)
+                .collect::<Vec<_>>()
+        };
+        assert_eq!(tail(&a, 5), tail(&b, 5), "last rows of {csv}");
+    }
+    let s2: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(second.join("summary.json")).unwrap())
+            .unwrap();
+    assert_eq!(s2["restarted"], true);
+    assert_eq!(s2["start_step"], checkpoints[0]["step"]);
+    let s1: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(straight.join("summary.json")).unwrap())
+            .unwrap();
+    assert_eq!(s2["end_step"], s1["end_step"]);
+    assert_eq!(s2["energy"], s1["energy"], "final energy ledger");
+    for key in [
+        "broad",
+        "narrow",
+        "laws",
+        "accumulate",
+        "integrate",
+        "checks",
+        "output",
+    ] {
+        assert!(
+            s1["stage_seconds"][key].is_f64(),
+            "stage_seconds.{key} in {s1}"
+        );
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -4,16 +4,20 @@
 //! - `polydem contact PAIRS.jsonl [--out FILE]`: the contact contract (format in `docs/contact-jsonl.md`):
 //!   one JSON object per input line with two point clouds, one answer (or error record) per line.
 //!   `-` reads standard input; output goes to standard output unless `--out` is given.
-//! - `polydem run SCENE --out DIR`: runs a scene file (format in `docs/scene-format.md`) and writes
-//!   `DIR/bodies.csv`, `DIR/energy.csv`, `DIR/walls.csv` and `DIR/summary.txt`; the summary is also printed. A progress bar
-//!   is drawn on standard error when it is a terminal.
+//! - `polydem run SCENE --out DIR [--vtk-interval T] [--checkpoint-interval T] [--end-time T] [--quiet]`:
+//!   runs a scene file (format in `docs/scene-format.md`) and writes `DIR/bodies.csv`, `DIR/energy.csv`,
+//!   `DIR/walls.csv`, VTK frames with `.pvd` collections, checkpoints in `DIR/checkpoints/`, and the run
+//!   summary `DIR/summary.txt` (also printed) and `DIR/summary.json` (formats in `docs/output-formats.md`
+//!   and `docs/checkpoint-format.md`). A progress bar with rates and ETA is drawn on standard error when it is
+//!   a terminal, unless `--quiet`.
+//! - `polydem run --restart FILE --out DIR [--end-time T] ...`: continues a checkpoint bit for bit.
 //! - `polydem rockfill [--full] [--out DIR] …`: the paper's rockfill experiment (`polydem::rockfill::cli`).
 
 use std::fs::File;
 use std::io::{self, BufReader, BufWriter, Write};
 use std::path::PathBuf;
 
-use anyhow::{Context, Result};
+use anyhow::{bail, Context, Result};
 use clap::{Parser, Subcommand};
 
 use polydem::contact::query_polyhedra;
@@ -40,23 +44,37 @@ enum Command {
         #[arg(long)]
         out: Option<PathBuf>,
     },
-    /// Run a scene file and write CSV time series (bodies, energy ledger) and a run summary.
-    Run {
-        /// The scene file (TOML).
-        scene: PathBuf,
-        /// Output directory (created if missing).
-        #[arg(long)]
-        out: PathBuf,
-    },
+    /// Run a scene file (or continue a checkpoint) and write CSV time series, optional VTK frames and
+    /// checkpoints, and a run summary.
+    Run(RunArgs),
     /// The paper's rockfill penetration experiment (quick variant by default; see `--help`).
     Rockfill(polydem::rockfill::cli::RockfillArgs),
 }
 
-fn main() -> Result<()> {
-    match Cli::parse().command {
+fn main() -> std::process::ExitCode {
+    let result = match Cli::parse().command {
         Command::Contact { pairs, out } => contact(&pairs, out.as_deref()),
-        Command::Run { scene, out } => run(&scene, &out),
+        Command::Run(args) => run(&args),
         Command::Rockfill(args) => polydem::rockfill::cli::run(&args),
+    };
+    match result {
+        Ok(()) => std::process::ExitCode::SUCCESS,
+        Err(e) => {
+            // The whole chain on one line ("what failed: why"), without a backtrace: these are user errors.
+            // A cause that its parent's message already quotes is not repeated.
+            let mut line = String::new();
+            for cause in e.chain() {
+                let text = cause.to_string();
+                if !line.contains(&text) {
+                    if !line.is_empty() {
+                        line.push_str(": ");
+                    }
+                    line.push_str(&text);
+                }
+            }
+            eprintln!("error: {line}");
+            std::process::ExitCode::FAILURE
+        }
     }
 }
 
@@ -85,9 +103,75 @@ fn contact(pairs: &std::path::Path, out: Option<&std::path::Path>) -> Result<()>
     Ok(())
 }
 
-fn run(scene: &std::path::Path, out_dir: &std::path::Path) -> Result<()> {
-    use polydem::io::csv_output;
-    let mut sim = polydem::scene::load_scene(scene)?;
+/// Options of `polydem run`.
+#[derive(clap::Args)]
+struct RunArgs {
+    /// The scene file (TOML); omit it with --restart.
+    #[arg(required_unless_present = "restart", conflicts_with = "restart")]
+    scene: Option<PathBuf>,
+    /// Output directory (created if missing).
+    #[arg(long)]
+    out: PathBuf,
+    /// Continue the run saved in this checkpoint file instead of starting a scene.
+    #[arg(long, value_name = "FILE")]
+    restart: Option<PathBuf>,
+    /// Simulated end time (s), replacing the scene's or the checkpoint's.
+    #[arg(long, value_name = "T", allow_negative_numbers = true)]
+    end_time: Option<f64>,
+    /// Write VTK frames every T seconds of simulated time (and at the start and the end).
+    #[arg(long, value_name = "T", allow_negative_numbers = true)]
+    vtk_interval: Option<f64>,
+    /// Write a checkpoint every T seconds of simulated time (and at the end).
+    #[arg(long, value_name = "T", allow_negative_numbers = true)]
+    checkpoint_interval: Option<f64>,
+    /// No progress bar and no messages on standard error (errors excepted).
+    #[arg(long, short)]
+    quiet: bool,
+}
+
+/// The step interval of an output given in seconds: round(T / Δt), at least one step.
+fn every_steps(flag: &str, interval: Option<f64>, dt: f64) -> Result<Option<u64>> {
+    match interval {
+        None => Ok(None),
+        Some(t) if t.is_finite() && t > 0.0 => Ok(Some(((t / dt).round() as u64).max(1))),
+        Some(t) => bail!("{flag} must be a finite, positive time in seconds, got {t}"),
+    }
+}
+
+fn run(args: &RunArgs) -> Result<()> {
+    use polydem::io::run_summary::{
+        summary_json, summary_text, CheckpointRecord, OutputRecord, RunOrigin,
+    };
+    use polydem::io::{checkpoint, csv_output, vtk::VtkWriter};
+    use std::time::Instant;
+
+    let (mut sim, source, restarted) = match (&args.restart, &args.scene) {
+        (Some(file), _) => {
+            let payload = checkpoint::load(file)
+                .with_context(|| format!("cannot restart from checkpoint {}", file.display()))?;
+            (payload.simulation, file.display().to_string(), true)
+        }
+        (None, Some(scene)) => (
+            polydem::scene::load_scene(scene)?,
+            scene.display().to_string(),
+            false,
+        ),
+        (None, None) => bail!("give a scene file or --restart FILE"),
+    };
+    if let Some(t) = args.end_time {
+        sim.set_end_time(t).context("--end-time")?;
+    }
+    let dt = sim.params.dt;
+    let vtk_every = every_steps("--vtk-interval", args.vtk_interval, dt)?;
+    let checkpoint_every = every_steps("--checkpoint-interval", args.checkpoint_interval, dt)?;
+    let origin = RunOrigin {
+        source,
+        restarted,
+        start_step: sim.world.step_index,
+        start_time: sim.world.time,
+    };
+
+    let out_dir = args.out.as_path();
     std::fs::create_dir_all(out_dir)
         .with_context(|| format!("cannot create output directory {}", out_dir.display()))?;
     let create = |name: &str| -> Result<BufWriter<File>> {
@@ -98,59 +182,154 @@ fn run(scene: &std::path::Path, out_dir: &std::path::Path) -> Result<()> {
     };
     let mut bodies = create("bodies.csv")?;
     let mut energy = create("energy.csv")?;
+    let mut walls = create("walls.csv")?;
     csv_output::write_bodies_header(&mut bodies)?;
     csv_output::write_energy_header(&mut energy)?;
-    let mut walls = create("walls.csv")?;
     csv_output::write_walls_header(&mut walls)?;
+    let mut vtk = match vtk_every {
+        Some(_) => Some(
+            VtkWriter::new(out_dir, &sim.world)
+                .with_context(|| format!("cannot create {}", out_dir.join("vtk").display()))?,
+        ),
+        None => None,
+    };
+    let checkpoint_dir = out_dir.join("checkpoints");
+    if checkpoint_every.is_some() {
+        std::fs::create_dir_all(&checkpoint_dir)
+            .with_context(|| format!("cannot create {}", checkpoint_dir.display()))?;
+    }
 
     let info = sim.time_step;
     let header = format!(
-        "scene {}: {} bodies, {} walls, dt = {:e} s ({}), shortest contact time {:e} s, stability limit {:e} s, {} steps to t = {} s",
-        scene.display(),
+        "{} {}: {} bodies, {} walls, dt = {:e} s ({}), shortest contact time {:e} s, stability limit {:e} s, steps {} → {} (t = {} s)",
+        if restarted { "restart from" } else { "scene" },
+        origin.source,
         sim.world.bodies.len(),
         sim.world.walls.len(),
         info.dt,
         if info.derived { "derived: t_c / steps_per_contact" } else { "given" },
         info.contact_time,
         info.stability_limit,
+        origin.start_step,
         sim.steps,
         sim.end_time
     );
-    eprintln!("{header}");
-    // Drawn only on a terminal: indicatif hides the bar when standard error is not one.
-    let bar = indicatif::ProgressBar::new(sim.steps);
+    if !args.quiet {
+        eprintln!("{header}");
+    }
+    // indicatif draws nothing when standard error is not a terminal.
+    let remaining = sim.steps.saturating_sub(origin.start_step);
+    let bar = if args.quiet {
+        indicatif::ProgressBar::hidden()
+    } else {
+        indicatif::ProgressBar::new(remaining)
+    };
+    let particles = sim.world.bodies.len() as f64;
     bar.set_style(
-        indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} steps  {per_sec}  eta {eta}")
-            .context("progress bar template")?,
+        indicatif::ProgressStyle::with_template(
+            "{bar:30} {pos}/{len} steps  {per_sec}  {particle_rate} particle-steps/s  elapsed {elapsed}  eta {eta}",
+        )
+        .context("progress bar template")?
+        .with_key(
+            "particle_rate",
+            move |state: &indicatif::ProgressState, w: &mut dyn std::fmt::Write| {
+                let _ = write!(w, "{:.2e}", state.per_sec() * particles);
+            },
+        ),
     );
+
+    let mut record = OutputRecord {
+        csv_every: sim.output_every,
+        vtk_every,
+        checkpoint_every,
+        ..OutputRecord::default()
+    };
+    let last_step = sim.steps;
+    let start_step = origin.start_step;
+    let output_time = std::cell::Cell::new(std::time::Duration::ZERO);
+    let mut vtk_time = std::time::Duration::ZERO;
+    let mut checkpoint_time = std::time::Duration::ZERO;
+    let mut checkpoints = Vec::new();
+    let mut write_vtk =
+        |vtk: &mut Option<VtkWriter>, s: &polydem::scene::Simulation| -> io::Result<()> {
+            if let Some(v) = vtk.as_mut() {
+                let t = Instant::now();
+                v.write_frame(&s.world)?;
+                vtk_time += t.elapsed();
+            }
+            Ok(())
+        };
+    let t0 = Instant::now();
+    write_vtk(&mut vtk, &sim)
+        .with_context(|| format!("writing VTK frames in {}", out_dir.display()))?;
+    output_time.set(output_time.get() + t0.elapsed());
     let summary = sim
         .run(
             |s| {
+                let t = Instant::now();
                 csv_output::write_bodies_rows(&mut bodies, s)?;
                 csv_output::write_walls_rows(&mut walls, s)?;
-                csv_output::write_energy_row(&mut energy, s)
+                csv_output::write_energy_row(&mut energy, s)?;
+                output_time.set(output_time.get() + t.elapsed());
+                Ok(())
             },
-            |n| {
-                if n % 256 == 0 {
-                    bar.set_position(n);
+            |s, n| {
+                if (n - start_step).is_multiple_of(16) || n == last_step {
+                    bar.set_position(n - start_step);
                 }
+                let t = Instant::now();
+                if vtk_every.is_some_and(|k| n.is_multiple_of(k)) || n == last_step {
+                    write_vtk(&mut vtk, s)?;
+                }
+                if checkpoint_every.is_some_and(|k| n.is_multiple_of(k) || n == last_step) {
+                    let tc = Instant::now();
+                    let file = format!("checkpoints/step_{n:09}.pdck");
+                    let bytes =
+                        checkpoint::save(&out_dir.join(&file), s).map_err(io::Error::other)?;
+                    let seconds = tc.elapsed();
+                    checkpoint_time += seconds;
+                    checkpoints.push(CheckpointRecord {
+                        file,
+                        step: n,
+                        time: s.world.time,
+                        bytes,
+                        seconds: seconds.as_secs_f64(),
+                    });
+                }
+                output_time.set(output_time.get() + t.elapsed());
+                Ok(())
             },
         )
-        .with_context(|| format!("running scene {}", scene.display()))?;
+        .with_context(|| format!("running {}", origin.source))?;
     bar.finish_and_clear();
-    bodies.flush()?;
-    energy.flush()?;
-    walls.flush()?;
-    let body_steps = summary.steps as f64 * sim.world.bodies.len() as f64;
-    let final_energy = sim.world.energy();
-    let text = format!(
-        "{header}\n{summary}\nparticle-steps per second {:.3e}\nfinal energy balance {:e} J (mechanical energy {:e} J)\n",
-        body_steps / summary.wall_time.as_secs_f64().max(1e-12),
-        final_energy.balance,
-        final_energy.mechanical()
-    );
+    for (name, w) in [
+        ("bodies.csv", &mut bodies),
+        ("energy.csv", &mut energy),
+        ("walls.csv", &mut walls),
+    ] {
+        w.flush()
+            .with_context(|| format!("writing {}", out_dir.join(name).display()))?;
+    }
+    record.time = output_time.get();
+    record.vtk_time = vtk_time;
+    record.checkpoint_time = checkpoint_time;
+    record.checkpoints = checkpoints;
+    if let Some(v) = &vtk {
+        record.vtk_frames = v.frames_written;
+        record.vtk_bytes = v.bytes_written;
+    }
+
+    let text = summary_text(&origin, &sim, &summary, &record);
     print!("{text}");
-    std::fs::write(out_dir.join("summary.txt"), &text)
-        .with_context(|| format!("cannot write {}", out_dir.join("summary.txt").display()))?;
+    let write = |name: &str, contents: &str| -> Result<()> {
+        let path = out_dir.join(name);
+        std::fs::write(&path, contents).with_context(|| format!("cannot write {}", path.display()))
+    };
+    write("summary.txt", &text)?;
+    let json = summary_json(&origin, &sim, &summary, &record);
+    write(
+        "summary.json",
+        &(serde_json::to_string_pretty(&json)? + "\n"),
+    )?;
     Ok(())
 }

@@ -37,7 +37,7 @@ use crate::shape::{ConvexPolyhedron, SupportMap};
 pub const SCAN_MAX_VERTICES: usize = 64;
 
 /// What the narrow phase remembers about a pair between queries (frame-1 quantities; small, `Copy`).
-#[derive(Copy, Clone, Debug, Default, PartialEq)]
+#[derive(Copy, Clone, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct PairCache {
     /// Last GJK search vector (≈ the point of A ⊖ B closest to the origin), in A's frame; zero if none.
     pub dir: Vector,

@@ -8,7 +8,7 @@
 use crate::math::Real;
 
 /// Tolerances and caps of GJK, EPA and the classification of a pair (dimensionless, times `L`).
-#[derive(Copy, Clone, Debug, PartialEq)]
+#[derive(Copy, Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct ContactTolerances {
     /// Touching band: a pair whose overlap or gap is at most `touching · L` is [`Touching`].
     /// Default 1e-11: far below the smallest overlap a DEM step produces (≳ 1e-9 L) and far above the

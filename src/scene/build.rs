@@ -51,7 +51,7 @@ pub enum SceneError {
 }
 
 /// A scene ready to run.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub struct Simulation {
     pub world: World,
     pub params: StepParams,
@@ -982,7 +982,7 @@ fn build(ctx: &Ctx, file: &SceneFile) -> Result<Simulation, SceneError> {
     }
     let mut params = StepParams::new(dt);
     params.damping = damping;
-    let steps = (end_time / dt - 1e-9).ceil().max(1.0) as u64;
+    let steps = super::run::steps_to(end_time, dt);
     let output_every = ((output_interval / dt).round() as u64).max(1);
     Ok(Simulation {
         world,

@@ -31,18 +31,22 @@ pub struct RunSummary {
 }
 
 impl Simulation {
-    /// Runs all steps. `on_output` is called at the start and every `output_every` steps (and after the last
-    /// step if it is not an output step); `on_step` after every step with the number of steps done.
+    /// Runs the remaining steps: from the world's step count (0 for a fresh scene, more for one restored
+    /// from a checkpoint) to `steps`. `on_output` is called at the start and every `output_every` steps
+    /// counted from step 0 (and after the last step if it is not an output step); `on_step` after every
+    /// step with the simulation and the number of steps done since step 0 (it may write frames or
+    /// checkpoints; its error stops the run).
     pub fn run(
         &mut self,
         mut on_output: impl FnMut(&Simulation) -> std::io::Result<()>,
-        mut on_step: impl FnMut(u64),
+        mut on_step: impl FnMut(&Simulation, u64) -> std::io::Result<()>,
     ) -> Result<RunSummary, RunError> {
         let start = Instant::now();
         let mut scratch = StepScratch::default();
         let mut summary = RunSummary::default();
+        let first = self.world.step_index + 1;
         on_output(self)?;
-        for n in 1..=self.steps {
+        for n in first..=self.steps {
             let report = step(&self.params, &mut self.world, &mut scratch)?;
             summary.counters.merge(&report.counters);
             summary.max_overlap_ratio = summary.max_overlap_ratio.max(report.max_overlap_ratio);
@@ -55,12 +59,53 @@ impl Simulation {
             if n % self.output_every == 0 || n == self.steps {
                 on_output(self)?;
             }
-            on_step(n);
+            on_step(self, n)?;
         }
-        summary.steps = self.steps;
+        summary.steps = (self.steps + 1).saturating_sub(first);
         summary.wall_time = start.elapsed();
         Ok(summary)
     }
+}
+
+impl Simulation {
+    /// Moves the end of the run to `end_time` (s), e.g. to continue a restored checkpoint further: the run
+    /// then covers ⌈end_time / Δt⌉ steps in total (counted from step 0, as the scene's own end time is).
+    pub fn set_end_time(&mut self, end_time: Real) -> Result<(), EndTimeError> {
+        let dt = self.params.dt;
+        if !(end_time.is_finite() && end_time > 0.0) {
+            return Err(EndTimeError::NotPositive { end_time });
+        }
+        let steps = steps_to(end_time, dt);
+        if steps < self.world.step_index {
+            return Err(EndTimeError::BeforeNow {
+                end_time,
+                time: self.world.time,
+                step: self.world.step_index,
+            });
+        }
+        self.end_time = end_time;
+        self.steps = steps;
+        Ok(())
+    }
+}
+
+/// The number of steps of size `dt` that covers `end_time` (at least one; an end time within 1e-9 steps
+/// of a whole number of steps is not rounded up by one more).
+pub(crate) fn steps_to(end_time: Real, dt: Real) -> u64 {
+    (end_time / dt - 1e-9).ceil().max(1.0) as u64
+}
+
+/// Why an end time was refused.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum EndTimeError {
+    #[error("end time {end_time} s must be finite and positive")]
+    NotPositive { end_time: Real },
+    #[error("end time {end_time} s lies before the current time {time} s (step {step})")]
+    BeforeNow {
+        end_time: Real,
+        time: Real,
+        step: u64,
+    },
 }
 
 impl std::fmt::Display for RunSummary {

@@ -23,7 +23,7 @@ use crate::math::Real;
 use std::f64::consts::PI;
 
 /// How the time step was chosen.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct TimeStepInfo {
     /// The time step used (s).
     pub dt: Real,

@@ -29,7 +29,7 @@ pub use support::SupportMap;
 use crate::math::Real;
 
 /// Any shape a body or wall can have. Polyhedra are shared (`Arc`) because many bodies use one shape.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub enum Shape {
     Polyhedron(std::sync::Arc<ConvexPolyhedron>),
     Sphere(Sphere),

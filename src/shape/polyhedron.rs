@@ -40,7 +40,7 @@ pub const LINEAR_SCAN_MAX_VERTICES: usize = 16;
 pub const VOLUME_ROUNDOFF_FACTOR: Real = 1e3;
 
 /// A convex polyhedron in its principal frame (see the module docs).
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub struct ConvexPolyhedron {
     vertices: Vec<Point>,
     /// Face `f` is `face_indices[face_starts[f]..face_starts[f + 1]]`.
@@ -228,6 +228,58 @@ impl ConvexPolyhedron {
             mass_properties,
         };
         Ok((shape, pose))
+    }
+
+    /// Checks the index structure of a polyhedron that was not built here (e.g. decoded from a checkpoint):
+    /// at least four vertices, every face, edge and adjacency index in range, monotone face and adjacency
+    /// starts, one normal and offset per face, all coordinates finite. Returns what is wrong. It does not
+    /// re-prove convexity; a checkpoint's checksum guards the values themselves.
+    pub fn check_structure(&self) -> Result<(), String> {
+        let n = self.vertices.len();
+        if n < 4 {
+            return Err(format!("{n} vertices (at least 4 needed)"));
+        }
+        let faces = self.face_normals.len();
+        let starts_ok = |starts: &[u32], count: usize, len: usize| {
+            starts.len() == count + 1
+                && starts.first() == Some(&0)
+                && starts.last().map(|&s| s as usize) == Some(len)
+                && starts.windows(2).all(|w| w[0] <= w[1])
+        };
+        if faces < 4 || self.face_offsets.len() != faces {
+            return Err(format!(
+                "{faces} face normals and {} face offsets",
+                self.face_offsets.len()
+            ));
+        }
+        if !starts_ok(&self.face_starts, faces, self.face_indices.len()) {
+            return Err("face starts do not partition the face indices".into());
+        }
+        if !starts_ok(&self.adjacency_starts, n, self.adjacency.len()) {
+            return Err("adjacency starts do not partition the adjacency list".into());
+        }
+        let in_range = |&i: &u32| (i as usize) < n;
+        if !self.face_indices.iter().all(in_range)
+            || !self.adjacency.iter().all(in_range)
+            || !self.edges.iter().flatten().all(in_range)
+        {
+            return Err(format!("a vertex index is out of range ({n} vertices)"));
+        }
+        let finite = self
+            .vertices
+            .iter()
+            .all(|p| p.iter().all(|x| x.is_finite()))
+            && self
+                .face_normals
+                .iter()
+                .all(|v| v.iter().all(|x| x.is_finite()))
+            && self.face_offsets.iter().all(|x| x.is_finite())
+            && self.bounding_radius.is_finite()
+            && self.bounding_radius > 0.0;
+        if !finite {
+            return Err("a coordinate, normal, offset or the bounding radius is not finite".into());
+        }
+        Ok(())
     }
 
     /// Vertices in the principal frame (m).

@@ -21,7 +21,7 @@ use crate::math::{Point, Real};
 pub type Pair = (u32, u32);
 
 /// The broad-phase state kept between steps.
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug, Default, serde::Serialize, serde::Deserialize)]
 pub struct BroadPhase {
     /// Extra margin (m) added to the sum of the radii; the list is valid while no body moved `skin / 2`.
     skin: Real,
@@ -31,9 +31,12 @@ pub struct BroadPhase {
     pairs: Vec<Pair>,
     /// How many times the grid has been rebuilt.
     rebuilds: u64,
-    // Scratch, reused between rebuilds.
+    // Scratch, reused between rebuilds (not part of the state: a checkpoint skips it).
+    #[serde(skip)]
     cell_start: Vec<u32>,
+    #[serde(skip)]
     cell_bodies: Vec<u32>,
+    #[serde(skip)]
     body_cells: Vec<CellRange>,
 }
 

@@ -31,7 +31,9 @@ use crate::law::TangentialHistory;
 use crate::math::{Point, Vector};
 
 /// The ordered pair a contact belongs to (see the module docs for the orientation).
-#[derive(Copy, Clone, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
+#[derive(
+    Copy, Clone, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, serde::Serialize, serde::Deserialize,
+)]
 pub enum ContactKey {
     /// Two bodies, `a < b`; A = body a, B = body b.
     Body { a: u32, b: u32 },
@@ -40,7 +42,7 @@ pub enum ContactKey {
 }
 
 /// What the store keeps for one pair.
-#[derive(Copy, Clone, Debug, PartialEq)]
+#[derive(Copy, Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct ContactState {
     /// Warm start of GJK/EPA (in A's frame).
     pub cache: PairCache,
@@ -98,12 +100,14 @@ impl ContactState {
 /// The contact store: entries sorted by key, aligned with the current candidate list after [`sync`].
 ///
 /// [`sync`]: ContactStore::sync
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug, Default, serde::Serialize, serde::Deserialize)]
 pub struct ContactStore {
     keys: Vec<ContactKey>,
     states: Vec<ContactState>,
-    // Scratch for the merge, kept to avoid reallocating every step.
+    // Scratch for the merge, kept to avoid reallocating every step (not part of the state).
+    #[serde(skip)]
     next_keys: Vec<ContactKey>,
+    #[serde(skip)]
     next_states: Vec<ContactState>,
 }
 

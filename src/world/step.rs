@@ -50,7 +50,7 @@ use super::world::World;
 pub const DEFAULT_OVERLAP_WARNING_FRACTION: Real = 0.05;
 
 /// Parameters of the step shared by all bodies.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct StepParams {
     /// Time step Δt (s).
     pub dt: Real,

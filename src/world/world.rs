@@ -48,7 +48,7 @@ pub enum WorldError {
 
 /// A wall: a half-space (see [`Plane`] for its convention) placed by a pose that moves with a prescribed
 /// constant velocity (zero for a fixed wall).
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Wall {
     pub name: String,
     pub plane: Plane,
@@ -72,7 +72,7 @@ impl Wall {
 }
 
 /// The symmetric table material pair → contact model.
-#[derive(Clone, Debug, Default, PartialEq)]
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct MaterialTable {
     names: Vec<String>,
     /// Row-major n × n, symmetric.
@@ -126,7 +126,7 @@ impl MaterialTable {
 /// Resultant force and torque on each body from the last contact evaluation, and the sums the energy
 /// ledger needs from it. The step evaluates forces once, at the new positions, and reuses them for the
 /// next step's first half kick.
-#[derive(Clone, Debug, Default, PartialEq)]
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Loads {
     /// Contact force on each body (N), world frame (gravity is added by the integrator).
     pub forces: Vec<Vector>,
@@ -147,7 +147,7 @@ pub struct Loads {
 }
 
 /// Every body, wall, shape and material of a simulation, and the state kept between steps.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub struct World {
     pub shapes: Vec<Shape>,
     pub bodies: Vec<RigidBody>,

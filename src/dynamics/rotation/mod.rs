@@ -77,7 +77,7 @@ pub enum SubRotation {
 
 /// A torque-free rotation update ("drift") over one time step.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
-#[serde(rename_all = "snake_case", tag = "scheme")]
+#[serde(rename_all = "snake_case")]
 pub enum RotationScheme {
     /// The DLM splitting of paper eqs. 19–25 (default: [`SubRotation::Cayley`] as in the paper).
     Splitting { sub_rotation: SubRotation },

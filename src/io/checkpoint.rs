@@ -1,0 +1,322 @@
+//! Checkpoints: the complete state of a [`Simulation`] in a versioned binary file, from which a run
+//! continues bit for bit as if it had never stopped.
+//!
+//! # File layout (format version 1; all integers little-endian)
+//! ```text
+//! offset  size  field
+//!      0     8  magic           b"PDEMCKPT"
+//!      8     4  format version  u32 (this build writes and reads FORMAT_VERSION)
+//!     12     4  reserved        u32, zero
+//!     16     8  payload length  u64, bytes that follow the header
+//!     24     4  checksum        u32, CRC-32 (IEEE, as in zip/PNG) of the payload
+//!     28     n  payload         postcard encoding of [`CheckpointPayload`]
+//! ```
+//! The file ends exactly after the payload. Reading checks, in this order: the magic (else
+//! [`CheckpointError::NotACheckpoint`]), the version ([`CheckpointError::UnsupportedVersion`]), the length
+//! ([`CheckpointError::Truncated`] / [`CheckpointError::TrailingData`]), the checksum
+//! ([`CheckpointError::Checksum`]), the decoding ([`CheckpointError::Decode`]) and the consistency of the
+//! decoded state — array lengths and every index (bodies, shapes, materials, walls, contact pairs, polyhedron
+//! topology) — so that a file that passes can never make a later step panic ([`CheckpointError::Invalid`]).
+//!
+//! # What is saved
+//! The whole [`Simulation`]: every body (pose, velocity, angular momentum, mass properties, motion), the
+//! shape table (polyhedra with their topology and principal frame), the material-pair laws, the walls at
+//! their current (moved) poses, the contact store with each pair's tangential spring and GJK/EPA warm-start
+//! cache, the broad phase's pair list and the centres it was built at (so it rebuilds at the same step), the
+//! loads of the last evaluation (the next half kick uses them), the energy ledger, time and step count, step
+//! parameters, the time-step derivation, end time, output interval, tracked bodies and input frames. Scratch
+//! buffers (`StepScratch`, the broad phase's grid, the store's merge buffers) are not saved: nothing in them
+//! survives a step. f64 values are stored as their 8 bytes, so the state read back is bitwise the state
+//! written; `tests/io_checkpoint.rs` proves that a run interrupted and restarted ends bitwise where the
+//! uninterrupted run does.
+//!
+//! # Versions
+//! The payload is the serde layout of the engine's types: a change to any serialised type (a field added,
+//! removed or reordered) changes the layout, and must bump [`FORMAT_VERSION`]. A file of another version is
+//! refused, never guessed at. The engine version that wrote a file is recorded in the payload.
+//!
+//! Writing goes to `FILE.tmp` first and renames it, so a crash never leaves a half-written file under the
+//! final name. The user documentation is `docs/checkpoint-format.md`.
+
+use std::path::{Path, PathBuf};
+
+use crate::scene::Simulation;
+use crate::shape::Shape;
+use crate::world::ContactKey;
+
+/// The first eight bytes of every checkpoint.
+pub const MAGIC: [u8; 8] = *b"PDEMCKPT";
+/// The format version this build writes and the only one it reads.
+pub const FORMAT_VERSION: u32 = 1;
+/// Bytes before the payload.
+pub const HEADER_LEN: usize = 28;
+
+/// What a checkpoint holds.
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
+pub struct CheckpointPayload {
+    /// `CARGO_PKG_VERSION` of the polydem that wrote the file (informative).
+    pub engine_version: String,
+    pub simulation: Simulation,
+}
+
+/// Why a checkpoint could not be written or read.
+#[derive(Debug, thiserror::Error)]
+pub enum CheckpointError {
+    #[error("{}: {source}", path.display())]
+    Io {
+        path: PathBuf,
+        #[source]
+        source: std::io::Error,
+    },
+    #[error(
+        "not a polydem checkpoint (the file does not start with the magic bytes \"PDEMCKPT\")"
+    )]
+    NotACheckpoint,
+    #[error("checkpoint format version {found} is not supported by this build (it reads version {supported} only)")]
+    UnsupportedVersion { found: u32, supported: u32 },
+    #[error("truncated checkpoint: {expected} bytes expected ({HEADER_LEN}-byte header + payload), the file has {actual}")]
+    Truncated { expected: u64, actual: u64 },
+    #[error("corrupt checkpoint: {extra} bytes after the end of the payload")]
+    TrailingData { extra: u64 },
+    #[error("corrupt checkpoint: payload checksum {computed:#010x} does not match the stored {stored:#010x}")]
+    Checksum { stored: u32, computed: u32 },
+    #[error("checkpoint payload cannot be decoded ({message}); it was written by a build with another layout or is damaged")]
+    Decode { message: String },
+    #[error("checkpoint state is inconsistent: {what}")]
+    Invalid { what: String },
+    #[error("cannot encode the checkpoint: {message}")]
+    Encode { message: String },
+}
+
+/// Encodes `sim` into the checkpoint format (header + payload).
+pub fn encode(sim: &Simulation) -> Result<Vec<u8>, CheckpointError> {
+    let payload = CheckpointPayload {
+        engine_version: env!("CARGO_PKG_VERSION").to_owned(),
+        simulation: sim.clone(),
+    };
+    encode_payload(&payload)
+}
+
+fn encode_payload(payload: &CheckpointPayload) -> Result<Vec<u8>, CheckpointError> {
+    let mut out = Vec::with_capacity(HEADER_LEN);
+    out.extend_from_slice(&MAGIC);
+    out.extend_from_slice(&FORMAT_VERSION.to_le_bytes());
+    out.extend_from_slice(&0u32.to_le_bytes());
+    out.extend_from_slice(&[0; 12]); // length and checksum, filled below
+    let mut out = postcard::to_extend(payload, out).map_err(|e| CheckpointError::Encode {
+        message: e.to_string(),
+    })?;
+    let len = (out.len() - HEADER_LEN) as u64;
+    let crc = crc32fast::hash(&out[HEADER_LEN..]);
+    out[16..24].copy_from_slice(&len.to_le_bytes());
+    out[24..28].copy_from_slice(&crc.to_le_bytes());
+    Ok(out)
+}
+
+/// Decodes a checkpoint (see the module docs for the checks, in order).
+pub fn decode(bytes: &[u8]) -> Result<CheckpointPayload, CheckpointError> {
+    if bytes.len() < MAGIC.len() || bytes[..MAGIC.len()] != MAGIC {
+        return Err(CheckpointError::NotACheckpoint);
+    }
+    let u32_at = |at: usize| {
+        bytes
+            .get(at..at + 4)
+            .map(|b| u32::from_le_bytes(b.try_into().expect("4 bytes")))
+    };
+    let header_short = || CheckpointError::Truncated {
+        expected: HEADER_LEN as u64,
+        actual: bytes.len() as u64,
+    };
+    let version = u32_at(8).ok_or_else(header_short)?;
+    if version != FORMAT_VERSION {
+        return Err(CheckpointError::UnsupportedVersion {
+            found: version,
+            supported: FORMAT_VERSION,
+        });
+    }
+    if bytes.len() < HEADER_LEN {
+        return Err(header_short());
+    }
+    let len = u64::from_le_bytes(bytes[16..24].try_into().expect("8 bytes"));
+    let stored = u32_at(24).expect("header checked");
+    let available = (bytes.len() - HEADER_LEN) as u64;
+    if available < len {
+        return Err(CheckpointError::Truncated {
+            expected: HEADER_LEN as u64 + len,
+            actual: bytes.len() as u64,
+        });
+    }
+    if available > len {
+        return Err(CheckpointError::TrailingData {
+            extra: available - len,
+        });
+    }
+    let payload = &bytes[HEADER_LEN..];
+    let computed = crc32fast::hash(payload);
+    if computed != stored {
+        return Err(CheckpointError::Checksum { stored, computed });
+    }
+    let decoded: CheckpointPayload =
+        postcard::from_bytes(payload).map_err(|e| CheckpointError::Decode {
+            message: e.to_string(),
+        })?;
+    check_consistency(&decoded.simulation).map_err(|what| CheckpointError::Invalid { what })?;
+    Ok(decoded)
+}
+
+/// Writes `sim` to `path` (through `path.tmp` and a rename); returns the number of bytes written.
+pub fn save(path: &Path, sim: &Simulation) -> Result<u64, CheckpointError> {
+    let bytes = encode(sim)?;
+    let mut tmp = path.as_os_str().to_owned();
+    tmp.push(".tmp");
+    let tmp = PathBuf::from(tmp);
+    let io = |path: &Path| {
+        let path = path.to_owned();
+        move |source| CheckpointError::Io { path, source }
+    };
+    std::fs::write(&tmp, &bytes).map_err(io(&tmp))?;
+    std::fs::rename(&tmp, path).map_err(io(path))?;
+    Ok(bytes.len() as u64)
+}
+
+/// Reads the checkpoint at `path`.
+pub fn load(path: &Path) -> Result<CheckpointPayload, CheckpointError> {
+    let bytes = std::fs::read(path).map_err(|source| CheckpointError::Io {
+        path: path.to_owned(),
+        source,
+    })?;
+    decode(&bytes)
+}
+
+/// Every length and index of a decoded simulation that a step relies on; the first problem found.
+fn check_consistency(sim: &Simulation) -> Result<(), String> {
+    let w = &sim.world;
+    let n = w.bodies.len();
+    let lengths = [
+        ("shape_of", w.shape_of.len()),
+        ("material_of", w.material_of.len()),
+        ("radii", w.radii.len()),
+        ("names", w.names.len()),
+        ("frames", sim.frames.len()),
+    ];
+    for (what, len) in lengths {
+        if len != n {
+            return Err(format!("{n} bodies but {len} entries in {what}"));
+        }
+    }
+    for (k, shape) in w.shapes.iter().enumerate() {
+        if let Shape::Polyhedron(p) = shape {
+            p.check_structure().map_err(|e| format!("shape {k}: {e}"))?;
+        }
+    }
+    for i in 0..n {
+        let name = &w.names[i];
+        match w.shapes.get(w.shape_of[i] as usize) {
+            None => {
+                return Err(format!(
+                    "body {i} ('{name}'): shape {} of {}",
+                    w.shape_of[i],
+                    w.shapes.len()
+                ))
+            }
+            Some(Shape::Plane(_)) => return Err(format!("body {i} ('{name}'): a plane shape")),
+            Some(_) => {}
+        }
+        if w.material_of[i] as usize >= w.materials.len() {
+            return Err(format!(
+                "body {i} ('{name}'): material {} of {}",
+                w.material_of[i],
+                w.materials.len()
+            ));
+        }
+        if !(w.radii[i].is_finite() && w.radii[i] >= 0.0) {
+            return Err(format!(
+                "body {i} ('{name}'): bounding radius {}",
+                w.radii[i]
+            ));
+        }
+    }
+    for (k, wall) in w.walls.iter().enumerate() {
+        if wall.material as usize >= w.materials.len() {
+            return Err(format!(
+                "wall {k} ('{}'): material {} of {}",
+                wall.name,
+                wall.material,
+                w.materials.len()
+            ));
+        }
+    }
+    if let Some(&t) = sim.tracked.iter().find(|&&t| t >= n) {
+        return Err(format!("tracked body {t} of {n}"));
+    }
+    if w.loads.current
+        && (w.loads.forces.len() != n
+            || w.loads.torques.len() != n
+            || w.loads.wall_forces.len() != w.walls.len())
+    {
+        return Err(format!(
+            "loads for {} / {} bodies and {} walls, world has {n} bodies and {} walls",
+            w.loads.forces.len(),
+            w.loads.torques.len(),
+            w.loads.wall_forces.len(),
+            w.walls.len()
+        ));
+    }
+    let keys = w.contacts.keys();
+    if keys.len() != w.contacts.states().len() {
+        return Err(format!(
+            "contact store: {} keys, {} states",
+            keys.len(),
+            w.contacts.states().len()
+        ));
+    }
+    if !keys.windows(2).all(|k| k[0] < k[1]) {
+        return Err("contact store keys are not strictly sorted".into());
+    }
+    let key_ok = |k: &ContactKey| match *k {
+        ContactKey::Body { a, b } => a < b && (b as usize) < n,
+        ContactKey::Wall { body, wall } => (body as usize) < n && (wall as usize) < w.walls.len(),
+    };
+    if let Some(k) = keys.iter().find(|k| !key_ok(k)) {
+        return Err(format!("contact store key {k:?} out of range"));
+    }
+    if let Some(p) = w
+        .broad_phase
+        .pairs()
+        .iter()
+        .find(|&&(i, j)| !(i < j && (j as usize) < n))
+    {
+        return Err(format!("broad-phase pair {p:?} out of range"));
+    }
+    if sim.output_every == 0 {
+        return Err("output interval of 0 steps".into());
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn short_inputs_are_refused_without_panicking() {
+        for len in 0..HEADER_LEN {
+            let mut bytes = MAGIC.to_vec();
+            bytes.extend_from_slice(&FORMAT_VERSION.to_le_bytes());
+            bytes.resize(HEADER_LEN, 0);
+            bytes.truncate(len);
+            let err = decode(&bytes).expect_err("a header alone is not a checkpoint");
+            if len < MAGIC.len() {
+                assert!(
+                    matches!(err, CheckpointError::NotACheckpoint),
+                    "{len}: {err}"
+                );
+            } else {
+                assert!(
+                    matches!(err, CheckpointError::Truncated { .. }),
+                    "{len}: {err}"
+                );
+            }
+        }
+    }
+}
