@@ -16,6 +16,11 @@ const KNOWN_FAILURES: &[(&str, &str)] = &[
          stiffness of the fall's peak overlap; rocking on vertices reaches deeper overlaps)",
     ),
     (
+        "cube_hertz_k1e10_found_over_theory",
+        "Hertz-type law, k = 1e10: 0.81 of the guard's limit after the merge of 2026-11-21 (1.03 before; 0.71 in \
+         the full profile's longer trials) — same reason",
+    ),
+    (
         "hull_hertz_k1e8_found_over_theory",
         "Hertz-type law on a random hull: 0.87 of the guard's limit (same reason)",
     ),
