@@ -121,6 +121,9 @@ struct RunArgs {
     /// Write VTK frames every T seconds of simulated time (and at the start and the end).
     #[arg(long, value_name = "T", allow_negative_numbers = true)]
     vtk_interval: Option<f64>,
+    /// Write the VTK numbers as text instead of inline base64 binary (both exact; text is larger and slower).
+    #[arg(long)]
+    vtk_ascii: bool,
     /// Write a checkpoint every T seconds of simulated time (and at the end).
     #[arg(long, value_name = "T", allow_negative_numbers = true)]
     checkpoint_interval: Option<f64>,
@@ -142,7 +145,8 @@ fn run(args: &RunArgs) -> Result<()> {
     use polydem::io::run_summary::{
         summary_json, summary_text, CheckpointRecord, OutputRecord, RunOrigin,
     };
-    use polydem::io::{checkpoint, csv_output, vtk::VtkWriter};
+    use polydem::io::vtk::{VtkFormat, VtkWriter};
+    use polydem::io::{checkpoint, csv_output};
     use std::time::Instant;
 
     let (mut sim, source, restarted) = match (&args.restart, &args.scene) {
@@ -188,8 +192,16 @@ fn run(args: &RunArgs) -> Result<()> {
     csv_output::write_walls_header(&mut walls)?;
     let mut vtk = match vtk_every {
         Some(_) => Some(
-            VtkWriter::new(out_dir, &sim.world)
-                .with_context(|| format!("cannot create {}", out_dir.join("vtk").display()))?,
+            VtkWriter::new(
+                out_dir,
+                &sim.world,
+                if args.vtk_ascii {
+                    VtkFormat::Ascii
+                } else {
+                    VtkFormat::Binary
+                },
+            )
+            .with_context(|| format!("cannot create {}", out_dir.join("vtk").display()))?,
         ),
         None => None,
     };
