@@ -88,6 +88,8 @@ impl DampingLaw {
                 }
                 let shape = if exponent == 1.0 {
                     1.0
+                } else if exponent == 1.5 {
+                    overlap.sqrt().sqrt()
                 } else {
                     overlap.powf(0.5 * (exponent - 1.0))
                 };

@@ -185,11 +185,17 @@ fn run_polydem(variant: &Variant, ctx: &mut CaseContext) -> Result<Run, SuiteErr
     let steps = sim.steps;
     ctx.progress().stage(&variant.name, steps);
     let load = load_average();
-    let cpu_start = thread_cpu_time();
-    let start = Instant::now();
-    let summary = {
-        let progress = ctx.progress();
-        sim.run(
+    // Single thread: the step's parallel stages run on rayon's current pool, here one of one thread; the
+    // CPU time is that of the pool's thread, read inside it.
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .map_err(|e| fail(format!("one-thread pool: {e}")))?;
+    let progress = ctx.progress();
+    let (summary, wall_time_s, cpu_time_s) = pool.install(|| {
+        let cpu_start = thread_cpu_time();
+        let start = Instant::now();
+        let summary = sim.run(
             |s| {
                 let b = &s.world.bodies[projectile];
                 history.t.push(s.world.time);
@@ -207,14 +213,15 @@ fn run_polydem(variant: &Variant, ctx: &mut CaseContext) -> Result<Run, SuiteErr
                 }
                 Ok(())
             },
-        )
-        .map_err(|e| fail(format!("{}: {e}", variant.scene)))?
-    };
-    let wall_time_s = start.elapsed().as_secs_f64();
-    let cpu_time_s = match (cpu_start, thread_cpu_time()) {
-        (Some(a), Some(b)) if b > a => Some(b - a),
-        _ => None,
-    };
+        );
+        let wall = start.elapsed().as_secs_f64();
+        let cpu = match (cpu_start, thread_cpu_time()) {
+            (Some(a), Some(b)) if b > a => Some(b - a),
+            _ => None,
+        };
+        (summary, wall, cpu)
+    });
+    let summary = summary.map_err(|e| fail(format!("{}: {e}", variant.scene)))?;
     Ok(Run {
         history,
         z0,
