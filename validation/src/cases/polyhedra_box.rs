@@ -127,11 +127,12 @@ fn run_polydem(scene: &Path, ctx: &mut CaseContext) -> Result<(CodeRun, Simulati
                     monitors.push(monitor(s));
                     Ok(())
                 },
-                |n| {
+                |_, n| {
                     if n % 200 == 0 || n == steps {
                         progress.inc(n - progress_steps);
                         progress_steps = n;
                     }
+                    Ok(())
                 },
             )
         })
