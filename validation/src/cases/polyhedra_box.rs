@@ -254,6 +254,14 @@ fn recorded_yade(root: &Path) -> Result<CodeRun, SuiteError> {
     Ok(run)
 }
 
+/// A monitor plot: file stem, title, y label and the monitored value.
+type MonitorPlot = (
+    &'static str,
+    &'static str,
+    &'static str,
+    fn(&Monitor) -> Real,
+);
+
 fn curve(label: &str, runs: &[Monitor], value: impl Fn(&Monitor) -> Real) -> Series {
     Series {
         label: label.into(),
@@ -400,7 +408,7 @@ impl Case for PolyhedraBox {
         );
 
         ctx.section("Trajectories (not gated: the two laws differ)");
-        let plots: [(&str, &str, &str, fn(&Monitor) -> Real); 4] = [
+        let plots: [MonitorPlot; 4] = [
             (
                 "mean_height",
                 "Mean height of the centres of mass",
