@@ -239,9 +239,15 @@ fn run(args: &RunArgs) -> Result<()> {
     let particles = sim.world.bodies.len() as f64;
     bar.set_style(
         indicatif::ProgressStyle::with_template(
-            "{bar:30} {pos}/{len} steps  {per_sec}  {particle_rate} particle-steps/s  elapsed {elapsed}  eta {eta}",
+            "{bar:20} {pos}/{len} steps {step_rate} steps/s {particle_rate} particle-steps/s eta {eta}",
         )
         .context("progress bar template")?
+        .with_key(
+            "step_rate",
+            |state: &indicatif::ProgressState, w: &mut dyn std::fmt::Write| {
+                let _ = write!(w, "{:.0}", state.per_sec());
+            },
+        )
         .with_key(
             "particle_rate",
             move |state: &indicatif::ProgressState, w: &mut dyn std::fmt::Write| {
