@@ -131,6 +131,17 @@ impl ContactStore {
     /// order: kept entries are marked touched at `step`, new ones are created, the others dropped.
     pub fn sync(&mut self, candidates: &[ContactKey], step: u64) -> SyncCounts {
         debug_assert!(candidates.windows(2).all(|w| w[0] < w[1]));
+        if candidates == self.keys.as_slice() {
+            // The same pairs as at the last sync (the usual case between broad-phase rebuilds): every entry
+            // is kept in place.
+            for s in &mut self.states {
+                s.last_touched = step;
+            }
+            return SyncCounts {
+                kept: candidates.len(),
+                ..SyncCounts::default()
+            };
+        }
         self.next_keys.clear();
         self.next_states.clear();
         let mut counts = SyncCounts::default();

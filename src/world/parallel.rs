@@ -27,15 +27,17 @@ use crate::contact::{EpaScratch, QueryCounters};
 /// overhead stays small.
 pub const CHUNKS_PER_THREAD: usize = 8;
 
-/// Default [`Parallelism::min_candidates`]: 128 candidate pairs. Measured with `benches/step.rs`
-/// (group `small_scene_threshold`) on the 2-core machine: below ~100 polyhedral candidates one step's
-/// narrow phase and laws take less than ~20 µs, of the order of two rayon fork/joins, and two threads
-/// were no faster than one; from a few hundred candidates on two threads win.
+/// Default [`Parallelism::min_candidates`]: 128 candidate pairs. Measured with `benches/step.rs` (group
+/// `threshold`, stages forced serial or parallel, 2 threads, 2026-11-21 on the shared 2-core machine at a
+/// load average of ~10, so only the small scenes are conclusive): 22 candidates 18 µs serial vs 22 µs
+/// parallel per step, 75 candidates 37 vs 58 µs, 241 candidates 224 vs 141 µs. The threshold lies between
+/// the last two.
 pub const DEFAULT_MIN_CANDIDATES: usize = 128;
 
-/// Default [`Parallelism::min_bodies`]: 2048 bodies. A half kick and drift costs ~40 ns per body, so below
-/// ~2000 bodies the integration takes less than the ~5–10 µs a fork/join costs on this machine.
-pub const DEFAULT_MIN_BODIES: usize = 2048;
+/// Default [`Parallelism::min_bodies`]: 512 bodies. The fork/joins of the 64-body scene above cost ~5 µs
+/// each (21 µs for four parallel regions); a half kick and drift cost ~250 ns per body (integrate stage of
+/// the 10^4-polyhedra bench), so from ~500 bodies on the integration is worth ≥ 25 fork/joins.
+pub const DEFAULT_MIN_BODIES: usize = 512;
 
 /// When the step uses more than one thread. Threads come from rayon's current pool (the global pool, or
 /// the one a caller `install`s); the results do not depend on the choice.

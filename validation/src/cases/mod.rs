@@ -7,6 +7,7 @@ pub mod chung_ooi;
 pub mod contact;
 pub mod friction;
 pub mod perf;
+pub mod polyhedra_box;
 pub mod precession;
 pub mod restitution;
 pub mod rockfill;
@@ -29,6 +30,7 @@ pub fn registry() -> Vec<&'static dyn Case> {
         &friction::Friction,
         &rockfill::Rockfill,
         &sphere_bed::SphereBed,
+        &polyhedra_box::PolyhedraBox,
         &stress_long_run::StressLongRun,
         &stress_impact::StressImpact,
         &stress_shapes::StressShapes,
