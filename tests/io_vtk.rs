@@ -6,7 +6,7 @@
 
 use std::path::{Path, PathBuf};
 
-use polydem::io::vtk::{VtkWriter, VTK_POLYGON, VTK_VERTEX};
+use polydem::io::vtk::{VtkFormat, VtkWriter, VTK_POLYGON, VTK_VERTEX};
 use polydem::math::{Point, Vector};
 use polydem::scene::{parse_scene, Simulation};
 use polydem::shape::Shape;
@@ -89,11 +89,29 @@ fn close(label: &str, got: &[f64], expected: &Vector, scale: f64) {
 }
 
 #[test]
-fn frames_parse_back_with_the_world_geometry_and_fields() {
+fn binary_frames_parse_back_with_the_world_geometry_and_fields() {
+    frames_parse_back_with_the_world_geometry_and_fields(VtkFormat::Binary);
+}
+
+#[test]
+fn ascii_frames_parse_back_with_the_world_geometry_and_fields() {
+    frames_parse_back_with_the_world_geometry_and_fields(VtkFormat::Ascii);
+}
+
+fn frames_parse_back_with_the_world_geometry_and_fields(format: VtkFormat) {
     let mut sim = scene();
-    let dir = temp_dir("frames");
-    let mut writer = VtkWriter::new(&dir, &sim.world).expect("writer");
-    writer.write_frame(&sim.world).expect("frame at t = 0");
+    let dir = temp_dir(&format!("frames-{format:?}"));
+    let mut writer = VtkWriter::new(&dir, &sim.world, format).expect("writer");
+    let first = std::fs::read_to_string({
+        writer.write_frame(&sim.world).expect("frame at t = 0");
+        dir.join("vtk/polyhedra_000000000.vtu")
+    })
+    .unwrap();
+    let expected_format = match format {
+        VtkFormat::Ascii => "format=\"ascii\"",
+        VtkFormat::Binary => "format=\"binary\"",
+    };
+    assert!(first.contains(expected_format), "{format:?} frame");
     sim.steps = 8000;
     sim.run(|_| Ok(()), |_, _| Ok(())).expect("run");
     writer
@@ -293,7 +311,7 @@ fn a_world_without_spheres_or_walls_writes_only_the_polyhedra_series() {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/two_polyhedra_elastic.toml");
     let sim = polydem::scene::load_scene(&path).unwrap();
     let dir = temp_dir("only_polyhedra");
-    let mut writer = VtkWriter::new(&dir, &sim.world).unwrap();
+    let mut writer = VtkWriter::new(&dir, &sim.world, VtkFormat::Ascii).unwrap();
     writer.write_frame(&sim.world).unwrap();
     assert!(dir.join("polyhedra.pvd").exists());
     assert!(!dir.join("spheres.pvd").exists() && !dir.join("walls.pvd").exists());

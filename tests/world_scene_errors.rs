@@ -415,3 +415,40 @@ fn linear_law_takes_restitution_or_dashpot_not_both() {
         "interaction[0].normal_damping",
     );
 }
+
+/// A density near the smallest f64 makes the effective mass, hence t_c and the derived step, underflow to
+/// 0 s: refused at the `steps_per_contact` line (found by tests/fuzz_scene.rs).
+#[test]
+fn underflowing_derived_step_is_refused() {
+    let text = edit("density", "density = 1e-308");
+    let (path, result) = load("underflow_step", &text);
+    let message = result.expect_err("zero time step accepted").to_string();
+    assert_names(
+        &message,
+        &path,
+        line_of(&text, "steps_per_contact"),
+        "simulation.steps_per_contact",
+    );
+}
+
+/// A finite but huge angular velocity overflows J ω: refused at the body's `angular_velocity` line (found by
+/// tests/fuzz_scene.rs).
+#[test]
+fn overflowing_angular_momentum_is_refused() {
+    // J ≈ 1e-7 m⁵ × ρ: with ρ = 1e306 kg/m³ and ω = 1e10 rad/s, J ω ≈ 1e309 overflows.
+    let text = edit(
+        "position = [0.0, 0.0, 0.2]",
+        "position = [0.0, 0.0, 0.2]\nangular_velocity = [1e10, 0.0, 0.0]",
+    )
+    .replace("density = 2600.0", "density = 1e306");
+    let (path, result) = load("huge_spin", &text);
+    let message = result
+        .expect_err("non-finite angular momentum accepted")
+        .to_string();
+    assert_names(
+        &message,
+        &path,
+        line_of(&text, "angular_velocity"),
+        "body[0].angular_velocity",
+    );
+}

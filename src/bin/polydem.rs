@@ -121,6 +121,9 @@ struct RunArgs {
     /// Write VTK frames every T seconds of simulated time (and at the start and the end).
     #[arg(long, value_name = "T", allow_negative_numbers = true)]
     vtk_interval: Option<f64>,
+    /// Write the VTK numbers as text instead of inline base64 binary (both exact; text is larger and slower).
+    #[arg(long)]
+    vtk_ascii: bool,
     /// Write a checkpoint every T seconds of simulated time (and at the end).
     #[arg(long, value_name = "T", allow_negative_numbers = true)]
     checkpoint_interval: Option<f64>,
@@ -142,7 +145,8 @@ fn run(args: &RunArgs) -> Result<()> {
     use polydem::io::run_summary::{
         summary_json, summary_text, CheckpointRecord, OutputRecord, RunOrigin,
     };
-    use polydem::io::{checkpoint, csv_output, vtk::VtkWriter};
+    use polydem::io::vtk::{VtkFormat, VtkWriter};
+    use polydem::io::{checkpoint, csv_output};
     use std::time::Instant;
 
     let (mut sim, source, restarted) = match (&args.restart, &args.scene) {
@@ -188,8 +192,16 @@ fn run(args: &RunArgs) -> Result<()> {
     csv_output::write_walls_header(&mut walls)?;
     let mut vtk = match vtk_every {
         Some(_) => Some(
-            VtkWriter::new(out_dir, &sim.world)
-                .with_context(|| format!("cannot create {}", out_dir.join("vtk").display()))?,
+            VtkWriter::new(
+                out_dir,
+                &sim.world,
+                if args.vtk_ascii {
+                    VtkFormat::Ascii
+                } else {
+                    VtkFormat::Binary
+                },
+            )
+            .with_context(|| format!("cannot create {}", out_dir.join("vtk").display()))?,
         ),
         None => None,
     };
@@ -227,9 +239,15 @@ fn run(args: &RunArgs) -> Result<()> {
     let particles = sim.world.bodies.len() as f64;
     bar.set_style(
         indicatif::ProgressStyle::with_template(
-            "{bar:30} {pos}/{len} steps  {per_sec}  {particle_rate} particle-steps/s  elapsed {elapsed}  eta {eta}",
+            "{bar:20} {pos}/{len} steps {step_rate} steps/s {particle_rate} particle-steps/s eta {eta}",
         )
         .context("progress bar template")?
+        .with_key(
+            "step_rate",
+            |state: &indicatif::ProgressState, w: &mut dyn std::fmt::Write| {
+                let _ = write!(w, "{:.0}", state.per_sec());
+            },
+        )
         .with_key(
             "particle_rate",
             move |state: &indicatif::ProgressState, w: &mut dyn std::fmt::Write| {

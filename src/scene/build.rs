@@ -611,6 +611,22 @@ fn build(ctx: &Ctx, file: &SceneFile) -> Result<Simulation, SceneError> {
         body.motion = motion;
         if !matches!(motion, Motion::Fixed) {
             body.set_angular_velocity(&omega);
+            // J ω can overflow for a finite but huge ω (or huge moments of inertia).
+            if !body.angular_momentum.iter().all(|x| x.is_finite()) {
+                let span = b
+                    .angular_velocity
+                    .as_ref()
+                    .map(|v| v.span())
+                    .unwrap_or_else(|| b.shape.span());
+                return Err(ctx.invalid(
+                    span,
+                    f("angular_velocity"),
+                    format!(
+                        "the angular momentum J ω = {:?} is not finite (ω = {:?} rad/s, principal moments {:?} kg·m²)",
+                        body.angular_momentum, omega, body.inertia.0
+                    ),
+                ));
+            }
         }
         world_bodies.push((
             name.to_owned(),
@@ -923,6 +939,13 @@ fn build(ctx: &Ctx, file: &SceneFile) -> Result<Simulation, SceneError> {
                 return Err(ctx.invalid(n.span(), "simulation.steps_per_contact", "no two bodies of this scene can touch, so there is no contact time: give time_step"));
             }
             let value = contact_time / n_value;
+            // A contact time that under- or overflowed (densities or stiffnesses near the ends of the f64
+            // range) gives a step of 0 s or a non-finite one: refuse it here rather than at the first step.
+            if !(value.is_finite() && value > 0.0) {
+                return Err(ctx.invalid(n.span(), "simulation.steps_per_contact", format!(
+                    "the derived step t_c/N = {value:e} s is not a positive finite time (shortest contact time t_c = {contact_time:e} s): check the densities and stiffnesses for values near the limits of f64"
+                )));
+            }
             if value > limit {
                 return Err(ctx.invalid(n.span(), "simulation.steps_per_contact", format!(
                     "t_c/N = {value:e} s exceeds the stability limit {limit:e} s; N must be at least {:.1}", contact_time / limit

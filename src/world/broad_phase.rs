@@ -266,8 +266,13 @@ impl BroadPhase {
         } else {
             largest_extent.max(1.0)
         };
-        let dims_for =
-            |size: Real| extent.map(|e| ((e / size).floor() as u64 + 1).min(u32::MAX as u64));
+        let dims_for = |size: Real| {
+            extent.map(|e| {
+                ((e / size).floor() as u64)
+                    .saturating_add(1)
+                    .min(u32::MAX as u64)
+            })
+        };
         loop {
             let dims = dims_for(cell_size);
             if (dims[0] as u128) * (dims[1] as u128) * (dims[2] as u128) <= MAX_CELLS as u128 {

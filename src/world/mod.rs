@@ -16,6 +16,7 @@ pub mod parallel;
 pub mod skips;
 pub mod sleeping;
 pub mod step;
+pub mod tunnelling;
 #[allow(clippy::module_inception)]
 pub mod world;
 

@@ -7,11 +7,17 @@ pub mod chung_ooi;
 pub mod contact;
 pub mod friction;
 pub mod perf;
+pub mod polyhedra_box;
 pub mod precession;
 pub mod restitution;
 pub mod rockfill;
 pub mod single_contact_energy;
 pub mod sphere_bed;
+pub mod stress_impact;
+pub mod stress_long_run;
+pub mod stress_shapes;
+pub mod stress_time_step;
+pub mod stress_util;
 
 /// Every case of the suite, in the order they run.
 pub fn registry() -> Vec<&'static dyn Case> {
@@ -24,6 +30,11 @@ pub fn registry() -> Vec<&'static dyn Case> {
         &friction::Friction,
         &rockfill::Rockfill,
         &sphere_bed::SphereBed,
+        &polyhedra_box::PolyhedraBox,
+        &stress_long_run::StressLongRun,
+        &stress_impact::StressImpact,
+        &stress_shapes::StressShapes,
+        &stress_time_step::StressTimeStep,
         &perf::Perf,
     ]
 }

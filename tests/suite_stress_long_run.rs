@@ -1,0 +1,73 @@
+//! Gate: the quick profile of the validation case `stress_long_run` (an elastic, frictionless closed box of
+//! spinning polyhedra; energy bounded with no drift trend), through the same rows that `cargo validate`
+//! writes to `reports/summary.csv`.
+//!
+//! Known failures, listed below with their reason, are not asserted (the trajectory is chaotic: any change
+//! of the engine's arithmetic moves the individual contact events, and with them whether these rows pass);
+//! the gate prints their state, the report shows them as FAIL when they fail, and every other row must pass.
+
+use polydem_validation::{run_case_in_memory, Profile};
+
+/// Rows that failed on the engine of 2026-11-21 (see reports/stress_long_run.md), and why.
+const KNOWN_FAILURES: &[(&str, &str)] = &[
+    (
+        "slabs_energy_error_max",
+        "single jumps of ~2e-3 E0 in the polyhedron–polyhedron box that did not shrink with Δt \
+         (3.4e-3 at t_c/200, 2.8e-3 at t_c/400 on one trajectory): a discontinuity of the contact \
+         potential, not integration error; other trajectories stay below 1e-3",
+    ),
+    (
+        "slabs_drift_fitted_change_over_scatter",
+        "per-event energy errors accumulate like a random walk: over a short run the fitted line's change \
+         is of the order of the scatter (1.4 and 4.8 on two trajectories)",
+    ),
+    (
+        "walls_drift_fitted_change_over_scatter",
+        "first-order errors of flat wall landings (deepest-vertex contact) accumulate like a random walk",
+    ),
+];
+
+#[test]
+fn stress_long_run_case_quick_profile_passes_every_check_but_the_known_failures() {
+    let report = run_case_in_memory("stress_long_run", Profile::Quick)
+        .expect("the stress_long_run case's data file must load");
+    assert!(
+        report.error.is_none(),
+        "stress_long_run case did not complete: {:?}",
+        report.error
+    );
+    assert!(
+        !report.checks.is_empty(),
+        "stress_long_run produced no checks"
+    );
+    let describe = |c: &polydem_validation::Check| {
+        format!(
+            "{}: measured {:e} {}, target {}",
+            c.metric,
+            c.value,
+            c.unit,
+            c.target.render()
+        )
+    };
+    let known = |m: &str| KNOWN_FAILURES.iter().any(|(k, _)| *k == m);
+    let failed: Vec<String> = report
+        .checks
+        .iter()
+        .filter(|c| !c.pass && !known(&c.metric))
+        .map(describe)
+        .collect();
+    assert!(
+        failed.is_empty(),
+        "{} of {} stress_long_run checks failed (quick profile, inputs: validation/cases/stress_long_run.toml):\n{}",
+        failed.len(),
+        report.checks.len(),
+        failed.join("\n")
+    );
+    for (metric, reason) in KNOWN_FAILURES {
+        let row = report.checks.iter().find(|c| c.metric == *metric);
+        let row =
+            row.unwrap_or_else(|| panic!("known failure {metric} is no longer a row of the case"));
+        let state = if row.pass { "passes now" } else { "fails" };
+        eprintln!("known failure ({state}): {} — {reason}", describe(row));
+    }
+}
