@@ -7,7 +7,7 @@
 //! of the engine's arithmetic moves the individual contact events, and with them whether these rows pass);
 //! the gate prints their state, the report shows them as FAIL when they fail, and every other row must pass.
 
-use polydem_validation::{run_case_in_memory, Profile};
+use polydem_validation::gate::assert_quick_case;
 
 /// Rows that failed on the engine of 2026-11-21 (see reports/stress_shapes.md), and why.
 const KNOWN_FAILURES: &[(&str, &str)] = &[
@@ -24,45 +24,5 @@ const KNOWN_FAILURES: &[(&str, &str)] = &[
 
 #[test]
 fn stress_shapes_case_quick_profile_passes_every_check_but_the_known_failures() {
-    let report = run_case_in_memory("stress_shapes", Profile::Quick)
-        .expect("the stress_shapes case's data file must load");
-    assert!(
-        report.error.is_none(),
-        "stress_shapes case did not complete: {:?}",
-        report.error
-    );
-    assert!(
-        !report.checks.is_empty(),
-        "stress_shapes produced no checks"
-    );
-    let describe = |c: &polydem_validation::Check| {
-        format!(
-            "{}: measured {:e} {}, target {}",
-            c.metric,
-            c.value,
-            c.unit,
-            c.target.render()
-        )
-    };
-    let known = |m: &str| KNOWN_FAILURES.iter().any(|(k, _)| *k == m);
-    let failed: Vec<String> = report
-        .checks
-        .iter()
-        .filter(|c| !c.pass && !known(&c.metric))
-        .map(describe)
-        .collect();
-    assert!(
-        failed.is_empty(),
-        "{} of {} stress_shapes checks failed (quick profile, inputs: validation/cases/stress_shapes.toml):\n{}",
-        failed.len(),
-        report.checks.len(),
-        failed.join("\n")
-    );
-    for (metric, reason) in KNOWN_FAILURES {
-        let row = report.checks.iter().find(|c| c.metric == *metric);
-        let row =
-            row.unwrap_or_else(|| panic!("known failure {metric} is no longer a row of the case"));
-        let state = if row.pass { "passes now" } else { "fails" };
-        eprintln!("known failure ({state}): {} — {reason}", describe(row));
-    }
+    assert_quick_case("stress_shapes", KNOWN_FAILURES);
 }

@@ -10,6 +10,7 @@ pub mod case;
 pub mod cases;
 pub mod context;
 pub mod error;
+pub mod gate;
 pub mod pairsets;
 pub mod peers;
 pub mod plot;
