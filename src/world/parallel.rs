@@ -27,17 +27,19 @@ use crate::contact::{EpaScratch, QueryCounters};
 /// overhead stays small.
 pub const CHUNKS_PER_THREAD: usize = 8;
 
-/// Default [`Parallelism::min_candidates`]: 128 candidate pairs. Measured with `benches/step.rs` (group
-/// `threshold`, stages forced serial or parallel, 2 threads, 2026-11-21 on the shared 2-core machine at a
-/// load average of ~10, so only the small scenes are conclusive): 22 candidates 18 µs serial vs 22 µs
-/// parallel per step, 75 candidates 37 vs 58 µs, 241 candidates 224 vs 141 µs. The threshold lies between
-/// the last two.
-pub const DEFAULT_MIN_CANDIDATES: usize = 128;
+/// Default [`Parallelism::min_candidates`]: 4096 candidate pairs. On this 2-core VM a parallel region costs
+/// tens of µs of thread wake-up, and a candidate that the cached axis or the bounding spheres reject costs
+/// ~90 ns, so a region must hold a few hundred µs of work to pay. Measured with `polydem run` on the
+/// polyhedra box of `reference/polyhedra_box` (quiet machine, 2026-11-21, RAYON_NUM_THREADS 1 vs 2): 1000
+/// bodies, ~1540 candidates per step: narrow phase 1131 ms serial vs 1244 ms parallel over 8000 steps
+/// (slower); 5000 bodies, ~7700 candidates: 1109 vs 831 ms over 2000 steps (1.33× faster). (An earlier
+/// threshold of 128, measured at a load average of ~10, made the 1000-body box slower on two threads.)
+pub const DEFAULT_MIN_CANDIDATES: usize = 4096;
 
-/// Default [`Parallelism::min_bodies`]: 512 bodies. The fork/joins of the 64-body scene above cost ~5 µs
-/// each (21 µs for four parallel regions); a half kick and drift cost ~250 ns per body (integrate stage of
-/// the 10^4-polyhedra bench), so from ~500 bodies on the integration is worth ≥ 25 fork/joins.
-pub const DEFAULT_MIN_BODIES: usize = 512;
+/// Default [`Parallelism::min_bodies`]: 20 000 bodies. A half kick and drift cost only ~16 ns per body
+/// (same runs: 5000 bodies, integration 160 ms over 2000 steps serial), while the two-thread version took
+/// 300 ms: the fork/joins cost more than the work. Below ~10^4 bodies the integration stays serial.
+pub const DEFAULT_MIN_BODIES: usize = 20_000;
 
 /// When the step uses more than one thread. Threads come from rayon's current pool (the global pool, or
 /// the one a caller `install`s); the results do not depend on the choice.
