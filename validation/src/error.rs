@@ -42,6 +42,14 @@ pub enum SuiteError {
 }
 
 impl SuiteError {
+    /// The error of case `case` that could not produce its figures; `msg` names the inputs.
+    pub fn case(case: &str, msg: impl Into<String>) -> SuiteError {
+        SuiteError::Case {
+            case: case.to_string(),
+            msg: msg.into(),
+        }
+    }
+
     /// Wraps an I/O error with the path it concerns.
     pub fn io(path: impl Into<PathBuf>) -> impl FnOnce(std::io::Error) -> SuiteError {
         let path = path.into();

@@ -131,10 +131,7 @@ impl Case for ChungOoi {
         let e_tol = data.tolerance(self.name(), "restitution_rel")?.value;
         let sliding_tol = data.tolerance(self.name(), "sliding_rel")?.value;
         let margin = data.tolerance(self.name(), "sliding_margin")?.value;
-        let fail = |msg: String| SuiteError::Case {
-            case: "chung_ooi".into(),
-            msg,
-        };
+        let fail = |msg: String| SuiteError::case("chung_ooi", msg);
         let material = |name: &'static str, prefix: &str| -> Result<Material, SuiteError> {
             Ok(Material {
                 name,

@@ -42,10 +42,7 @@ const HEADER: [&str; 8] = [
 ];
 
 fn case_err(msg: impl Into<String>) -> SuiteError {
-    SuiteError::Case {
-        case: NAME.into(),
-        msg: msg.into(),
-    }
+    SuiteError::case(NAME, msg)
 }
 
 fn read_history(path: &Path) -> Result<Vec<Vec<String>>, SuiteError> {

@@ -56,10 +56,7 @@ fn workspace_root() -> PathBuf {
 }
 
 fn fail(msg: String) -> SuiteError {
-    SuiteError::Case {
-        case: "polyhedra_box".into(),
-        msg,
-    }
+    SuiteError::case("polyhedra_box", msg)
 }
 
 /// CPU time of this process (user + system, all threads), in seconds.

@@ -159,10 +159,7 @@ fn vector(a: [Real; 3]) -> Vector {
 }
 
 fn case_error(msg: String) -> SuiteError {
-    SuiteError::Case {
-        case: "precession".into(),
-        msg,
-    }
+    SuiteError::case("precession", msg)
 }
 
 impl Case for Precession {

@@ -232,10 +232,7 @@ impl Case for Restitution {
         let tol = data.tolerance(self.name(), "restitution_rel")?.value;
         let bound = data.tolerance(self.name(), "first_order_bound")?.value;
         let reference = data.reference(self.name(), "restitution")?.value;
-        let fail = |msg: String| SuiteError::Case {
-            case: "restitution".into(),
-            msg,
-        };
+        let fail = |msg: String| SuiteError::case("restitution", msg);
         ctx.progress().stage(
             "impacts",
             (PAIRS.len() * 2 * (p.restitutions.len() + p.steps_per_contact.len() * 2)) as u64,

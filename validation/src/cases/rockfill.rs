@@ -26,10 +26,7 @@ struct Params {
 }
 
 fn case_error(msg: String) -> SuiteError {
-    SuiteError::Case {
-        case: "rockfill".into(),
-        msg,
-    }
+    SuiteError::case("rockfill", msg)
 }
 
 impl Case for Rockfill {

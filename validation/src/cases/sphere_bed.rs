@@ -74,10 +74,7 @@ fn repo_root() -> PathBuf {
 }
 
 fn fail(msg: String) -> SuiteError {
-    SuiteError::Case {
-        case: NAME.into(),
-        msg,
-    }
+    SuiteError::case(NAME, msg)
 }
 
 /// Reads `reference/<code>/out/<variant>.csv`.

@@ -56,10 +56,7 @@ const PLOT_FLOOR: f64 = 1e-18;
 const CDF_POINTS: usize = 400;
 
 fn case_err(msg: impl Into<String>) -> SuiteError {
-    SuiteError::Case {
-        case: NAME.into(),
-        msg: msg.into(),
-    }
+    SuiteError::case(NAME, msg)
 }
 
 impl Params {
