@@ -5,7 +5,8 @@
 //! `bed_*.csv`), `monitors.csv`, `summary.txt` and `section.svg` (the Fig. 7 picture). After every run the
 //! study rewrites `OUT/runs.csv` (one row per run, [`StudyRun::CSV_HEADER`]) and `OUT/study.md` (the table
 //! per size with min/mean/max over the seeds, against the paper), so an interrupted study keeps what it
-//! measured, and `--reuse-beds` resumes from the saved beds.
+//! measured, and `--reuse-beds` resumes from the saved beds. The runs go seed by seed (every size of the
+//! first seed, then the next seed), so an interrupted study still covers every size.
 //!
 //! # Paper figures compared
 //! Residual velocity 1000–1025 m/s for 100–200 mm and about 1100 m/s for 290 mm (read here as
@@ -301,8 +302,9 @@ pub fn run_study(
     let total = params.sizes_mm.len() * params.seeds.len();
     let start = Instant::now();
     let mut runs: Vec<StudyRun> = Vec::new();
-    for &size in &params.sizes_mm {
-        for &seed in &params.seeds {
+    // Seed-major: an interrupted study has every size of the first seeds.
+    for &seed in &params.seeds {
+        for &size in &params.sizes_mm {
             let k = runs.len() + 1;
             let config = run_config(params, size, seed);
             let dir = run_dir(&params.out, size, seed);
