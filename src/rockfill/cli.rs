@@ -5,7 +5,7 @@
 //! polydem rockfill study [--config FILE | --full] --sizes 100,130,175,200,290 --seeds 1,2,3
 //!                        [--section-sizes K] [--reuse-beds] --out DIR
 //! polydem rockfill convergence [--config FILE | --full] [--dt-divisors 1,2,4] [--sections 1.0,1.5,2.0]
-//!                        [--bed DIR] --out DIR
+//!                        [--no-time-step] [--bed DIR] --out DIR
 //! ```
 //! Without a subcommand it runs one experiment: the quick variant (`scenes/rockfill/quick.toml`, compiled in)
 //! or with `--full` the full-scale layer (`scenes/rockfill/paper.toml`). `--bed DIR` starts from a bed saved
@@ -110,9 +110,12 @@ pub struct StudyArgs {
 pub struct ConvergenceArgs {
     #[command(flatten)]
     pub experiment: ExperimentArgs,
-    /// Divisors k of the penetration time step (Δt/k), comma-separated; empty to skip.
+    /// Divisors k of the penetration time step (Δt/k), comma-separated.
     #[arg(long, value_delimiter = ',', default_value = "1,2,4")]
     pub dt_divisors: Vec<f64>,
+    /// Skip the time-step sequence (run only the cross-sections).
+    #[arg(long)]
+    pub no_time_step: bool,
     /// Layer widths = heights (m) of the rock-count sequence, comma-separated; empty to skip.
     #[arg(long, value_delimiter = ',')]
     pub sections: Vec<f64>,
@@ -186,7 +189,11 @@ fn convergence(a: &ConvergenceArgs) -> Result<()> {
     let (base, label) = a.experiment.load()?;
     let params = ConvergenceParams {
         base,
-        dt_divisors: a.dt_divisors.clone(),
+        dt_divisors: if a.no_time_step {
+            Vec::new()
+        } else {
+            a.dt_divisors.clone()
+        },
         sections: a.sections.clone(),
         out: a.out.clone(),
         bed: a.bed.clone(),

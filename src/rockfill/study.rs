@@ -214,11 +214,12 @@ pub fn write_monitors(path: &Path, rows: &[MonitorRow]) -> Result<(), StudyError
     std::fs::write(path, csv).map_err(io_error(path))
 }
 
-/// Tip positions of the four section instants (m): a quarter, half and three quarters of the layer; the
-/// fourth panel is the end of the run.
+/// Tip positions of the section instants (m): a quarter of the layer (the projectile before the plane
+/// x = L/2), half its length past the plane (its body in the plane), the right face; the fourth panel is the
+/// end of the run.
 pub fn section_instants(config: &ExperimentConfig) -> Vec<Real> {
     let l = config.layer.length;
-    vec![0.25 * l, 0.5 * l, 0.75 * l]
+    vec![0.25 * l, 0.5 * l + 0.5 * config.projectile.length, l]
 }
 
 /// Whether `dir` holds a saved bed (checkpoint or CSV).
@@ -275,7 +276,8 @@ pub fn draw_run_sections(
         width: config.layer.width,
         height: config.layer.height * 1.1,
         mean_size: config.rock.mean_size,
-        displacement_scale: 1.0,
+        // Twice the threshold of the disturbed zone: a rock at the threshold is mid-scale.
+        displacement_scale: 2.0 * config.impact.disturbed_threshold,
         projectile: world.bodies.len() - 1,
         title,
     };

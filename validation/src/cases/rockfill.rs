@@ -234,9 +234,11 @@ impl Case for Rockfill {
             for &seed in &p.seeds {
                 ctx.text(&format!(
                     "![Section, seed {seed}](rockfill/section_seed_{seed}.svg)\n\nRocks cut by the plane x = L/2, \
-                     coloured by their displacement since the start of the run (0 to ≥ 1 mean size); the projectile \
-                     in red (its section when it crosses the plane, else its outline projected, thin). Instants: \
-                     tip at L/4, L/2, 3L/4 and the end of the run."
+                     coloured by their displacement since the start of the run (0 to ≥ twice the disturbed-zone \
+                     threshold, i.e. {} mean sizes); the projectile in red (its section when it crosses the plane, \
+                     else its outline projected, thin). Instants: tip at L/4, at L/2 + half the projectile's length, \
+                     at L, and the end of the run.",
+                    2.0 * base.impact.disturbed_threshold
                 ));
             }
         }
