@@ -707,6 +707,20 @@ fn narrow_phase(
         ContactKey::Wall { body, wall } => {
             let wall = &world.walls[wall as usize];
             let body = body as usize;
+            if params.skips.bounding_spheres {
+                // The wall list has a skin: a body listed may still be beyond its radius from the plane.
+                let x = &world.bodies[body].position;
+                if let Some(g) = skips::reject_wall_by_bounding_sphere(
+                    wall.signed_distance(x),
+                    &wall.normal_world(),
+                    x,
+                    world.radii[body],
+                    &mut worker.query,
+                ) {
+                    state.geometry = g;
+                    return Ok(());
+                }
+            }
             if let Shape::Sphere(s) = world.shape(body) {
                 worker.query.sphere_plane += 1;
                 state.geometry = contact_plane_sphere(
