@@ -31,7 +31,7 @@ pub struct ContactTolerances {
     /// fallback.
     pub epa_max_iterations: u32,
     /// The overlap a polyhedron–wall contact hands to the law (default: the smoothed depth with a band of
-    /// 1e-3 L; see [`super::wall_depth`]). Not a tolerance of the status, which is always exact.
+    /// 1e-4 L; see [`super::wall_depth`]). Not a tolerance of the status, which is always exact.
     pub wall_depth: super::wall_depth::WallDepth,
 }
 
