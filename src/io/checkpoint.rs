@@ -1,7 +1,7 @@
 //! Checkpoints: the complete state of a [`Simulation`] in a versioned binary file, from which a run
 //! continues bit for bit as if it had never stopped.
 //!
-//! # File layout (format version 1; all integers little-endian)
+//! # File layout (format version 2; all integers little-endian)
 //! ```text
 //! offset  size  field
 //!      0     8  magic           b"PDEMCKPT"
@@ -47,7 +47,7 @@ use crate::world::ContactKey;
 /// The first eight bytes of every checkpoint.
 pub const MAGIC: [u8; 8] = *b"PDEMCKPT";
 /// The format version this build writes and the only one it reads.
-pub const FORMAT_VERSION: u32 = 2;
+pub const FORMAT_VERSION: u32 = 3;
 /// Bytes before the payload.
 pub const HEADER_LEN: usize = 28;
 

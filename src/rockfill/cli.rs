@@ -2,12 +2,21 @@
 //!
 //! ```text
 //! polydem rockfill [--config FILE | --full] [--size MM] [--seed N] [--bed DIR] [--out DIR]
+//! polydem rockfill study [--config FILE | --full] --sizes 100,130,175,200,290 --seeds 1,2,3
+//!                        [--section-sizes K] [--reuse-beds] --out DIR
+//! polydem rockfill convergence [--config FILE | --full] [--dt-divisors 1,2,4] [--sections 1.0,1.5,2.0]
+//!                        [--no-time-step] [--bed DIR] --out DIR
 //! ```
-//! Without options it runs the quick variant (`scenes/rockfill/quick.toml`, compiled in); `--full` the
-//! full-scale layer (`scenes/rockfill/paper.toml`). `--bed DIR` starts from a bed saved by an earlier run
-//! instead of generating and packing. Writes into `--out` (default `out/rockfill`): `monitors.csv` (the
-//! projectile's time series, columns in [`MonitorRow::CSV_HEADER`]), the packed bed (`bed_*.csv`, when
-//! generated) and `summary.txt` (also printed).
+//! Without a subcommand it runs one experiment: the quick variant (`scenes/rockfill/quick.toml`, compiled in)
+//! or with `--full` the full-scale layer (`scenes/rockfill/paper.toml`). `--bed DIR` starts from a bed saved
+//! by an earlier run (its checkpoint `bed.pdck` when there is one, else its CSV files; see
+//! [`super::bed`]) instead of generating and packing. Writes into `--out` (default `out/rockfill`):
+//! `monitors.csv` (the projectile's time series, columns in [`super::penetration::MonitorRow::CSV_HEADER`]), the packed bed
+//! (`bed.pdck`, `bed_info.json`, `bed_*.csv`, when generated), `section.svg` (the paper's Fig. 7 picture)
+//! and `summary.txt` (also printed).
+//!
+//! `study` runs the size study ([`super::study`]); `convergence` the time-step and rock-count sequences
+//! ([`super::convergence`]).
 
 use std::fmt::Write as _;
 use std::path::PathBuf;
@@ -15,25 +24,25 @@ use std::path::PathBuf;
 use anyhow::{Context, Result};
 
 use super::config::ExperimentConfig;
-use super::experiment::{run_experiment, BedSource, ExperimentResult};
-use super::penetration::MonitorRow;
+use super::convergence::{run_convergence, ConvergenceParams};
+use super::experiment::ExperimentResult;
+use super::study::{run_one, run_study, StudyParams};
 
 /// Options of `polydem rockfill`.
 #[derive(clap::Args, Debug, Clone)]
+#[command(args_conflicts_with_subcommands = true)]
 pub struct RockfillArgs {
-    /// Experiment file (TOML, format of scenes/rockfill/paper.toml); default: the quick variant.
-    #[arg(long, conflicts_with = "full")]
-    pub config: Option<PathBuf>,
-    /// Use the full-scale experiment (scenes/rockfill/paper.toml).
-    #[arg(long)]
-    pub full: bool,
+    #[command(subcommand)]
+    pub command: Option<RockfillCommand>,
+    #[command(flatten)]
+    pub experiment: ExperimentArgs,
     /// Override the mean rock size (mm).
     #[arg(long)]
     pub size: Option<f64>,
     /// Override the random seed of the sample.
     #[arg(long)]
     pub seed: Option<u64>,
-    /// Start from a bed saved by an earlier run (directory with bed_*.csv).
+    /// Start from a bed saved by an earlier run (directory with bed.pdck or bed_*.csv).
     #[arg(long)]
     pub bed: Option<PathBuf>,
     /// Output directory.
@@ -41,13 +50,91 @@ pub struct RockfillArgs {
     pub out: PathBuf,
 }
 
+/// The experiment file.
+#[derive(clap::Args, Debug, Clone)]
+pub struct ExperimentArgs {
+    /// Experiment file (TOML, format of scenes/rockfill/paper.toml); default: the quick variant.
+    #[arg(long, conflicts_with = "full")]
+    pub config: Option<PathBuf>,
+    /// Use the full-scale experiment (scenes/rockfill/paper.toml).
+    #[arg(long)]
+    pub full: bool,
+}
+
+impl ExperimentArgs {
+    fn load(&self) -> Result<(ExperimentConfig, String)> {
+        Ok(match (&self.config, self.full) {
+            (Some(path), _) => (ExperimentConfig::load(path)?, path.display().to_string()),
+            (None, true) => (ExperimentConfig::paper(), "paper.toml (full scale)".into()),
+            (None, false) => (
+                ExperimentConfig::quick(),
+                "quick.toml (quick variant)".into(),
+            ),
+        })
+    }
+}
+
+/// Subcommands of `polydem rockfill`.
+#[derive(clap::Subcommand, Debug, Clone)]
+pub enum RockfillCommand {
+    /// The five-size study: every size × seed, a table against the paper (OUT/study.md, OUT/runs.csv).
+    Study(StudyArgs),
+    /// Time-step and rock-count convergence with a work-precision plot (OUT/convergence.csv, .svg).
+    Convergence(ConvergenceArgs),
+}
+
+/// Options of `polydem rockfill study`.
+#[derive(clap::Args, Debug, Clone)]
+pub struct StudyArgs {
+    #[command(flatten)]
+    pub experiment: ExperimentArgs,
+    /// Mean rock sizes (mm), comma-separated.
+    #[arg(long, value_delimiter = ',', default_value = "100,130,175,200,290")]
+    pub sizes: Vec<f64>,
+    /// Seeds, comma-separated.
+    #[arg(long, value_delimiter = ',', default_value = "1,2,3")]
+    pub seeds: Vec<u64>,
+    /// Reduced scale: layer width and height in mean rock sizes (the length stays the file's).
+    #[arg(long)]
+    pub section_sizes: Option<f64>,
+    /// Start each run from the bed an earlier study saved in its directory, when there is one.
+    #[arg(long)]
+    pub reuse_beds: bool,
+    /// Output directory.
+    #[arg(long, default_value = "out/rockfill_study")]
+    pub out: PathBuf,
+}
+
+/// Options of `polydem rockfill convergence`.
+#[derive(clap::Args, Debug, Clone)]
+pub struct ConvergenceArgs {
+    #[command(flatten)]
+    pub experiment: ExperimentArgs,
+    /// Divisors k of the penetration time step (Δt/k), comma-separated.
+    #[arg(long, value_delimiter = ',', default_value = "1,2,4")]
+    pub dt_divisors: Vec<f64>,
+    /// Skip the time-step sequence (run only the cross-sections).
+    #[arg(long)]
+    pub no_time_step: bool,
+    /// Layer widths = heights (m) of the rock-count sequence, comma-separated; empty to skip.
+    #[arg(long, value_delimiter = ',')]
+    pub sections: Vec<f64>,
+    /// Bed directory for the time-step sequence (default: generate and pack one into OUT/bed).
+    #[arg(long)]
+    pub bed: Option<PathBuf>,
+    /// Output directory.
+    #[arg(long, default_value = "out/rockfill_convergence")]
+    pub out: PathBuf,
+}
+
 /// Runs the subcommand.
 pub fn run(args: &RockfillArgs) -> Result<()> {
-    let mut config = match (&args.config, args.full) {
-        (Some(path), _) => ExperimentConfig::load(path)?,
-        (None, true) => ExperimentConfig::paper(),
-        (None, false) => ExperimentConfig::quick(),
-    };
+    match &args.command {
+        Some(RockfillCommand::Study(a)) => return study(a),
+        Some(RockfillCommand::Convergence(a)) => return convergence(a),
+        None => {}
+    }
+    let (mut config, _) = args.experiment.load()?;
     if let Some(mm) = args.size {
         anyhow::ensure!(
             mm.is_finite() && mm > 0.0,
@@ -58,29 +145,63 @@ pub fn run(args: &RockfillArgs) -> Result<()> {
     if let Some(seed) = args.seed {
         config.rock.seed = seed;
     }
-    std::fs::create_dir_all(&args.out)
-        .with_context(|| format!("creating {}", args.out.display()))?;
-    let bed = match &args.bed {
-        Some(dir) => BedSource::Load(dir),
-        None => BedSource::Generate {
-            save: Some(&args.out),
-        },
-    };
     let mut progress = |stage: &str, text: String| eprintln!("[{stage}] {text}");
-    let result = run_experiment(&config, bed, &mut progress)?;
-    let mut csv = String::with_capacity(result.penetration.rows.len() * 200);
-    csv.push_str(MonitorRow::CSV_HEADER);
-    csv.push('\n');
-    for row in &result.penetration.rows {
-        csv.push_str(&row.csv_row());
-        csv.push('\n');
+    let title = format!(
+        "{} mm rocks, seed {}",
+        config.rock.mean_size * 1e3,
+        config.rock.seed
+    );
+    let result = run_one(
+        &config,
+        &args.out,
+        args.bed.as_deref(),
+        &title,
+        &mut progress,
+    )?;
+    print!("{}", summary(&config, &result));
+    Ok(())
+}
+
+fn study(a: &StudyArgs) -> Result<()> {
+    let (base, label) = a.experiment.load()?;
+    let params = StudyParams {
+        base,
+        sizes_mm: a.sizes.clone(),
+        seeds: a.seeds.clone(),
+        section_sizes: a.section_sizes,
+        reuse_beds: a.reuse_beds,
+        out: a.out.clone(),
+        label,
+    };
+    if let Some(k) = a.section_sizes {
+        anyhow::ensure!(
+            k.is_finite() && k > 0.0,
+            "--section-sizes {k}: must be positive"
+        );
     }
-    let path = args.out.join("monitors.csv");
-    std::fs::write(&path, csv).with_context(|| format!("writing {}", path.display()))?;
-    let text = summary(&config, &result);
-    let path = args.out.join("summary.txt");
-    std::fs::write(&path, &text).with_context(|| format!("writing {}", path.display()))?;
-    print!("{text}");
+    let runs = run_study(&params, &mut |line| eprintln!("{line}"))?;
+    print!("{}", super::study::study_table(&params, &runs));
+    eprintln!("wrote {}/study.md and runs.csv", a.out.display());
+    Ok(())
+}
+
+fn convergence(a: &ConvergenceArgs) -> Result<()> {
+    let (base, label) = a.experiment.load()?;
+    let params = ConvergenceParams {
+        base,
+        dt_divisors: if a.no_time_step {
+            Vec::new()
+        } else {
+            a.dt_divisors.clone()
+        },
+        sections: a.sections.clone(),
+        out: a.out.clone(),
+        bed: a.bed.clone(),
+        label,
+    };
+    let result = run_convergence(&params, &mut |line| eprintln!("{line}"))
+        .with_context(|| "convergence study".to_string())?;
+    print!("{}", result.csv());
     Ok(())
 }
 
@@ -151,7 +272,7 @@ pub fn summary(config: &ExperimentConfig, r: &ExperimentResult) -> String {
     let p = &r.penetration;
     let _ = writeln!(
         s,
-        "penetration: {:?} after {} steps of {:.3e} s ({} rocks); {:.1} s wall time\n  residual speed {:.1} m/s (axial {:.1} m/s; paper: 1000–1025 m/s for 100–200 mm, ≈1100 m/s for 290 mm)\n  deflection at the end: velocity {:.2}°, axis {:.2}° (max {:.2}°, {:.2}°; paper: 10°–20°)\n  max axial resistance {:.3e} N; disturbed rocks {}, zone width {:.3} m = {:.2} mean sizes (paper: 6–7)\n  energy: projectile lost {:.4e} J, damping {:.4e} J, friction {:.4e} J; ledger balance / initial projectile energy {:.3e}\n  max overlap/size {:.3}, steps with overlap warnings {}",
+        "penetration: {:?} after {} steps of {:.3e} s ({} rocks); {:.1} s wall time\n  residual speed {:.1} m/s (axial {:.1} m/s; paper: 1000–1025 m/s for 100–200 mm, ≈1100 m/s for 290 mm)\n  deflection at the end: velocity {:.2}°, axis {:.2}° (max {:.2}°, {:.2}°; paper: 10°–20°)\n  max axial resistance {:.3e} N; in the layer: mean {:.3e} N, CV per step {:.3}, CV over windows of one rock size {:.3} ({} windows)\n  disturbed rocks {}, zone width {:.3} m = {:.2} mean sizes (paper: 6–7)\n  energy: projectile lost {:.4e} J, damping {:.4e} J, friction {:.4e} J; ledger balance / initial projectile energy {:.3e}\n  max overlap/size {:.3}, steps with overlap warnings {}",
         p.outcome,
         p.steps,
         p.dt,
@@ -164,6 +285,10 @@ pub fn summary(config: &ExperimentConfig, r: &ExperimentResult) -> String {
         p.max_velocity_deflection,
         p.max_axis_deflection,
         p.max_axial_force,
+        p.resistance.mean,
+        p.resistance.cv,
+        p.resistance.cv_window,
+        p.resistance.windows,
         p.disturbed_rocks,
         p.disturbed_width,
         p.disturbed_width_sizes,

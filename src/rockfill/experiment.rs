@@ -3,16 +3,21 @@
 use std::path::Path;
 use std::time::Duration;
 
+use super::bed::{
+    has_checkpoint, load_bed_checkpoint, load_bed_info, save_bed_checkpoint, BedError, BedInfo,
+};
 use super::config::ExperimentConfig;
 use super::generation::{generate, GenerationError, GenerationParams, Sample};
 use super::packing::{load_bed, loose_world, pack, save_bed, PackingError, PackingReport};
 use super::penetration::{
-    add_projectile, penetrate, MonitorRow, PenetrationError, PenetrationReport,
+    add_projectile, penetrate_with, MonitorRow, PenetrationError, PenetrationOptions,
+    PenetrationReport,
 };
 use super::projectile::{Projectile, ProjectileError};
 use super::seeds::{Region, SeedError};
 use super::statistics::{sample_statistics, SampleStatistics};
 use crate::math::{Point, Real};
+use crate::world::World;
 
 /// Why the experiment failed.
 #[derive(Debug, thiserror::Error)]
@@ -27,14 +32,17 @@ pub enum ExperimentError {
     Packing(#[from] PackingError),
     #[error(transparent)]
     Penetration(#[from] PenetrationError),
+    #[error(transparent)]
+    Bed(#[from] BedError),
 }
 
 /// Where the bed comes from.
 #[derive(Clone, Copy, Debug)]
 pub enum BedSource<'a> {
-    /// Generate and pack; save the packed bed into the directory if one is given.
+    /// Generate and pack; save the packed bed into the directory if one is given (the checkpoint
+    /// `bed.pdck` with `bed_info.json`, and the CSV files; see [`super::bed`]).
     Generate { save: Option<&'a Path> },
-    /// Load a bed saved earlier.
+    /// Load a bed saved earlier: its checkpoint when the directory has one, else its CSV files.
     Load(&'a Path),
 }
 
@@ -57,8 +65,15 @@ pub struct GenerationSummary {
 pub struct ExperimentResult {
     pub generation: Option<GenerationSummary>,
     pub packing: Option<PackingReport>,
+    /// The bed's facts: written with a generated bed, read with a loaded one (absent for a CSV bed
+    /// without `bed_info.json`).
+    pub bed: Option<BedInfo>,
+    /// Whether the bed was read from a checkpoint (false: generated, or read from CSV).
+    pub bed_from_checkpoint: bool,
     pub projectile: Projectile,
     pub penetration: PenetrationReport,
+    /// The world at the end of the run (the projectile is the last body).
+    pub world: World,
 }
 
 /// Progress messages: (stage, text).
@@ -88,9 +103,36 @@ pub fn run_experiment(
     bed: BedSource,
     progress: Progress,
 ) -> Result<ExperimentResult, ExperimentError> {
+    run_experiment_with(config, bed, &PenetrationOptions::default(), progress)
+}
+
+/// [`run_experiment`] with options for the penetration run.
+pub fn run_experiment_with(
+    config: &ExperimentConfig,
+    bed: BedSource,
+    options: &PenetrationOptions,
+    progress: Progress,
+) -> Result<ExperimentResult, ExperimentError> {
     let projectile = Projectile::new(config.projectile)?;
-    let (mut world, generation, packing) = match bed {
-        BedSource::Load(dir) => (load_bed(config, dir)?, None, None),
+    let (mut world, generation, packing, bed_info, from_checkpoint) = match bed {
+        BedSource::Load(dir) => {
+            let checkpoint = has_checkpoint(dir);
+            let world = if checkpoint {
+                load_bed_checkpoint(dir)?
+            } else {
+                load_bed(config, dir)?
+            };
+            progress(
+                "bed",
+                format!(
+                    "{} bodies from {} ({})",
+                    world.bodies.len(),
+                    dir.display(),
+                    if checkpoint { "checkpoint" } else { "CSV" }
+                ),
+            );
+            (world, None, None, load_bed_info(dir)?, checkpoint)
+        }
         BedSource::Generate { save } => {
             let start = std::time::Instant::now();
             let sample = generate_sample(config)?;
@@ -120,18 +162,26 @@ pub fn run_experiment(
             let packing = pack(config, &mut world, |stage, t, h| {
                 progress(stage, format!("t = {t:.3} s, height {h:.3} m"))
             })?;
+            let info = BedInfo::new(
+                config.rock.mean_size,
+                config.rock.seed,
+                generation.wall_time,
+                &packing,
+            );
             if let Some(dir) = save {
                 save_bed(&world, dir)?;
+                save_bed_checkpoint(&world, &packing, &info, dir)?;
             }
-            (world, Some(generation), Some(packing))
+            (world, Some(generation), Some(packing), Some(info), false)
         }
     };
     let index = add_projectile(config, &mut world, &projectile)?;
-    let penetration = penetrate(
+    let penetration = penetrate_with(
         config,
         &mut world,
         &projectile,
         index,
+        options,
         |row: &MonitorRow| {
             progress(
                 "penetration",
@@ -148,7 +198,10 @@ pub fn run_experiment(
     Ok(ExperimentResult {
         generation,
         packing,
+        bed: bed_info,
+        bed_from_checkpoint: from_checkpoint,
         projectile,
         penetration,
+        world,
     })
 }

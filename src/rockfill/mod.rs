@@ -9,21 +9,26 @@
 //! - [`statistics`]: realised size distribution and shape statistics;
 //! - [`projectile`]: the ogive-nosed projectile with its internal cavity (mass properties solid − cavity);
 //! - [`config`]: the experiment's parameters as data (Table 1 and what the paper does not state), the laws;
-//! - [`packing`]: the container, deposition under gravity, compaction by a moving top wall, hold, bed file;
+//! - [`packing`]: the container, deposition under gravity, compaction by a moving top wall, hold, bed CSV;
+//! - [`bed`]: the packed bed as an engine checkpoint, so that penetration runs start from it;
 //! - [`penetration`]: the impact run and its monitors (velocity, resistance, deflection, disturbed zone);
 //! - [`experiment`]: generation → packing (or a saved bed) → penetration;
 //! - [`cli`]: the `polydem rockfill` subcommand.
 
+pub mod bed;
 pub mod cli;
 pub mod config;
+pub mod convergence;
 pub mod experiment;
 pub mod generation;
 pub mod grading;
 pub mod packing;
 pub mod penetration;
 pub mod projectile;
+pub mod section;
 pub mod seeds;
 pub mod statistics;
+pub mod study;
 pub mod voronoi;
 
 pub use generation::{generate, GenerationError, GenerationParams, Sample};

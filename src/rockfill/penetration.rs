@@ -25,7 +25,7 @@ use super::config::ExperimentConfig;
 use super::packing::{rock_time_step, top_wall_height, PackingError, KEPT_WALLS, STEEL};
 use super::projectile::Projectile;
 use crate::dynamics::{Motion, RigidBody, ViscousDamping};
-use crate::math::{Point, Real, Vector};
+use crate::math::{Point, Pose, Real, Vector};
 use crate::shape::Shape;
 use crate::world::{
     step, ContactKey, EnergyLedger, StepError, StepParams, StepScratch, World, WorldError,
@@ -103,6 +103,97 @@ pub enum Outcome {
     TimeLimit,
 }
 
+/// Options of a penetration run beyond the experiment file.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PenetrationOptions {
+    /// The run's Δt is the experiment's Δt divided by this (1 for the experiment; 2, 4, … for a time-step
+    /// convergence study).
+    pub dt_divisor: Real,
+    /// Tip positions x (m): at the first step at which the tip is at or past each, every body's pose is
+    /// recorded ([`Snapshot`]); when the list is not empty, the state at the end of the run is recorded too.
+    pub snapshot_tip_x: Vec<Real>,
+}
+
+impl Default for PenetrationOptions {
+    fn default() -> Self {
+        Self {
+            dt_divisor: 1.0,
+            snapshot_tip_x: Vec::new(),
+        }
+    }
+}
+
+/// Every body's pose at one instant of the run (for section pictures).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Snapshot {
+    /// Time since the start of the run (s).
+    pub time: Real,
+    pub tip: Point,
+    pub poses: Vec<Pose>,
+}
+
+/// The fluctuation of the penetration resistance R = −F·e₀ while the projectile is in the layer (from the
+/// tip entering the left face to the base leaving the right face, or the end of the run).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct ResistanceStatistics {
+    /// Steps in the interval.
+    pub samples: usize,
+    /// Mean and standard deviation of R over the steps (N).
+    pub mean: Real,
+    pub std: Real,
+    /// std / mean of the per-step R.
+    pub cv: Real,
+    /// std / mean of R averaged over consecutive windows of one mean rock size of travel at the impact speed
+    /// (removes the step-to-step chatter of single contacts; the paper's curves are of this kind).
+    pub cv_window: Real,
+    /// Windows in the interval.
+    pub windows: usize,
+}
+
+impl ResistanceStatistics {
+    /// From the monitor rows; `window_steps` steps per window.
+    pub fn from_rows(
+        rows: &[MonitorRow],
+        length: Real,
+        projectile_length: Real,
+        window_steps: usize,
+    ) -> Self {
+        let inside: Vec<Real> = rows
+            .iter()
+            .filter(|r| {
+                // The base lies `projectile_length` behind the tip along the axis.
+                let base_x = r.tip.x - projectile_length * r.axis_deflection.to_radians().cos();
+                r.tip.x >= 0.0 && base_x <= length
+            })
+            .map(|r| -r.axial_force)
+            .collect();
+        let (mean, std) = mean_std(&inside);
+        let windows: Vec<Real> = inside
+            .chunks_exact(window_steps.max(1))
+            .map(|w| w.iter().sum::<Real>() / w.len() as Real)
+            .collect();
+        let (wmean, wstd) = mean_std(&windows);
+        Self {
+            samples: inside.len(),
+            mean,
+            std,
+            cv: std / mean,
+            cv_window: wstd / wmean,
+            windows: windows.len(),
+        }
+    }
+}
+
+fn mean_std(x: &[Real]) -> (Real, Real) {
+    if x.is_empty() {
+        return (Real::NAN, Real::NAN);
+    }
+    let n = x.len() as Real;
+    let mean = x.iter().sum::<Real>() / n;
+    let var = x.iter().map(|v| (v - mean).powi(2)).sum::<Real>() / n;
+    (mean, var.sqrt())
+}
+
 /// What the run measured.
 #[derive(Clone, Debug)]
 pub struct PenetrationReport {
@@ -138,6 +229,11 @@ pub struct PenetrationReport {
     /// engine's warning fraction.
     pub max_overlap_ratio: Real,
     pub steps_with_overlap_warnings: u64,
+    /// Fluctuation of the axial resistance while in the layer.
+    pub resistance: ResistanceStatistics,
+    /// Every body's position at the start of the run, and the snapshots asked for in the options.
+    pub start_positions: Vec<Point>,
+    pub snapshots: Vec<Snapshot>,
     pub wall_time: Duration,
 }
 
@@ -186,12 +282,40 @@ pub fn penetrate(
     world: &mut World,
     projectile: &Projectile,
     index: usize,
+    progress: impl FnMut(&MonitorRow),
+) -> Result<PenetrationReport, PenetrationError> {
+    penetrate_with(
+        config,
+        world,
+        projectile,
+        index,
+        &PenetrationOptions::default(),
+        progress,
+    )
+}
+
+/// The experiment's Δt of the penetration run (before [`PenetrationOptions::dt_divisor`]).
+pub fn penetration_time_step(
+    config: &ExperimentConfig,
+    world: &World,
+) -> Result<Real, PenetrationError> {
+    let (dt_rocks, _) = rock_time_step(config, world)?;
+    let imp = &config.impact;
+    Ok(dt_rocks.min(imp.travel_per_step * config.rock.mean_size / imp.speed))
+}
+
+/// [`penetrate`] with options (time-step divisor, pose snapshots).
+pub fn penetrate_with(
+    config: &ExperimentConfig,
+    world: &mut World,
+    projectile: &Projectile,
+    index: usize,
+    options: &PenetrationOptions,
     mut progress: impl FnMut(&MonitorRow),
 ) -> Result<PenetrationReport, PenetrationError> {
     let start = Instant::now();
-    let (dt_rocks, _) = rock_time_step(config, world)?;
     let imp = &config.impact;
-    let dt = dt_rocks.min(imp.travel_per_step * config.rock.mean_size / imp.speed);
+    let dt = penetration_time_step(config, world)? / options.dt_divisor;
     let mut params = StepParams::new(dt);
     params.damping = ViscousDamping::None;
     let mut scratch = StepScratch::default();
@@ -207,6 +331,9 @@ pub fn penetrate(
     let mut steps = 0u64;
     let mut warned = 0u64;
     let mut max_overlap: Real = 0.0;
+    let mut snapshots = Vec::new();
+    let mut pending: Vec<Real> = options.snapshot_tip_x.clone();
+    pending.sort_by(|a, b| b.total_cmp(a));
     let outcome = loop {
         let report = step(&params, world, &mut scratch)?;
         steps += 1;
@@ -240,6 +367,10 @@ pub fn penetrate(
             contacts,
         };
         rows.push(row);
+        while pending.last().is_some_and(|&x| tip.x >= x) {
+            pending.pop();
+            snapshots.push(snapshot(world, row.time, tip));
+        }
         if steps.is_multiple_of(100) {
             progress(&row);
         }
@@ -254,8 +385,11 @@ pub fn penetrate(
             break Outcome::TimeLimit;
         }
     };
-    let body = &world.bodies[index];
     let last = *rows.last().expect("at least one step");
+    if !options.snapshot_tip_x.is_empty() {
+        snapshots.push(snapshot(world, last.time, last.tip));
+    }
+    let body = &world.bodies[index];
     // Disturbed zone.
     let aim_y = 0.5 * config.layer.width;
     let aim_z = rows.first().map_or(0.0, |r| r.position.z);
@@ -306,9 +440,25 @@ pub fn penetrate(
         dissipated_friction: energy.dissipated_friction,
         max_overlap_ratio: max_overlap,
         steps_with_overlap_warnings: warned,
+        resistance: ResistanceStatistics::from_rows(
+            &rows,
+            config.layer.length,
+            length,
+            ((config.rock.mean_size / imp.speed) / dt).round() as usize,
+        ),
+        start_positions,
+        snapshots,
         wall_time: start.elapsed(),
         rows,
     })
+}
+
+fn snapshot(world: &World, time: Real, tip: Point) -> Snapshot {
+    Snapshot {
+        time,
+        tip,
+        poses: (0..world.bodies.len()).map(|i| world.pose(i)).collect(),
+    }
 }
 
 /// Distance from the base to the centre of mass along the axis (m): the centre of mass lies at

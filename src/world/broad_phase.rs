@@ -14,8 +14,19 @@
 //!
 //! Output: pairs `(i, j)` with `i < j`, sorted, so every later stage sees the same order on every run and
 //! for any thread count.
+//!
+//! # Walls
+//! Body–wall candidates use the same skin ([`BroadPhase::update_with_walls`]): a body is a candidate of a
+//! wall when its signed distance from the plane is below its radius plus the skin, and the list stays valid
+//! while no body and no wall moved half the skin since it was built (a pair left out had a distance of at
+//! least r + skin, so after the moves it still has more than r: it cannot touch). A wall that moved half the
+//! skin rebuilds the whole broad phase, so that bodies and walls share one build time. Without this list the
+//! step tested every body against every wall at every step, and the candidate list — hence the contact
+//! store — changed whenever one body crossed its wall distance, which forced the store's merge.
 
-use crate::math::{Point, Real};
+use crate::math::{Point, Real, Vector};
+
+use super::world::Wall;
 
 /// A candidate pair of body indices, `i < j`.
 pub type Pair = (u32, u32);
@@ -31,6 +42,11 @@ pub struct BroadPhase {
     pairs: Vec<Pair>,
     /// How many times the grid has been rebuilt.
     rebuilds: u64,
+    /// Body–wall candidates `(body, wall)`, sorted, built with the bodies by
+    /// [`update_with_walls`](BroadPhase::update_with_walls) (empty when only the bodies were rebuilt).
+    wall_pairs: Vec<Pair>,
+    /// Wall translations at the last build with walls.
+    walls_at_build: Vec<Vector>,
     // Scratch, reused between rebuilds (not part of the state: a checkpoint skips it).
     #[serde(skip)]
     cell_start: Vec<u32>,
@@ -113,6 +129,44 @@ impl BroadPhase {
             .any(|(now, then)| (now - then).norm_squared() >= limit_sq)
     }
 
+    /// The body–wall candidates `(body, wall)` of the last [`update_with_walls`](Self::update_with_walls),
+    /// sorted; every body whose bounding sphere can reach a wall before the next rebuild is listed.
+    pub fn wall_pairs(&self) -> &[Pair] {
+        &self.wall_pairs
+    }
+
+    /// Whether a wall was added or removed, or moved half the skin, since the last build with walls.
+    pub fn walls_moved(&self, walls: &[Wall]) -> bool {
+        if walls.len() != self.walls_at_build.len() {
+            return true;
+        }
+        let limit_sq = 0.25 * self.skin * self.skin;
+        walls
+            .iter()
+            .zip(&self.walls_at_build)
+            .any(|(w, then)| (w.pose.translation.vector - then).norm_squared() >= limit_sq)
+    }
+
+    /// Rebuilds the body pairs and the body–wall pairs if a body or a wall moved half the skin (or the
+    /// counts changed); returns whether it did.
+    pub fn update_with_walls(&mut self, centres: &[Point], radii: &[Real], walls: &[Wall]) -> bool {
+        if self.needs_rebuild(centres) || self.walls_moved(walls) {
+            self.rebuild_with_walls(centres, radii, walls);
+            true
+        } else {
+            false
+        }
+    }
+
+    /// Recomputes the body pairs and the body–wall pairs from scratch.
+    pub fn rebuild_with_walls(&mut self, centres: &[Point], radii: &[Real], walls: &[Wall]) {
+        self.rebuild(centres, radii);
+        self.walls_at_build.clear();
+        self.walls_at_build
+            .extend(walls.iter().map(|w| w.pose.translation.vector));
+        self.wall_pairs = brute_force_wall_pairs(centres, radii, walls, self.skin);
+    }
+
     /// Rebuilds the pair list if [`needs_rebuild`](Self::needs_rebuild); returns whether it did.
     pub fn update(&mut self, centres: &[Point], radii: &[Real]) -> bool {
         if self.needs_rebuild(centres) {
@@ -134,6 +188,10 @@ impl BroadPhase {
             "broad phase: one radius per centre"
         );
         self.rebuilds += 1;
+        // The body–wall list belongs to a build with walls: a plain rebuild forgets it (the next
+        // `update_with_walls` then rebuilds when there are walls).
+        self.wall_pairs.clear();
+        self.walls_at_build.clear();
         self.centres_at_build.clear();
         self.centres_at_build.extend_from_slice(centres);
         self.pairs.clear();
@@ -304,6 +362,25 @@ fn spheres_within(c1: Point, r1: Real, c2: Point, r2: Real, skin: Real) -> bool 
     (c2 - c1).norm_squared() < reach * reach
 }
 
+/// The body–wall candidates: `(body, wall)` for every body whose signed distance from the wall's plane is
+/// below its radius plus `skin`, sorted by body then wall. O(bodies × walls) — the handful of walls of a box.
+pub fn brute_force_wall_pairs(
+    centres: &[Point],
+    radii: &[Real],
+    walls: &[Wall],
+    skin: Real,
+) -> Vec<Pair> {
+    let mut pairs = Vec::new();
+    for (i, (c, &r)) in centres.iter().zip(radii).enumerate() {
+        for (w, wall) in walls.iter().enumerate() {
+            if wall.signed_distance(c) < r + skin {
+                pairs.push((i as u32, w as u32));
+            }
+        }
+    }
+    pairs
+}
+
 /// The O(N²) definition of the candidate pairs: the oracle the grid must match exactly.
 pub fn brute_force_pairs(centres: &[Point], radii: &[Real], skin: Real) -> Vec<Pair> {
     let mut pairs = Vec::new();
@@ -459,6 +536,67 @@ mod tests {
         assert_matches_oracle("sparse huge extent", &sparse, &[0.6; 50], 0.0);
         assert_matches_oracle("no bodies", &[], &[], 0.1);
         assert_matches_oracle("one body", &[Point::origin()], &[1.0], 0.1);
+    }
+
+    #[test]
+    fn wall_pairs_keep_every_body_that_can_touch_a_wall_until_the_rebuild() {
+        use crate::shape::Plane;
+        let (mut centres, radii) = random_scene(5, 400, 1.0, 0.04, 0.06);
+        let skin = 0.02;
+        let wall = |name: &str, normal: Vector, offset: Real, velocity: Vector| Wall {
+            name: name.to_owned(),
+            plane: Plane::new(normal, offset).expect("plane"),
+            pose: crate::math::Pose::identity(),
+            velocity,
+            material: 0,
+        };
+        let mut walls = vec![
+            wall("floor", Vector::z(), 0.05, Vector::zeros()),
+            wall("side", -Vector::x(), -0.95, Vector::zeros()),
+            wall("lid", -Vector::z(), -0.9, Vector::new(0.0, 0.0, -1.0)),
+        ];
+        let mut broad = BroadPhase::new(skin);
+        assert!(broad.update_with_walls(&centres, &radii, &walls));
+        let built = broad.wall_pairs().to_vec();
+        assert!(
+            !built.is_empty(),
+            "no body near a wall: the scene tests nothing"
+        );
+        // Every body moves 0.49 skin in a seeded direction, the lid 0.49 skin down: no rebuild, and every
+        // body–wall pair whose sphere reaches the plane now is in the kept list.
+        let mut rng = SplitMix(9);
+        for c in &mut centres {
+            let d = Vector::new(
+                rng.uniform(-1.0, 1.0),
+                rng.uniform(-1.0, 1.0),
+                rng.uniform(-1.0, 1.0),
+            );
+            *c += d.normalize() * 0.49 * skin;
+        }
+        walls[2].pose.translation.vector.z -= 0.49 * skin;
+        assert!(
+            !broad.update_with_walls(&centres, &radii, &walls),
+            "moves of 0.49 skin must not rebuild"
+        );
+        let touching_now = brute_force_wall_pairs(&centres, &radii, &walls, 0.0);
+        let lost: Vec<_> = touching_now
+            .iter()
+            .filter(|p| built.binary_search(p).is_err())
+            .collect();
+        assert!(
+            lost.is_empty(),
+            "kept wall list ({} pairs) lost pairs that reach a wall now: {lost:?}",
+            built.len()
+        );
+        walls[2].pose.translation.vector.z -= 0.02 * skin;
+        assert!(
+            broad.update_with_walls(&centres, &radii, &walls),
+            "a wall moving 0.51 skin must rebuild"
+        );
+        assert_eq!(
+            broad.wall_pairs(),
+            brute_force_wall_pairs(&centres, &radii, &walls, skin).as_slice()
+        );
     }
 
     #[test]

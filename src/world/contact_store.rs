@@ -48,10 +48,9 @@ pub struct ContactState {
     pub cache: PairCache,
     /// The tangential spring (B relative to A) and the normal it is expressed in.
     pub history: TangentialHistory,
-    /// The step at which the pair entered the candidate list.
+    /// The step at which the pair entered the candidate list (the last step it was in the list is the
+    /// store's [`ContactStore::last_touched`]: an entry that leaves the list is dropped).
     pub since_step: u64,
-    /// The last step at which the pair was in the candidate list (and evaluated).
-    pub last_touched: u64,
     /// The geometry of the last evaluation (A → B).
     pub geometry: ContactGeometry,
     /// The force on B of the last evaluation (N); A received its opposite.
@@ -65,7 +64,6 @@ impl ContactState {
             cache: PairCache::default(),
             history: TangentialHistory::default(),
             since_step: step,
-            last_touched: step,
             geometry: ContactGeometry {
                 kind: ContactKind::Separated,
                 depth: 0.0,
@@ -104,6 +102,8 @@ impl ContactState {
 pub struct ContactStore {
     keys: Vec<ContactKey>,
     states: Vec<ContactState>,
+    /// The step of the last sync: every entry was in the candidate list then.
+    last_touched: u64,
     // Scratch for the merge, kept to avoid reallocating every step (not part of the state).
     #[serde(skip)]
     next_keys: Vec<ContactKey>,
@@ -114,7 +114,9 @@ pub struct ContactStore {
 /// Two stores are equal when they hold the same entries (the merge scratch does not count).
 impl PartialEq for ContactStore {
     fn eq(&self, other: &Self) -> bool {
-        self.keys == other.keys && self.states == other.states
+        self.keys == other.keys
+            && self.states == other.states
+            && self.last_touched == other.last_touched
     }
 }
 
@@ -128,15 +130,14 @@ pub struct SyncCounts {
 
 impl ContactStore {
     /// Makes the store hold exactly one entry per key of `candidates` (sorted, no duplicates), in that
-    /// order: kept entries are marked touched at `step`, new ones are created, the others dropped.
+    /// order: kept entries stay as they are, new ones are created, the others dropped; the store is marked
+    /// touched at `step`.
     pub fn sync(&mut self, candidates: &[ContactKey], step: u64) -> SyncCounts {
         debug_assert!(candidates.windows(2).all(|w| w[0] < w[1]));
+        self.last_touched = step;
         if candidates == self.keys.as_slice() {
             // The same pairs as at the last sync (the usual case between broad-phase rebuilds): every entry
             // is kept in place.
-            for s in &mut self.states {
-                s.last_touched = step;
-            }
             return SyncCounts {
                 kept: candidates.len(),
                 ..SyncCounts::default()
@@ -152,11 +153,10 @@ impl ContactStore {
                 counts.dropped += 1;
             }
             let state = if old < self.keys.len() && self.keys[old] == key {
-                let mut s = self.states[old];
+                let kept = self.states[old];
                 old += 1;
                 counts.kept += 1;
-                s.last_touched = step;
-                s
+                kept
             } else {
                 counts.created += 1;
                 ContactState::new(step)
@@ -180,6 +180,11 @@ impl ContactStore {
 
     pub fn states_mut(&mut self) -> &mut [ContactState] {
         &mut self.states
+    }
+
+    /// The step of the last [`sync`](Self::sync): every entry was in the candidate list at that step.
+    pub fn last_touched(&self) -> u64 {
+        self.last_touched
     }
 
     /// The entry of `key`, if stored.
@@ -224,7 +229,7 @@ mod tests {
         );
         let kept = store.get(&k(0, 1)).expect("kept entry");
         assert_eq!(kept.history.displacement, Vector::new(1.0, 0.0, 0.0));
-        assert_eq!((kept.since_step, kept.last_touched), (0, 5));
+        assert_eq!((kept.since_step, store.last_touched()), (0, 5));
         assert_eq!(store.get(&k(1, 3)).expect("new entry").since_step, 5);
         assert!(store.get(&k(0, 2)).is_none());
     }

@@ -7,7 +7,8 @@
 //!   2. drift             x, q ← x_{n+1}, q_{n+1}; walls move with their prescribed velocity
 //!   3. broad phase       bounding spheres + Verlet skin → sorted body pairs; body–wall pairs by distance
 //!   4. narrow phase      contact store synced to the candidate list; one contact query per candidate
-//!   5. laws              ContactModel::evaluate per overlapping candidate (tangential history in the store)
+//!   5. laws              ContactModel::evaluate per overlapping candidate (tangential history in the store);
+//!                        4 and 5 run fused, one pass over the candidates (the store entry is in cache)
 //!   6. accumulate        per-body sums of forces and torques in candidate order (fixed, deterministic)
 //!  6b. (sleeping on) wake the sleeping islands touched by moving bodies or walls
 //!   7. second half kick  v, L ← v, L + ½Δt (F_{n+1}, p_{n+1})
@@ -29,8 +30,10 @@
 use std::time::{Duration, Instant};
 
 use crate::contact::{
-    query_with, ContactError, ContactGeometry, ContactKind, ContactTolerances, QueryCounters,
+    contact_plane_sphere, contact_sphere_sphere, query_with, ContactError, ContactKind,
+    ContactTolerances, QueryCounters,
 };
+use crate::dynamics::rotation::{drift_isotropic, is_isotropic};
 use crate::dynamics::translation::drift_position;
 use crate::dynamics::{Integrator, Motion, RotationScheme, TranslationParams, ViscousDamping};
 use crate::law::{ContactKinematics, ContactModel, ContactResponse, DampingLaw, TangentialLaw};
@@ -92,6 +95,13 @@ impl StepParams {
 #[derive(Clone, Debug, Default)]
 pub struct StepScratch {
     centres: Vec<Point>,
+    /// Per body: whether it is dynamic, and its world angular velocity (rad/s).
+    dynamic: Vec<bool>,
+    omega: Vec<Vector>,
+    /// Per body: its length scale (m), [`World::length_scale`].
+    scales: Vec<Real>,
+    /// The contact model of each material pair with the skips applied.
+    models: Vec<Option<ContactModel>>,
     candidates: Vec<ContactKey>,
     evaluated: Vec<Evaluated>,
     /// One per chunk of the parallel stages (see [`super::parallel`]).
@@ -106,7 +116,9 @@ pub struct StepScratch {
 pub struct StepCounters {
     pub steps: u64,
     pub broad: Duration,
+    /// The fused narrow phase and laws (one pass over the candidates).
     pub narrow: Duration,
+    /// The collection of the laws' results for the report (the law evaluations are in `narrow`).
     pub laws: Duration,
     pub accumulate: Duration,
     pub integrate: Duration,
@@ -285,22 +297,36 @@ pub fn step(
     let parallel_bodies = world.bodies.len() >= params.parallel.min_bodies;
     let (loads, asleep) = (&world.loads, &world.sleep);
     let skip = params.skips;
-    let splitting = matches!(params.rotation, RotationScheme::Splitting { .. });
+    let splitting = match params.rotation {
+        RotationScheme::Splitting { sub_rotation } => Some(sub_rotation),
+        _ => None,
+    };
     for_each_item(parallel_bodies, &mut world.bodies, |i, body| {
         if asleep.is_asleep(i) || (skip.non_dynamic_pairs && is_at_rest_fixed(body)) {
             return;
         }
         integrator.first_half_kick(body, &loads.forces[i], &loads.torques[i], dt);
-        if skip.still_rotation
-            && splitting
-            && body.is_dynamic()
-            && body.angular_momentum == Vector::zeros()
-        {
-            // Zero angular momentum: the rotation sub-flows are identities (see `skips`).
-            drift_position(body, dt);
-        } else {
-            integrator.drift(body, dt);
+        if let (Some(form), true) = (splitting, body.is_dynamic()) {
+            if skip.still_rotation && body.angular_momentum == Vector::zeros() {
+                // Zero angular momentum: the rotation sub-flows are identities (see `skips`).
+                drift_position(body, dt);
+                return;
+            }
+            if skip.isotropic_rotation && is_isotropic(&body.inertia.0) {
+                // Equal principal moments: the free rotation is one turn about L (see `skips`).
+                drift_position(body, dt);
+                let moment = body.inertia.0.x;
+                drift_isotropic(
+                    form,
+                    &mut body.orientation,
+                    &body.angular_momentum,
+                    moment,
+                    dt,
+                );
+                return;
+            }
         }
+        integrator.drift(body, dt);
     });
     for wall in &mut world.walls {
         wall.pose.translation.vector += dt * wall.velocity;
@@ -376,42 +402,72 @@ fn evaluate_loads(
         .centres
         .extend(world.bodies.iter().map(|b| b.position));
     if !params.skips.verlet_skin {
-        world.broad_phase.rebuild(&scratch.centres, &world.radii);
+        world
+            .broad_phase
+            .rebuild_with_walls(&scratch.centres, &world.radii, &world.walls);
         counters.broad_rebuilds += 1;
-    } else if world.broad_phase.update(&scratch.centres, &world.radii) {
+    } else if world
+        .broad_phase
+        .update_with_walls(&scratch.centres, &world.radii, &world.walls)
+    {
         counters.broad_rebuilds += 1;
     }
     scratch.candidates.clear();
     let skip_non_dynamic = params.skips.non_dynamic_pairs;
+    // Per-body flags and angular velocities, read by the pair loops below: one pass over the bodies instead
+    // of a random access to a whole body (or two frame changes for ω) per pair.
+    scratch.dynamic.clear();
+    scratch
+        .dynamic
+        .extend(world.bodies.iter().map(|b| b.is_dynamic()));
+    scratch.scales.clear();
+    scratch
+        .scales
+        .extend((0..world.bodies.len()).map(|i| world.length_scale(i)));
+    let isotropic = params.skips.isotropic_rotation;
+    scratch.omega.clear();
+    scratch.omega.extend(world.bodies.iter().map(|b| {
+        if isotropic && is_isotropic(&b.inertia.0) {
+            // ω = R J̄⁻¹ Rᵀ L = L / J when J̄ = J·I (see `skips`).
+            b.angular_momentum / b.inertia.0.x
+        } else {
+            b.angular_velocity()
+        }
+    }));
+    let dynamic = &scratch.dynamic;
     for &(a, b) in world.broad_phase.pairs() {
-        if !skip_non_dynamic
-            || world.bodies[a as usize].is_dynamic()
-            || world.bodies[b as usize].is_dynamic()
-        {
+        if !skip_non_dynamic || dynamic[a as usize] || dynamic[b as usize] {
             scratch.candidates.push(ContactKey::Body { a, b });
         }
     }
     counters.body_pairs_tested += scratch.candidates.len() as u64;
-    for (i, body) in world.bodies.iter().enumerate() {
-        if !body.is_dynamic() {
-            continue;
+    // Body–wall pairs: the broad phase's list (bodies that can reach a wall before its next rebuild).
+    let before = scratch.candidates.len();
+    for &(body, wall) in world.broad_phase.wall_pairs() {
+        if dynamic[body as usize] {
+            scratch.candidates.push(ContactKey::Wall { body, wall });
         }
-        for (w, wall) in world.walls.iter().enumerate() {
-            // A body whose bounding sphere does not reach the plane cannot touch it.
-            if wall.signed_distance(&body.position) < world.radii[i] {
-                scratch.candidates.push(ContactKey::Wall {
-                    body: i as u32,
-                    wall: w as u32,
-                });
-                counters.wall_pairs_tested += 1;
-            } else {
-                counters.wall_pairs_rejected += 1;
-            }
+    }
+    let wall_pairs = (scratch.candidates.len() - before) as u64;
+    let dynamic_bodies = dynamic.iter().filter(|&&d| d).count() as u64;
+    counters.wall_pairs_tested += wall_pairs;
+    counters.wall_pairs_rejected += dynamic_bodies * world.walls.len() as u64 - wall_pairs;
+    // The contact models of every material pair with the skips applied, once per step.
+    let n_materials = world.materials.len();
+    scratch.models.clear();
+    for a in 0..n_materials as u32 {
+        for b in 0..n_materials as u32 {
+            let model = world.materials.model(a, b);
+            scratch
+                .models
+                .push(model.map(|m| effective_model(m, &params.skips)));
         }
     }
     counters.broad += t.elapsed();
 
-    // 4. Narrow phase: one query per candidate, in parallel, each writing its own store entry.
+    // 4–5. Narrow phase and laws, fused: per candidate, the contact query then (if the shapes overlap) the
+    // law, in one pass over the store (in parallel, each candidate writing its own store entry and result
+    // slot). Frozen candidates keep their last geometry and force (see [`super::sleeping`]).
     let t = Instant::now();
     // The store is taken out of the world for stages 4–5 so that the queries can read the bodies while
     // writing the per-pair state; it is put back before any return.
@@ -421,57 +477,50 @@ fn evaluate_loads(
     counters.contacts_dropped += sync.dropped as u64;
     let n_candidates = scratch.candidates.len();
     let parallel = n_candidates >= params.parallel.min_candidates;
-    // Every slot is overwritten below (the frozen flag in stage 4, the rest in stage 5): no clearing.
+    // Every slot's flags are overwritten below (the rest only for overlapping pairs): no clearing.
     scratch.evaluated.resize(n_candidates, Evaluated::default());
     let world_ref: &World = world;
     let candidates = &scratch.candidates;
-    let narrow = for_each_chunked(
+    let pair = PairInputs {
+        world: world_ref,
+        omega: &scratch.omega,
+        scales: &scratch.scales,
+        models: &scratch.models,
+        n_materials,
+        dt,
+        step_index,
+    };
+    let scales = &scratch.scales;
+    let evaluated = for_each_chunked(
         parallel,
         contacts.states_mut(),
         &mut scratch.evaluated,
         &mut scratch.workers,
         |i, state, out, worker| {
-            out.frozen = sleeping::is_frozen(world_ref, candidates[i]);
-            if out.frozen {
-                return Ok(());
+            let key = candidates[i];
+            if sleeping::is_frozen(world_ref, key) {
+                return frozen_response(&pair, key, state, out);
             }
-            state.geometry = narrow_phase(params, world_ref, candidates[i], state, worker)?;
-            Ok(())
+            narrow_phase(params, world_ref, scales, key, state, worker).map_err(|source| {
+                StepError::Contact {
+                    step: step_index,
+                    source,
+                }
+            })?;
+            contact_law(&pair, key, state, out)
         },
     );
     for worker in &mut scratch.workers {
         counters.query.merge(&worker.query);
         worker.query = QueryCounters::default();
     }
-    if let Err(source) = narrow {
-        world.contacts = contacts;
-        return Err(StepError::Contact {
-            step: step_index,
-            source,
-        });
-    }
+    world.contacts = contacts;
+    evaluated?;
     counters.narrow += t.elapsed();
 
-    // 5. Laws: one evaluation per candidate, in parallel, each writing its own store entry and result slot.
-    let t = Instant::now();
-    let laws = for_each_chunked(
-        parallel,
-        contacts.states_mut(),
-        &mut scratch.evaluated,
-        &mut scratch.workers,
-        |i, state, out, _| {
-            *out = if out.frozen {
-                frozen_response(world_ref, candidates[i], state, step_index)?
-            } else {
-                contact_law(params, world_ref, candidates[i], state, dt, step_index)?
-            };
-            Ok(())
-        },
-    );
-    world.contacts = contacts;
-    laws?;
     // The report describes the state at the end of the step: an initial evaluation's findings are
     // replaced by those of the step's own evaluation. Collected in candidate order.
+    let t = Instant::now();
     report.contacts = 0;
     report.max_overlap_ratio = 0.0;
     report.overlap_warnings.clear();
@@ -507,6 +556,10 @@ fn evaluate_loads(
     loads.damping_power = 0.0;
     loads.friction_dissipation = 0.0;
     for (key, e) in scratch.candidates.iter().zip(&scratch.evaluated) {
+        if !e.overlapping {
+            // A separated pair contributes nothing (its response slot is stale).
+            continue;
+        }
         let r = &e.response;
         match *key {
             ContactKey::Body { a, b } => {
@@ -542,7 +595,8 @@ fn evaluate_loads(
     Ok(())
 }
 
-/// The result of stage 5 for one candidate.
+/// The result of stage 5 for one candidate. The flags are written for every candidate; the other fields
+/// only when `overlapping` (a separated pair contributes nothing, and no stage reads them).
 #[derive(Clone, Copy, Debug, Default)]
 struct Evaluated {
     response: ContactResponse,
@@ -555,14 +609,52 @@ struct Evaluated {
     overlap_ratio: Real,
 }
 
-/// Stage 4 for one candidate: the contact query between its two shapes (A = body a or the wall, B = body b).
+/// What stages 4–5 read for every candidate, gathered once per step.
+struct PairInputs<'a> {
+    world: &'a World,
+    /// World angular velocity of each body (rad/s).
+    omega: &'a [Vector],
+    /// Length scale of each body (m).
+    scales: &'a [Real],
+    /// The contact model of each material pair (row-major `n_materials²`), with the skips applied.
+    models: &'a [Option<ContactModel>],
+    n_materials: usize,
+    dt: Real,
+    step_index: u64,
+}
+
+impl PairInputs<'_> {
+    fn model(&self, mat_a: u32, mat_b: u32) -> Result<&ContactModel, StepError> {
+        self.models[mat_a as usize * self.n_materials + mat_b as usize]
+            .as_ref()
+            .ok_or(StepError::MissingLaw {
+                step: self.step_index,
+                a: mat_a,
+                b: mat_b,
+            })
+    }
+
+    /// Velocity (m/s) of the material point of body `i` at `point` (world).
+    #[inline]
+    fn velocity_at(&self, i: usize, point: &Point) -> Vector {
+        let body = &self.world.bodies[i];
+        body.velocity + self.omega[i].cross(&(point - body.position))
+    }
+}
+
+/// Stage 4 for one candidate: the contact query between its two shapes (A = body a or the wall, B = body b),
+/// written to `state.geometry`. Sphere–sphere and wall–sphere pairs call their closed forms directly with
+/// the body positions (the dispatcher's own cases, without building the poses: the same values).
+#[inline]
 fn narrow_phase(
     params: &StepParams,
     world: &World,
+    scales: &[Real],
     key: ContactKey,
     state: &mut ContactState,
     worker: &mut Worker,
-) -> Result<ContactGeometry, ContactError> {
+) -> Result<(), ContactError> {
+    let tol = &params.tolerances;
     let (pose_a, shape_a, pose_b, shape_b);
     let wall_shape;
     match key {
@@ -570,22 +662,26 @@ fn narrow_phase(
             let (a, b) = (a as usize, b as usize);
             shape_a = world.shape(a);
             shape_b = world.shape(b);
+            let (xa, xb) = (&world.bodies[a].position, &world.bodies[b].position);
             if params.skips.bounding_spheres {
-                let scale = shape_a
-                    .length_scale()
-                    .unwrap_or(0.0)
-                    .max(shape_b.length_scale().unwrap_or(0.0));
                 if let Some(g) = skips::reject_by_bounding_spheres(
-                    &world.bodies[a].position,
+                    xa,
                     world.radii[a],
-                    &world.bodies[b].position,
+                    xb,
                     world.radii[b],
-                    scale,
-                    &params.tolerances,
+                    scales[a].max(scales[b]),
+                    tol,
                     &mut worker.query,
                 ) {
-                    return Ok(g);
+                    state.geometry = g;
+                    return Ok(());
                 }
+            }
+            if let (Shape::Sphere(sa), Shape::Sphere(sb)) = (shape_a, shape_b) {
+                worker.query.sphere_sphere += 1;
+                state.geometry = contact_sphere_sphere(xa, sa.radius(), xb, sb.radius(), tol);
+                worker.query.record(&state.geometry);
+                return Ok(());
             }
             pose_a = world.pose(a);
             pose_b = world.pose(b);
@@ -596,46 +692,76 @@ fn narrow_phase(
                         pa,
                         &pose_b,
                         pb,
-                        &params.tolerances,
+                        tol,
                         &mut state.cache,
                         &mut worker.query,
                     ) {
-                        return Ok(g);
+                        state.geometry = g;
+                        return Ok(());
                     }
                 }
             }
         }
         ContactKey::Wall { body, wall } => {
             let wall = &world.walls[wall as usize];
+            let body = body as usize;
+            if let Shape::Sphere(s) = world.shape(body) {
+                worker.query.sphere_plane += 1;
+                state.geometry = contact_plane_sphere(
+                    &wall.pose,
+                    wall.plane.normal(),
+                    wall.plane.offset(),
+                    &world.bodies[body].position,
+                    s.radius(),
+                    tol,
+                );
+                worker.query.record(&state.geometry);
+                return Ok(());
+            }
             wall_shape = Shape::Plane(wall.plane);
             pose_a = wall.pose;
             shape_a = &wall_shape;
-            pose_b = world.pose(body as usize);
-            shape_b = world.shape(body as usize);
+            pose_b = world.pose(body);
+            shape_b = world.shape(body);
         }
     }
-    query_with(
+    state.geometry = query_with(
         &pose_a,
         shape_a,
         &pose_b,
         shape_b,
-        &params.tolerances,
+        tol,
         &mut state.cache,
         &mut worker.epa,
         &mut worker.query,
-    )
+    )?;
+    Ok(())
 }
 
 /// Stage 5 for one candidate: the pair's contact model on the geometry of stage 4 (stored in `state`),
-/// updating the tangential history and the stored force.
+/// updating the tangential history and the stored force; the result goes to `out`.
+#[inline]
 fn contact_law(
-    params: &StepParams,
-    world: &World,
+    pair: &PairInputs,
     key: ContactKey,
     state: &mut ContactState,
-    dt: Real,
-    step_index: u64,
-) -> Result<Evaluated, StepError> {
+    out: &mut Evaluated,
+) -> Result<(), StepError> {
+    out.frozen = false;
+    let ContactState {
+        geometry: g,
+        history,
+        force_on_b,
+        ..
+    } = state;
+    if g.kind != ContactKind::Overlap {
+        // The law resets the history of a pair that does not overlap.
+        *history = Default::default();
+        *force_on_b = Vector::zeros();
+        out.overlapping = false;
+        return Ok(());
+    }
+    let world = pair.world;
     let (a_body, a_velocity_at, mat_a, b) = match key {
         ContactKey::Body { a, b } => (Some(a as usize), None, world.material_of[a as usize], b),
         ContactKey::Wall { body, wall } => {
@@ -644,21 +770,7 @@ fn contact_law(
         }
     };
     let b = b as usize;
-    let mat_b = world.material_of[b];
-    let Some(model) = world.materials.model(mat_a, mat_b) else {
-        return Err(StepError::MissingLaw {
-            step: step_index,
-            a: mat_a,
-            b: mat_b,
-        });
-    };
-    let g = &state.geometry;
-    if g.kind != ContactKind::Overlap {
-        // The law resets the history of a pair that does not overlap.
-        state.history = Default::default();
-        state.force_on_b = Vector::zeros();
-        return Ok(Evaluated::default());
-    }
+    let model = pair.model(mat_a, world.material_of[b])?;
     let body_b = &world.bodies[b];
     let (velocity_a, center_a, effective_mass, scale) = match a_body {
         Some(a) => {
@@ -668,35 +780,30 @@ fn contact_law(
                 (true, false) => body_a.mass,
                 _ => body_b.mass,
             };
-            let scale = world.length_scale(a).min(world.length_scale(b));
-            (body_a.velocity_at(&g.point), body_a.position, m, scale)
+            let scale = pair.scales[a].min(pair.scales[b]);
+            (pair.velocity_at(a, &g.point), body_a.position, m, scale)
         }
         None => (
             a_velocity_at.unwrap_or_else(Vector::zeros),
             g.point_a,
             body_b.mass,
-            world.length_scale(b),
+            pair.scales[b],
         ),
     };
     let kinematics = ContactKinematics {
-        relative_velocity: body_b.velocity_at(&g.point) - velocity_a,
+        relative_velocity: pair.velocity_at(b, &g.point) - velocity_a,
         effective_mass,
         center_a,
         center_b: body_b.position,
-        dt,
+        dt: pair.dt,
     };
-    let g = *g;
     let model = model.for_shapes(a_body.map(|a| world.shape(a)), world.shape(b));
-    let model = effective_model(&model, &params.skips);
-    let response = model.evaluate(&g, &kinematics, &mut state.history);
-    state.force_on_b = response.force_on_b;
-    Ok(Evaluated {
-        response,
-        overlapping: true,
-        frozen: false,
-        depth: g.depth,
-        overlap_ratio: g.depth / scale,
-    })
+    out.response = model.evaluate(g, &kinematics, history);
+    *force_on_b = out.response.force_on_b;
+    out.overlapping = true;
+    out.depth = g.depth;
+    out.overlap_ratio = g.depth / scale;
+    Ok(())
 }
 
 /// The model with the slots the skips make free: no tangential spring when μ = 0, no damping term when its
@@ -727,17 +834,17 @@ fn is_at_rest_fixed(body: &crate::dynamics::RigidBody) -> bool {
 /// Stage 5 for a frozen candidate: the kept geometry and force of its last evaluation, the torques about
 /// the unmoved centres and the elastic energy at the kept overlap (see [`super::sleeping`]).
 fn frozen_response(
-    world: &World,
+    pair: &PairInputs,
     key: ContactKey,
     state: &ContactState,
-    step_index: u64,
-) -> Result<Evaluated, StepError> {
+    out: &mut Evaluated,
+) -> Result<(), StepError> {
+    let world = pair.world;
+    out.frozen = true;
     let g = &state.geometry;
     if g.kind != ContactKind::Overlap {
-        return Ok(Evaluated {
-            frozen: true,
-            ..Evaluated::default()
-        });
+        out.overlapping = false;
+        return Ok(());
     }
     let (center_a, mat_a, b) = match key {
         ContactKey::Body { a, b } => (
@@ -748,14 +855,15 @@ fn frozen_response(
         ContactKey::Wall { body, wall } => (g.point_a, world.walls[wall as usize].material, body),
     };
     let b = b as usize;
-    let mat_b = world.material_of[b];
-    let Some(model) = world.materials.model(mat_a, mat_b) else {
-        return Err(StepError::MissingLaw {
-            step: step_index,
-            a: mat_a,
-            b: mat_b,
-        });
-    };
+    let model =
+        world
+            .materials
+            .model(mat_a, world.material_of[b])
+            .ok_or(StepError::MissingLaw {
+                step: pair.step_index,
+                a: mat_a,
+                b: world.material_of[b],
+            })?;
     let shape_a = match key {
         ContactKey::Body { a, .. } => Some(world.shape(a as usize)),
         ContactKey::Wall { .. } => None,
@@ -767,24 +875,22 @@ fn frozen_response(
         ContactKey::Body { a, .. } => world.length_scale(a as usize).min(world.length_scale(b)),
         ContactKey::Wall { .. } => world.length_scale(b),
     };
-    Ok(Evaluated {
-        response: ContactResponse {
-            force_on_b: force,
-            torque_on_a: (g.point - center_a).cross(&(-force)),
-            torque_on_b: (g.point - world.bodies[b].position).cross(&force),
-            normal_force: force.dot(&g.normal),
-            tangential_force: force - g.normal * force.dot(&g.normal),
-            normal_potential: model.normal.potential(g.depth),
-            tangential_potential: 0.5 * k_t * state.history.displacement.norm_squared(),
-            damping_power: 0.0,
-            friction_dissipation: 0.0,
-            sliding: false,
-        },
-        overlapping: true,
-        frozen: true,
-        depth: g.depth,
-        overlap_ratio: g.depth / scale,
-    })
+    out.response = ContactResponse {
+        force_on_b: force,
+        torque_on_a: (g.point - center_a).cross(&(-force)),
+        torque_on_b: (g.point - world.bodies[b].position).cross(&force),
+        normal_force: force.dot(&g.normal),
+        tangential_force: force - g.normal * force.dot(&g.normal),
+        normal_potential: model.normal.potential(g.depth),
+        tangential_potential: 0.5 * k_t * state.history.displacement.norm_squared(),
+        damping_power: 0.0,
+        friction_dissipation: 0.0,
+        sliding: false,
+    };
+    out.overlapping = true;
+    out.depth = g.depth;
+    out.overlap_ratio = g.depth / scale;
+    Ok(())
 }
 
 /// Stage 8: every dynamic body's state and loads are finite.

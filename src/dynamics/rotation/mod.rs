@@ -57,9 +57,11 @@
 //!   accumulate secularly over long runs.
 
 mod explicit;
+mod isotropic;
 mod splitting;
 
 pub use explicit::{drift_explicit_euler, drift_runge_kutta4};
+pub use isotropic::{drift_isotropic, is_isotropic};
 pub use splitting::{drift_splitting, sub_rotation};
 
 use crate::dynamics::body::PrincipalInertia;
