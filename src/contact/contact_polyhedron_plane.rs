@@ -1,27 +1,36 @@
-//! Plane–polyhedron contact: exact depth from the support along the plane normal, the force point at the
-//! support point (the gradient point of the Minkowski overlap).
+//! Plane–polyhedron contact: exact status and depth from the support along the plane normal; the overlap
+//! handed to the law and its force point from the smoothed depth of [`super::wall_depth`].
 //!
-//! The plane (A, a wall) is the half-space {x : n·x ≤ o}. The overlap is the exact support distance
-//! δ = o − min_v n·v over the polyhedron's vertices (B), normal n (from the wall to the body).
+//! The plane (A, a wall) is the half-space {x : n·x ≤ o}. The exact overlap is the support distance
+//! δ = o − min_v n·v over the polyhedron's vertices (B), normal n (from the wall to the body); the contact
+//! status (overlap / touching / separated) is always classified from this exact δ, as the SAT oracle would.
 //!
-//! Contact point: δ is the maximum of the vertex depths, so its gradient with respect to the body's pose is
-//! that of the deepest vertex: a force −U'(δ) n applied at the deepest vertex is exactly the generalised
-//! force of the potential U(δ), which is what makes an elastic law energy-conserving (paper §2.1). c2 is
-//! therefore the deepest vertex and c1 = c2 + δ n its foot on the plane (c1 − c2 = δ n exactly). When several
-//! vertices are equally deep within round-off (1e-12 L: a face or an edge resting flat on the wall) the
-//! point is their centroid, the symmetric element of the sub-gradient. The point jumps between vertices as
-//! a flat face rocks through the tie — the kink of δ = max(d_i) is a property of the Minkowski-overlap model,
-//! not of this path. (A depth-weighted centroid of all penetrating vertices varies continuously but is not
-//! the gradient of any potential; it was measured to lose ~10 % of the energy of an edge landing flat,
-//! `tests/polyhedral_energy_gates.rs`.)
+//! What the law sees depends on [`ContactTolerances::wall_depth`]:
+//! - [`WallDepth::Smoothed`] (default): `depth` is the smoothed depth D ≤ δ of the vertices within 2h of
+//!   the deepest one (D = δ when one vertex leads by 2h or more, and at exact ties), and c2 the
+//!   ∂D/∂d_i-weighted mean of those vertices, brought to the level of the overlap along n; c1 = c2 + D n on
+//!   the plane. A force −U'(D) n at c_M is then exactly the generalised force of U(D), so an elastic law
+//!   conserves energy also when a face or an edge lands flat and rocks (see [`super::wall_depth`]). When
+//!   D ≤ 0 while δ > 0 (a tilted face just touching), the status is `Overlap` with depth 0: the law exerts
+//!   nothing, continuously.
+//! - [`WallDepth::DeepestVertex`]: `depth` is δ and c2 the deepest vertex — the gradient point of
+//!   δ = max(d_i) — or the centroid of the vertices tied with it within round-off (1e-12 L: a face or an edge
+//!   resting exactly flat), the symmetric element of the sub-gradient. The point jumps between vertices as a
+//!   flat face rocks through the tie: first-order energy error (measured in `single_contact_energy`).
+//!   (A depth-weighted centroid of all penetrating vertices varies continuously but is not the gradient of
+//!   any potential; it was measured to lose ~10 % of the energy of an edge landing flat.)
 //!
-//! Status `Exact`. O(V), no allocation.
+//! Status `Exact`. O(V), no allocation unless more than 64 vertices lie within 2h of the deepest one.
 
 use super::contact_sphere_sphere::classify;
 use super::sat::Polytope;
 use super::tolerances::ContactTolerances;
-use super::{ContactGeometry, SolverStatus};
+use super::wall_depth::{smoothed_depth, WallDepth};
+use super::{ContactGeometry, ContactKind, SolverStatus};
 use crate::math::{Point, Pose, Real, Vector};
+
+/// Vertices within 2h of the deepest one that are handled on the stack.
+const STACK_BAND: usize = 64;
 
 /// Contact of the plane (A: pose `pos1`, local outward normal `normal1`, offset `offset1`) with the
 /// polytope `b` at `pos2`.
@@ -46,28 +55,72 @@ pub fn contact_plane_polytope<B: Polytope + ?Sized>(
     let signed = o2 - lowest;
     let touch = tol.touching * b.length_scale();
     let (kind, depth, distance) = classify(signed, touch);
-    // The deepest vertex, or the centroid of the vertices tied with it within round-off.
-    let tie = 1e-12 * b.length_scale();
-    let (mut sum, mut count) = (Vector::zeros(), 0.0);
-    for v in verts {
-        if n2.dot(&v.coords) <= lowest + tie {
-            sum += v.coords;
-            count += 1.0;
+    let (c2_local, law_depth) = match tol.wall_depth {
+        WallDepth::Smoothed { band } if kind == ContactKind::Overlap => {
+            let h = band * b.length_scale();
+            let (point, d) = smoothed_point(verts, &n2, o2, lowest, h);
+            (point, d.max(0.0))
         }
-    }
-    let xbar = sum / count;
-    let c2_local = xbar - n2 * (n2.dot(&xbar) - lowest);
+        _ => {
+            // The deepest vertex, or the centroid of the vertices tied with it within round-off.
+            let tie = 1e-12 * b.length_scale();
+            let (mut sum, mut count) = (Vector::zeros(), 0.0);
+            for v in verts {
+                if n2.dot(&v.coords) <= lowest + tie {
+                    sum += v.coords;
+                    count += 1.0;
+                }
+            }
+            let xbar = sum / count;
+            (xbar - n2 * (n2.dot(&xbar) - lowest), depth)
+        }
+    };
     let point_b = pos2 * Point::from(c2_local);
-    let point_a = point_b + n * signed;
+    // c1 on the plane: c1 − c2 = D n when overlapping, c2 − c1 = d n when apart.
+    let point_a = point_b
+        + n * if kind == ContactKind::Overlap {
+            law_depth
+        } else {
+            signed
+        };
     ContactGeometry::from_points(
         kind,
-        depth,
+        law_depth,
         distance,
         n,
         point_a,
         point_b,
         SolverStatus::Exact,
     )
+}
+
+/// The smoothed depth D of the vertices within 2h of the deepest one (depths d_i = o2 − n2·v_i, deepest
+/// o2 − `lowest`) and the ∂D/∂d_i-weighted mean of those vertices moved along n2 to the level o2 − D, in B's
+/// frame.
+fn smoothed_point(verts: &[Point], n2: &Vector, o2: Real, lowest: Real, h: Real) -> (Vector, Real) {
+    let in_band = |v: &Point| n2.dot(&v.coords) < lowest + 2.0 * h;
+    let count = verts.iter().filter(|v| in_band(v)).count();
+    let mut stack = [[0.0; STACK_BAND]; 3];
+    let mut heap;
+    let [depths, weights, scratch]: [&mut [Real]; 3] = if count <= STACK_BAND {
+        let [a, b, c] = &mut stack;
+        [&mut a[..count], &mut b[..count], &mut c[..count]]
+    } else {
+        heap = vec![0.0; 3 * count];
+        let (a, rest) = heap.split_at_mut(count);
+        let (b, c) = rest.split_at_mut(count);
+        [a, b, c]
+    };
+    for (d, v) in depths.iter_mut().zip(verts.iter().filter(|v| in_band(v))) {
+        *d = o2 - n2.dot(&v.coords);
+    }
+    let d = smoothed_depth(depths, h, weights, scratch);
+    let mut xbar = Vector::zeros();
+    for (w, v) in weights.iter().zip(verts.iter().filter(|v| in_band(v))) {
+        xbar += v.coords * *w;
+    }
+    // Level of the overlap: n2·c2 = o2 − D.
+    (xbar - n2 * (n2.dot(&xbar) - (o2 - d)), d)
 }
 
 #[cfg(test)]
@@ -106,9 +159,16 @@ mod tests {
     /// The torque of the contact force about the body's centre is the gradient of δ with respect to the
     /// body's rotation: d δ / d θ (about axis e) = −((c2 − x_B) × n)·e, checked by central differences on
     /// random tilted poses. This is what makes an elastic law energy-conserving.
+    fn deepest_vertex() -> ContactTolerances {
+        ContactTolerances {
+            wall_depth: WallDepth::DeepestVertex,
+            ..ContactTolerances::default()
+        }
+    }
+
     #[test]
     fn contact_point_is_the_gradient_point_of_the_overlap() {
-        let tol = ContactTolerances::default();
+        let tol = deepest_vertex();
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(9);
         let bx = TestPolytope::cuboid(Vector::new(1.0, 0.5, 0.25));
         let depth_at = |pos2: &Pose| {
@@ -159,7 +219,7 @@ mod tests {
 
     #[test]
     fn depth_is_the_support_distance_for_random_poses() {
-        let tol = ContactTolerances::default();
+        let tol = deepest_vertex();
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(5);
         let bx = TestPolytope::cuboid(Vector::new(1.0, 0.7, 0.3));
         let wall = Pose::from_parts(
@@ -188,6 +248,132 @@ mod tests {
                 (n.dot(&g.point_a.coords) - o).abs() <= 1e-14,
                 "c1 off the wall"
             );
+        }
+    }
+
+    /// Smoothed wall depth: the status is the exact one of the support distance δ, the law's depth D never
+    /// exceeds δ and equals it when one vertex leads by 2h or more, on random and on nearly flat poses.
+    #[test]
+    fn smoothed_depth_keeps_the_exact_status_and_never_exceeds_the_overlap() {
+        let tol = ContactTolerances::default();
+        let WallDepth::Smoothed { band } = tol.wall_depth else {
+            panic!(
+                "the default wall depth is the smoothed one: {:?}",
+                tol.wall_depth
+            );
+        };
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(21);
+        for scale in [1e-3, 1.0, 1e3] {
+            let bx = TestPolytope::cuboid(Vector::new(1.0, 0.7, 0.3) * scale);
+            let h = band * bx.length_scale();
+            for k in 0..400 {
+                let rot = if k % 2 == 0 {
+                    random_rotation(&mut rng)
+                } else {
+                    let axis = Vector::new(
+                        rng.random_range(-1.0..1.0),
+                        rng.random_range(-1.0..1.0),
+                        0.0,
+                    );
+                    crate::math::Rotation::from_scaled_axis(axis * 3.0 * band)
+                };
+                let heights: Vec<Real> = bx.verts.iter().map(|v| (rot * v).z).collect();
+                let low = heights.iter().copied().fold(Real::INFINITY, Real::min);
+                let offset = rng.random_range(-2.0..2.0) * h;
+                let pos2 = Pose::from_parts(Vector::new(0.1, 0.2, -low - offset).into(), rot);
+                let g =
+                    contact_plane_polytope(&Pose::identity(), &Vector::z(), 0.0, &pos2, &bx, &tol);
+                let exact = -heights
+                    .iter()
+                    .map(|z| z + pos2.translation.z)
+                    .fold(Real::INFINITY, Real::min);
+                let (kind, _, distance) = classify(exact, tol.touching * bx.length_scale());
+                assert_eq!(g.kind, kind, "scale {scale}, pose {k}: δ = {exact}, {g:?}");
+                assert!(
+                    (g.distance - distance).abs() <= 1e-15 * scale,
+                    "distance {} want {distance}",
+                    g.distance
+                );
+                assert!(
+                    g.depth <= exact.max(0.0) + 1e-15 * scale,
+                    "scale {scale}, pose {k}: law depth {} above the overlap {exact}",
+                    g.depth
+                );
+                let mut sorted = heights.clone();
+                sorted.sort_by(Real::total_cmp);
+                if kind == ContactKind::Overlap && sorted[1] - sorted[0] >= 2.0 * h {
+                    assert!(
+                        (g.depth - exact).abs() <= 1e-14 * scale,
+                        "scale {scale}, pose {k}: one vertex leads by {} ≥ 2h = {}, depth {} want {exact}",
+                        sorted[1] - sorted[0],
+                        2.0 * h,
+                        g.depth
+                    );
+                }
+                let gap = if kind == ContactKind::Overlap {
+                    g.point_a - g.point_b - g.normal * g.depth
+                } else {
+                    g.point_b - g.point_a - g.normal * g.distance
+                };
+                assert!(
+                    gap.norm() <= 1e-14 * scale + tol.touching * bx.length_scale(),
+                    "scale {scale}, pose {k}: c1, c2 inconsistent with the depth: {g:?}"
+                );
+            }
+        }
+    }
+
+    /// Smoothed wall depth: the force point is the gradient point of the law's depth D. With the body
+    /// nearly flat (several vertices within the band), central differences of D give dD/dθ about each axis
+    /// = −((c2 − x_B) × n)·e, dD/dx along −n = 1 and 0 along the wall: a force −U'(D) n at c_M is the
+    /// generalised force of U(D).
+    #[test]
+    fn smoothed_force_point_is_the_gradient_point_of_the_law_depth() {
+        let tol = ContactTolerances::default();
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(17);
+        let bx = TestPolytope::cuboid(Vector::new(1.0, 0.5, 0.25));
+        let law_depth = |pos2: &Pose| {
+            contact_plane_polytope(&Pose::identity(), &Vector::z(), 0.0, pos2, &bx, &tol).depth
+        };
+        for k in 0..200 {
+            let axis = Vector::new(
+                rng.random_range(-1.0..1.0),
+                rng.random_range(-1.0..1.0),
+                0.0,
+            );
+            let rot = crate::math::Rotation::from_scaled_axis(axis * 4e-3 * (k % 4) as Real);
+            let low = bx
+                .verts
+                .iter()
+                .map(|v| (rot * v).z)
+                .fold(Real::INFINITY, Real::min);
+            let pos2 = Pose::from_parts(Vector::new(0.3, -0.2, -low - 1e-2).into(), rot);
+            let g = contact_plane_polytope(&Pose::identity(), &Vector::z(), 0.0, &pos2, &bx, &tol);
+            assert_eq!(g.kind, ContactKind::Overlap);
+            assert!(g.depth > 0.0);
+            let arm = g.point_b - Point::from(pos2.translation.vector);
+            let e_fd = 1e-7;
+            for e in [Vector::x(), Vector::y(), Vector::z()] {
+                let turn = |s: Real| {
+                    let r = crate::math::Rotation::from_scaled_axis(e * s);
+                    Pose::from_parts(pos2.translation, r * pos2.rotation)
+                };
+                let fd = (law_depth(&turn(e_fd)) - law_depth(&turn(-e_fd))) / (2.0 * e_fd);
+                let want = -arm.cross(&g.normal).dot(&e);
+                assert!(
+                    (fd - want).abs() < 1e-6,
+                    "pose {k}, axis {e:?}: dD/dθ = {fd}, torque arm gives {want}"
+                );
+                let shift = |s: Real| {
+                    Pose::from_parts((pos2.translation.vector + e * s).into(), pos2.rotation)
+                };
+                let fd = (law_depth(&shift(e_fd)) - law_depth(&shift(-e_fd))) / (2.0 * e_fd);
+                let want = -e.dot(&g.normal);
+                assert!(
+                    (fd - want).abs() < 1e-6,
+                    "pose {k}, shift {e:?}: dD/dx = {fd}, want {want}"
+                );
+            }
         }
     }
 }

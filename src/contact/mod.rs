@@ -29,6 +29,7 @@ pub mod gjk;
 pub mod minkowski;
 pub mod sat;
 pub mod tolerances;
+pub mod wall_depth;
 
 #[cfg(test)]
 pub(crate) mod testing;
@@ -51,3 +52,4 @@ pub use epa::EpaScratch;
 pub use geometry::{ContactGeometry, ContactKind, SolverStatus};
 pub use sat::{sat_polytopes, Polytope};
 pub use tolerances::ContactTolerances;
+pub use wall_depth::WallDepth;

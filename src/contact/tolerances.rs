@@ -30,6 +30,9 @@ pub struct ContactTolerances {
     /// Iteration cap of EPA (default 256; each iteration adds one vertex). Reaching it triggers the exact
     /// fallback.
     pub epa_max_iterations: u32,
+    /// The overlap a polyhedron–wall contact hands to the law (default: the smoothed depth with a band of
+    /// 1e-4 L; see [`super::wall_depth`]). Not a tolerance of the status, which is always exact.
+    pub wall_depth: super::wall_depth::WallDepth,
 }
 
 impl Default for ContactTolerances {
@@ -40,6 +43,7 @@ impl Default for ContactTolerances {
             epa_gap: 1e-13,
             gjk_max_iterations: 128,
             epa_max_iterations: 256,
+            wall_depth: Default::default(),
         }
     }
 }

@@ -5,7 +5,9 @@
 
 use std::sync::Arc;
 
-use polydem::contact::{query, EpaScratch, PairCache, QueryCounters};
+use polydem::contact::{
+    query_with, ContactTolerances, EpaScratch, PairCache, QueryCounters, WallDepth,
+};
 use polydem::dynamics::{
     Integrator, Motion, PrincipalInertia, RigidBody, RotationScheme, TranslationParams,
     ViscousDamping,
@@ -30,8 +32,15 @@ pub struct Run {
     pub max_tilt: Real,
 }
 
-/// The cube on the incline of angle `theta` with friction `mu`, for `duration` seconds.
+/// The cube on the incline of angle `theta` with friction `mu`, for `duration` seconds. The wall contact
+/// is the smoothed depth with its band set by the rule of `polydem::contact::wall_depth`: h = the static
+/// overlap m g cos θ / k_n.
 pub fn slide(theta: Real, mu: Real, duration: Real) -> Run {
+    slide_with(theta, mu, duration, None)
+}
+
+/// [`slide`] with the given wall contact law (`None`: the smoothed depth with h = the static overlap).
+pub fn slide_with(theta: Real, mu: Real, duration: Real, wall_depth: Option<WallDepth>) -> Run {
     let h = 0.5 * SIDE;
     let mut corners = Vec::new();
     for sx in [-h, h] {
@@ -50,6 +59,12 @@ pub fn slide(theta: Real, mu: Real, duration: Real) -> Run {
     let model = linear_spring_dashpot(k_n, k_t, 0.3, mu).unwrap();
     let gravity = Vector::new(G * theta.sin(), 0.0, -G * theta.cos());
     let static_overlap = mass * G * theta.cos() / k_n;
+    let tolerances = ContactTolerances {
+        wall_depth: wall_depth.unwrap_or(WallDepth::Smoothed {
+            band: static_overlap / shape_b.length_scale().expect("a polyhedron has a size"),
+        }),
+        ..ContactTolerances::default()
+    };
     let mut wall = RigidBody::new_dynamic(
         Point::origin(),
         1.0,
@@ -80,11 +95,12 @@ pub fn slide(theta: Real, mu: Real, duration: Real) -> Run {
     let mut history = TangentialHistory::default();
     let pose = |b: &RigidBody| Pose::from_parts(b.position.coords.into(), b.orientation);
     let mut evaluate = |body: &RigidBody, history: &mut TangentialHistory| {
-        let g = query(
+        let g = query_with(
             &pose(&wall),
             &shape_a,
             &pose(body),
             &shape_b,
+            &tolerances,
             &mut cache,
             &mut scratch,
             &mut counters,
