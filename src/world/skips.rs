@@ -3,7 +3,7 @@
 //!
 //! | switch | what is skipped | equivalence with the switch off |
 //! |---|---|---|
-//! | `bounding_spheres` | the query of a body pair whose bounding spheres are apart by more than the touching band | same forces; the pair's GJK warm start is not refreshed, so later EPA answers of that pair may differ at the solver tolerance |
+//! | `bounding_spheres` | the query of a body pair whose bounding spheres are apart by more than the touching band, and of a body–wall pair whose bounding sphere does not reach the plane | same forces; the pair's GJK warm start is not refreshed, so later EPA answers of that pair may differ at the solver tolerance |
 //! | `cached_axis` | GJK for a polyhedron pair still separated along its cached separating direction (one support call per shape) | as above |
 //! | `verlet_skin` | broad-phase rebuilds while no body moved half the skin since the last one | exact: the pair list only differs by pairs whose bounding spheres are farther apart than the skin |
 //! | `frictionless_history` | the tangential spring of pairs with μ = 0 (its force is zero: the Coulomb cap is 0) | bit-identical bodies and forces (up to the sign of zero); the stored history stays empty |
@@ -98,6 +98,30 @@ pub fn reject_by_bounding_spheres(
     let dist = dist_sq.sqrt();
     let n = d / dist;
     Some(separated(dist - ra - rb, n, xa + n * ra, xb - n * rb))
+}
+
+/// The bounding-sphere rejection of a body against a wall: `Some(separated)` when the body's bounding
+/// sphere (centre `x`, radius `r`) does not reach the plane (signed distance `distance` ≥ r: the body
+/// cannot touch it). The wall is A, `normal` its world normal. The step's body–wall list has a skin, so it
+/// holds such pairs; this keeps the exact query for those that can touch.
+pub fn reject_wall_by_bounding_sphere(
+    distance: Real,
+    normal: &Vector,
+    x: &Point,
+    r: Real,
+    counters: &mut QueryCounters,
+) -> Option<ContactGeometry> {
+    if distance < r {
+        return None;
+    }
+    counters.bounding_sphere_rejections += 1;
+    counters.separated += 1;
+    Some(separated(
+        distance - r,
+        *normal,
+        x - normal * distance,
+        x - normal * r,
+    ))
 }
 
 /// The cached-axis rejection of two polyhedra at `pos1`, `pos2`: `Some(separated)` when the pair's cached

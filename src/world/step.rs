@@ -95,11 +95,10 @@ impl StepParams {
 #[derive(Clone, Debug, Default)]
 pub struct StepScratch {
     centres: Vec<Point>,
-    /// Per body: whether it is dynamic, and its world angular velocity (rad/s).
+    /// Per body: whether it is dynamic.
     dynamic: Vec<bool>,
-    omega: Vec<Vector>,
-    /// Per body: its length scale (m), [`World::length_scale`].
-    scales: Vec<Real>,
+    /// Whether some body has a prescribed motion (its power enters the ledger).
+    any_prescribed: bool,
     /// The contact model of each material pair with the skips applied.
     models: Vec<Option<ContactModel>>,
     candidates: Vec<ContactKey>,
@@ -118,7 +117,8 @@ pub struct StepCounters {
     pub broad: Duration,
     /// The fused narrow phase and laws (one pass over the candidates).
     pub narrow: Duration,
-    /// The collection of the laws' results for the report (the law evaluations are in `narrow`).
+    /// Zero since the laws run fused with the narrow phase (their time is in `narrow`); kept so that the
+    /// summaries keep their columns.
     pub laws: Duration,
     pub accumulate: Duration,
     pub integrate: Duration,
@@ -290,7 +290,16 @@ pub fn step(
     }
     let external_power_start = world.loads.external_power;
     let damping_power_start = world.loads.damping_power;
-    let viscous_start = viscous_power(world, |m| params.damping.coefficient(m));
+    // Without global damping the viscous power is zero: no pass over the bodies.
+    let damped = params.damping != ViscousDamping::None;
+    let viscous = |world: &World| {
+        if damped {
+            viscous_power(world, |m| params.damping.coefficient(m))
+        } else {
+            0.0
+        }
+    };
+    let viscous_start = viscous(world);
 
     // 1–2. First half kick with the kept loads, drift.
     let t = Instant::now();
@@ -372,7 +381,7 @@ pub fn step(
     report.counters.sleeping_body_steps += world.sleep.sleeping as u64;
 
     // 9. Ledger and counters.
-    let viscous_end = viscous_power(world, |m| params.damping.coefficient(m));
+    let viscous_end = viscous(world);
     let ledger = &mut world.ledger;
     ledger.dissipated_damping += 0.5 * (damping_power_start + world.loads.damping_power) * dt;
     ledger.dissipated_friction += world.loads.friction_dissipation;
@@ -420,20 +429,10 @@ fn evaluate_loads(
     scratch
         .dynamic
         .extend(world.bodies.iter().map(|b| b.is_dynamic()));
-    scratch.scales.clear();
-    scratch
-        .scales
-        .extend((0..world.bodies.len()).map(|i| world.length_scale(i)));
-    let isotropic = params.skips.isotropic_rotation;
-    scratch.omega.clear();
-    scratch.omega.extend(world.bodies.iter().map(|b| {
-        if isotropic && is_isotropic(&b.inertia.0) {
-            // ω = R J̄⁻¹ Rᵀ L = L / J when J̄ = J·I (see `skips`).
-            b.angular_momentum / b.inertia.0.x
-        } else {
-            b.angular_velocity()
-        }
-    }));
+    scratch.any_prescribed = world
+        .bodies
+        .iter()
+        .any(|b| matches!(b.motion, Motion::Prescribed { .. }));
     let dynamic = &scratch.dynamic;
     for &(a, b) in world.broad_phase.pairs() {
         if !skip_non_dynamic || dynamic[a as usize] || dynamic[b as usize] {
@@ -483,14 +482,12 @@ fn evaluate_loads(
     let candidates = &scratch.candidates;
     let pair = PairInputs {
         world: world_ref,
-        omega: &scratch.omega,
-        scales: &scratch.scales,
+        isotropic: params.skips.isotropic_rotation,
         models: &scratch.models,
         n_materials,
         dt,
         step_index,
     };
-    let scales = &scratch.scales;
     let evaluated = for_each_chunked(
         parallel,
         contacts.states_mut(),
@@ -501,7 +498,7 @@ fn evaluate_loads(
             if sleeping::is_frozen(world_ref, key) {
                 return frozen_response(&pair, key, state, out);
             }
-            narrow_phase(params, world_ref, scales, key, state, worker).map_err(|source| {
+            narrow_phase(params, world_ref, key, state, worker).map_err(|source| {
                 StepError::Contact {
                     step: step_index,
                     source,
@@ -518,32 +515,12 @@ fn evaluate_loads(
     evaluated?;
     counters.narrow += t.elapsed();
 
-    // The report describes the state at the end of the step: an initial evaluation's findings are
-    // replaced by those of the step's own evaluation. Collected in candidate order.
+    // 6. Accumulate, in candidate order, with the report (the state at the end of the step: an initial
+    // evaluation's findings are replaced by those of the step's own evaluation), in one pass.
     let t = Instant::now();
     report.contacts = 0;
     report.max_overlap_ratio = 0.0;
     report.overlap_warnings.clear();
-    for (key, e) in scratch.candidates.iter().zip(&scratch.evaluated) {
-        counters.frozen_pairs += e.frozen as u64;
-        if !e.overlapping {
-            continue;
-        }
-        report.contacts += 1;
-        report.max_overlap_ratio = report.max_overlap_ratio.max(e.overlap_ratio);
-        if e.overlap_ratio > params.overlap_warning_fraction {
-            report.overlap_warnings.push(OverlapWarning {
-                key: *key,
-                depth: e.depth,
-                ratio: e.overlap_ratio,
-            });
-        }
-    }
-    counters.contacts += report.contacts as u64;
-    counters.laws += t.elapsed();
-
-    // 6. Accumulate, in candidate order.
-    let t = Instant::now();
     let n = world.bodies.len();
     let loads = &mut world.loads;
     loads.forces.clear();
@@ -556,9 +533,19 @@ fn evaluate_loads(
     loads.damping_power = 0.0;
     loads.friction_dissipation = 0.0;
     for (key, e) in scratch.candidates.iter().zip(&scratch.evaluated) {
+        counters.frozen_pairs += e.frozen as u64;
         if !e.overlapping {
             // A separated pair contributes nothing (its response slot is stale).
             continue;
+        }
+        report.contacts += 1;
+        report.max_overlap_ratio = report.max_overlap_ratio.max(e.overlap_ratio);
+        if e.overlap_ratio > params.overlap_warning_fraction {
+            report.overlap_warnings.push(OverlapWarning {
+                key: *key,
+                depth: e.depth,
+                ratio: e.overlap_ratio,
+            });
         }
         let r = &e.response;
         match *key {
@@ -578,9 +565,15 @@ fn evaluate_loads(
         loads.damping_power += r.damping_power;
         loads.friction_dissipation += r.friction_dissipation;
     }
+    counters.contacts += report.contacts as u64;
     // Power delivered to the system by everything that moves without responding to forces.
     let mut external_power = 0.0;
-    for (i, body) in world.bodies.iter().enumerate() {
+    let prescribed = if scratch.any_prescribed {
+        world.bodies.as_slice()
+    } else {
+        &[]
+    };
+    for (i, body) in prescribed.iter().enumerate() {
         if let Motion::Prescribed { .. } = body.motion {
             external_power -= loads.forces[i].dot(&body.velocity)
                 + loads.torques[i].dot(&body.angular_velocity());
@@ -612,10 +605,8 @@ struct Evaluated {
 /// What stages 4–5 read for every candidate, gathered once per step.
 struct PairInputs<'a> {
     world: &'a World,
-    /// World angular velocity of each body (rad/s).
-    omega: &'a [Vector],
-    /// Length scale of each body (m).
-    scales: &'a [Real],
+    /// Whether ω of a body with equal principal moments is taken as L/J (the `isotropic_rotation` skip).
+    isotropic: bool,
     /// The contact model of each material pair (row-major `n_materials²`), with the skips applied.
     models: &'a [Option<ContactModel>],
     n_materials: usize,
@@ -634,11 +625,20 @@ impl PairInputs<'_> {
             })
     }
 
-    /// Velocity (m/s) of the material point of body `i` at `point` (world).
+    /// Velocity (m/s) of the material point of body `i` at `point` (world): [`RigidBody::velocity_at`],
+    /// with ω = L/J for a body with equal principal moments when the skip is on (ω = R J̄⁻¹ Rᵀ L = L/J
+    /// when J̄ = J·I; see `skips`).
+    ///
+    /// [`RigidBody::velocity_at`]: crate::dynamics::RigidBody::velocity_at
     #[inline]
     fn velocity_at(&self, i: usize, point: &Point) -> Vector {
         let body = &self.world.bodies[i];
-        body.velocity + self.omega[i].cross(&(point - body.position))
+        let omega = if self.isotropic && is_isotropic(&body.inertia.0) {
+            body.angular_momentum / body.inertia.0.x
+        } else {
+            body.angular_velocity()
+        };
+        body.velocity + omega.cross(&(point - body.position))
     }
 }
 
@@ -649,7 +649,6 @@ impl PairInputs<'_> {
 fn narrow_phase(
     params: &StepParams,
     world: &World,
-    scales: &[Real],
     key: ContactKey,
     state: &mut ContactState,
     worker: &mut Worker,
@@ -669,7 +668,10 @@ fn narrow_phase(
                     world.radii[a],
                     xb,
                     world.radii[b],
-                    scales[a].max(scales[b]),
+                    shape_a
+                        .length_scale()
+                        .unwrap_or(0.0)
+                        .max(shape_b.length_scale().unwrap_or(0.0)),
                     tol,
                     &mut worker.query,
                 ) {
@@ -705,6 +707,20 @@ fn narrow_phase(
         ContactKey::Wall { body, wall } => {
             let wall = &world.walls[wall as usize];
             let body = body as usize;
+            if params.skips.bounding_spheres {
+                // The wall list has a skin: a body listed may still be beyond its radius from the plane.
+                let x = &world.bodies[body].position;
+                if let Some(g) = skips::reject_wall_by_bounding_sphere(
+                    wall.signed_distance(x),
+                    &wall.normal_world(),
+                    x,
+                    world.radii[body],
+                    &mut worker.query,
+                ) {
+                    state.geometry = g;
+                    return Ok(());
+                }
+            }
             if let Shape::Sphere(s) = world.shape(body) {
                 worker.query.sphere_plane += 1;
                 state.geometry = contact_plane_sphere(
@@ -780,14 +796,14 @@ fn contact_law(
                 (true, false) => body_a.mass,
                 _ => body_b.mass,
             };
-            let scale = pair.scales[a].min(pair.scales[b]);
+            let scale = world.length_scale(a).min(world.length_scale(b));
             (pair.velocity_at(a, &g.point), body_a.position, m, scale)
         }
         None => (
             a_velocity_at.unwrap_or_else(Vector::zeros),
             g.point_a,
             body_b.mass,
-            pair.scales[b],
+            world.length_scale(b),
         ),
     };
     let kinematics = ContactKinematics {
