@@ -299,6 +299,16 @@ pub fn summary(config: &ExperimentConfig, r: &ExperimentResult) -> String {
         p.max_overlap_ratio,
         p.steps_with_overlap_warnings
     );
+    let zones: Vec<String> = p
+        .disturbed_by_threshold
+        .iter()
+        .map(|(f, n, w)| format!("{f}: {n} rocks, {w:.2} sizes"))
+        .collect();
+    let _ = writeln!(
+        s,
+        "  disturbed zone by displacement threshold (mean sizes): {}",
+        zones.join("; ")
+    );
     s
 }
 

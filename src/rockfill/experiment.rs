@@ -16,6 +16,7 @@ use super::penetration::{
 use super::projectile::{Projectile, ProjectileError};
 use super::seeds::{Region, SeedError};
 use super::statistics::{sample_statistics, SampleStatistics};
+use crate::io::checkpoint::CheckpointError;
 use crate::math::{Point, Real};
 use crate::world::World;
 
@@ -42,7 +43,8 @@ pub enum BedSource<'a> {
     /// Generate and pack; save the packed bed into the directory if one is given (the checkpoint
     /// `bed.pdck` with `bed_info.json`, and the CSV files; see [`super::bed`]).
     Generate { save: Option<&'a Path> },
-    /// Load a bed saved earlier: its checkpoint when the directory has one, else its CSV files.
+    /// Load a bed saved earlier: its checkpoint when the directory has one (its CSV files when the checkpoint
+    /// is of another format version), else its CSV files.
     Load(&'a Path),
 }
 
@@ -116,9 +118,27 @@ pub fn run_experiment_with(
     let projectile = Projectile::new(config.projectile)?;
     let (mut world, generation, packing, bed_info, from_checkpoint) = match bed {
         BedSource::Load(dir) => {
-            let checkpoint = has_checkpoint(dir);
+            let mut checkpoint = has_checkpoint(dir);
             let world = if checkpoint {
-                load_bed_checkpoint(dir)?
+                match load_bed_checkpoint(dir) {
+                    Ok(world) => world,
+                    // A checkpoint of another format version (written by another build): the CSV files of
+                    // the same bed are version-free.
+                    Err(BedError::Checkpoint(CheckpointError::UnsupportedVersion {
+                        found,
+                        supported,
+                    })) if dir.join("bed_rocks.csv").is_file() => {
+                        progress(
+                            "bed",
+                            format!(
+                                "checkpoint format {found} is not this build's ({supported}): reading the CSV bed"
+                            ),
+                        );
+                        checkpoint = false;
+                        load_bed(config, dir)?
+                    }
+                    Err(e) => return Err(e.into()),
+                }
             } else {
                 load_bed(config, dir)?
             };

@@ -92,6 +92,10 @@ impl MonitorRow {
     }
 }
 
+/// Displacement thresholds (in mean sizes) at which the disturbed zone is also measured: the paper's
+/// "affected range" is read off a picture, with no threshold stated.
+pub const DISTURBED_THRESHOLDS: [Real; 5] = [0.01, 0.02, 0.05, 0.1, 0.2];
+
 /// How the run ended.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Outcome {
@@ -219,6 +223,8 @@ pub struct PenetrationReport {
     /// Width of the disturbed zone (see the module docs), in metres and in mean rock sizes.
     pub disturbed_width: Real,
     pub disturbed_width_sizes: Real,
+    /// The zone at each of [`DISTURBED_THRESHOLDS`]: (threshold / mean size, rocks, width in mean sizes).
+    pub disturbed_by_threshold: Vec<(Real, usize, Real)>,
     /// Energy-ledger balance at the end / the projectile's initial kinetic energy.
     pub ledger_balance_relative: Real,
     /// Projectile kinetic energy lost (J) and the terms it went to (J).
@@ -393,22 +399,33 @@ pub fn penetrate_with(
     // Disturbed zone.
     let aim_y = 0.5 * config.layer.width;
     let aim_z = rows.first().map_or(0.0, |r| r.position.z);
-    let threshold = imp.disturbed_threshold * config.rock.mean_size;
-    let mut radii: Vec<Real> = (0..world.bodies.len())
-        .filter(|&i| i != index && world.bodies[i].is_dynamic())
-        .filter(|&i| (world.bodies[i].position - start_positions[i]).norm() > threshold)
-        .map(|i| {
-            let p = start_positions[i];
-            ((p.y - aim_y).powi(2) + (p.z - aim_z).powi(2)).sqrt()
+    let zone = |fraction: Real| -> (usize, Real) {
+        let threshold = fraction * config.rock.mean_size;
+        let mut radii: Vec<Real> = (0..world.bodies.len())
+            .filter(|&i| i != index && world.bodies[i].is_dynamic())
+            .filter(|&i| (world.bodies[i].position - start_positions[i]).norm() > threshold)
+            .map(|i| {
+                let p = start_positions[i];
+                ((p.y - aim_y).powi(2) + (p.z - aim_z).powi(2)).sqrt()
+            })
+            .collect();
+        radii.sort_by(|a, b| a.total_cmp(b));
+        let width = if radii.is_empty() {
+            0.0
+        } else {
+            let k = ((0.95 * radii.len() as Real).ceil() as usize).clamp(1, radii.len()) - 1;
+            2.0 * radii[k]
+        };
+        (radii.len(), width)
+    };
+    let (disturbed_rocks, width) = zone(imp.disturbed_threshold);
+    let disturbed_by_threshold = DISTURBED_THRESHOLDS
+        .iter()
+        .map(|&f| {
+            let (n, w) = zone(f);
+            (f, n, w / config.rock.mean_size)
         })
         .collect();
-    radii.sort_by(|a, b| a.total_cmp(b));
-    let width = if radii.is_empty() {
-        0.0
-    } else {
-        let k = ((0.95 * radii.len() as Real).ceil() as usize).clamp(1, radii.len()) - 1;
-        2.0 * radii[k]
-    };
     let energy = world.energy();
     let kinetic = body.translational_kinetic_energy() + body.rotational_kinetic_energy();
     Ok(PenetrationReport {
@@ -431,7 +448,8 @@ pub fn penetrate_with(
             .iter()
             .map(|r| r.axial_force.abs())
             .fold(0.0, Real::max),
-        disturbed_rocks: radii.len(),
+        disturbed_rocks,
+        disturbed_by_threshold,
         disturbed_width: width,
         disturbed_width_sizes: width / config.rock.mean_size,
         ledger_balance_relative: energy.balance / kinetic0,

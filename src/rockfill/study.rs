@@ -95,11 +95,15 @@ pub struct StudyRun {
     pub resistance_cv: Real,
     pub resistance_cv_window: Real,
     pub disturbed_width_sizes: Real,
+    /// The width with a displacement threshold of 0.02 mean sizes instead of the experiment's.
+    pub disturbed_width_sizes_002: Real,
+    /// Largest overlap / particle size of the run.
+    pub max_overlap_ratio: Real,
     pub ledger_balance: Real,
 }
 
 impl StudyRun {
-    pub const CSV_HEADER: &'static str = "size_mm,seed,width_m,height_m,rocks,bed,generation_s,packing_s,penetration_s,solid_fraction,exited,residual_speed,velocity_deflection_deg,axis_deflection_deg,max_velocity_deflection_deg,max_axis_deflection_deg,resistance_mean_n,resistance_cv,resistance_cv_window,disturbed_width_sizes,ledger_balance";
+    pub const CSV_HEADER: &'static str = "size_mm,seed,width_m,height_m,rocks,bed,generation_s,packing_s,penetration_s,solid_fraction,exited,residual_speed,velocity_deflection_deg,axis_deflection_deg,max_velocity_deflection_deg,max_axis_deflection_deg,resistance_mean_n,resistance_cv,resistance_cv_window,disturbed_width_sizes,disturbed_width_sizes_002,max_overlap_ratio,ledger_balance";
 
     pub fn from_result(size_mm: Real, config: &ExperimentConfig, r: &ExperimentResult) -> Self {
         let p = &r.penetration;
@@ -134,13 +138,19 @@ impl StudyRun {
             resistance_cv: p.resistance.cv,
             resistance_cv_window: p.resistance.cv_window,
             disturbed_width_sizes: p.disturbed_width_sizes,
+            disturbed_width_sizes_002: p
+                .disturbed_by_threshold
+                .iter()
+                .find(|z| z.0 == 0.02)
+                .map_or(Real::NAN, |z| z.2),
+            max_overlap_ratio: p.max_overlap_ratio,
             ledger_balance: p.ledger_balance_relative,
         }
     }
 
     pub fn csv_row(&self) -> String {
         format!(
-            "{},{},{},{},{},{},{:.3},{:.3},{:.3},{:.4},{},{:.3},{:.4},{:.4},{:.4},{:.4},{:.6e},{:.4},{:.4},{:.3},{:.3e}",
+            "{},{},{},{},{},{},{:.3},{:.3},{:.3},{:.4},{},{:.3},{:.4},{:.4},{:.4},{:.4},{:.6e},{:.4},{:.4},{:.3},{:.3},{:.4},{:.3e}",
             self.size_mm,
             self.seed,
             self.width,
@@ -161,6 +171,8 @@ impl StudyRun {
             self.resistance_cv,
             self.resistance_cv_window,
             self.disturbed_width_sizes,
+            self.disturbed_width_sizes_002,
+            self.max_overlap_ratio,
             self.ledger_balance
         )
     }
