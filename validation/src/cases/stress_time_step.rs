@@ -1,7 +1,8 @@
 //! Stability stress test, the largest stable time step (issue 5): for a polyhedron resting on a wall under
 //! gravity (linear and Hertz-type laws, several masses and stiffnesses), the largest Δt at which the run
 //! stays stable is found by bisection and compared with the scene's theoretical limit
-//! Δt_max = 2/ω_max (`polydem::scene::time_step`: ω² = κ k_eff/m*, κ = 1 + m r_b²/J_min).
+//! Δt_max = f(n) · 2/ω_max (`polydem::scene::time_step`: ω² = κ k_eff/m*, κ = 1 + m r_b²/J_min, f(n) the
+//! overshoot factor of a stiffening law, 1 for the linear law and 0.7314 for n = 3/2).
 //!
 //! The test: the body is placed touching the floor (zero overlap) at rest, tilted so that one vertex
 //! touches first; gravity pulls it into the contact, it rocks and rattles on its vertices (e = 1, no
@@ -251,7 +252,7 @@ impl Case for StressTimeStep {
         }
         ctx.section("Largest stable step against the theory");
         ctx.text(&format!(
-            "Δt_max(theory) is the scene's stability limit 2/ω_max with κ = 1 + m r_b²/J_min; the translation-only \
+            "Δt_max(theory) is the scene's stability limit f(n) · 2/ω_max with κ = 1 + m r_b²/J_min and the overshoot factor f(n) (1 linear, 0.7314 for n = 3/2); the translation-only \
              limit is 2√(m/k_eff) with k_eff the tangent stiffness at the peak overlap. Found: the largest stable Δt \
              by bisection to a relative {:.0e} ({} steps per trial, unstable when the energy error exceeds {} \
              m g L (L the body's size: enough to throw it its own size out of the contact), or a step fails).",
