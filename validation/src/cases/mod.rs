@@ -7,6 +7,7 @@ pub mod chung_ooi;
 pub mod contact;
 pub mod friction;
 pub mod perf;
+pub mod polyhedra_bed;
 pub mod polyhedra_box;
 pub mod precession;
 pub mod restitution;
@@ -30,6 +31,7 @@ pub fn registry() -> Vec<&'static dyn Case> {
         &friction::Friction,
         &rockfill::Rockfill,
         &sphere_bed::SphereBed,
+        &polyhedra_bed::PolyhedraBed,
         &polyhedra_box::PolyhedraBox,
         &stress_long_run::StressLongRun,
         &stress_impact::StressImpact,

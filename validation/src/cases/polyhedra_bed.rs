@@ -1,0 +1,748 @@
+//! Case `polyhedra_bed` (issue 7): the sphere-bed penetration with every sphere of the settled bed replaced
+//! by a random convex polyhedron of the same volume (polydem only), run beside the sphere bed of the same
+//! scene, to show what the shape of the grains does to the penetration.
+
+pub mod crossings;
+pub mod generate;
+
+use std::path::Path;
+
+use polydem::math::Real;
+
+use generate::BedBody;
+
+/// The sphere bed whose spheres are replaced (relative to the repository root).
+pub const SPHERE_FILE: &str = "reference/sphere_bed/bed_quick.csv";
+/// The settled state of the polyhedral bed (relative to the repository root).
+pub const STATE_FILE: &str = "reference/sphere_bed/polyhedra_bed.csv";
+/// Gap between the projectile and the highest point of the bed at the start (m), as in the sphere bed.
+pub const PROJECTILE_GAP: Real = 0.5e-3;
+/// Radius of the projectile (m), as in the sphere bed.
+pub const PROJECTILE_RADIUS: Real = 5.0e-3;
+
+/// The sphere-bed scene a variant is built from.
+pub fn template_scene(variant: &str) -> Result<&'static str, String> {
+    match variant {
+        "a" | "a_hertz_5ms" => Ok("scenes/sphere_bed_a_hertz_5ms.toml"),
+        "b" | "b_hertz_200ms" => Ok("scenes/sphere_bed_b_hertz_200ms.toml"),
+        _ => Err(format!("unknown variant '{variant}' (a or b)")),
+    }
+}
+
+/// The polyhedral scene of a variant: the sphere scene's settings, laws, box and projectile, the projectile
+/// placed `PROJECTILE_GAP` above the highest vertex of the settled polyhedral bed.
+pub fn scene_for_variant(root: &Path, variant: &str) -> Result<(String, Vec<BedBody>), String> {
+    let template_path = template_scene(variant)?;
+    let template = std::fs::read_to_string(root.join(template_path))
+        .map_err(|e| format!("{template_path}: {e}"))?;
+    let spheres = generate::read_spheres(&root.join(SPHERE_FILE))?;
+    let state =
+        std::fs::read_to_string(root.join(STATE_FILE)).map_err(|e| format!("{STATE_FILE}: {e}"))?;
+    let bodies = generate::bed_bodies(&spheres, &state)?;
+    let z0 = generate::bed_top(&bodies) + PROJECTILE_GAP + PROJECTILE_RADIUS;
+    let header = format!(
+        "# The sphere-bed penetration of {template_path} with every sphere of {SPHERE_FILE} replaced by a\n\
+         # random convex polyhedron of equal volume, settled ({STATE_FILE}); written by\n\
+         # validation/examples/generate_polyhedra_bed.rs (validation case polyhedra_bed). Projectile centre\n\
+         # {PROJECTILE_GAP} m + its radius above the highest vertex of the bed.\n"
+    );
+    let text = generate::scene_text(&template, &bodies, Some(z0), &[], &header)?;
+    Ok((text, bodies))
+}
+
+use std::path::PathBuf;
+use std::time::Instant;
+
+use polydem::contact::contact_polyhedron_polyhedron::sat_polyhedra;
+use polydem::contact::ContactKind;
+use polydem::law::hertz_mindlin::{effective_young_modulus, ElasticMaterial};
+use polydem::scene::{load_scene, parse_scene, Simulation};
+use polydem::shape::Shape;
+use polydem::world::{step, StepScratch};
+use serde::Deserialize;
+
+use crate::case::{Case, CaseData, Profile, Target};
+use crate::context::CaseContext;
+use crate::error::SuiteError;
+use crate::plot::{Plot, Series, SeriesStyle};
+
+/// The case (registered in [`crate::cases::registry`]).
+pub struct PolyhedraBed;
+
+const NAME: &str = "polyhedra_bed";
+
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct Variant {
+    /// Variant of the sphere bed: `a_hertz_5ms` or `b_hertz_200ms`.
+    name: String,
+    /// Steps to run (at most the scene's); fewer steps compare the first part of the run.
+    steps: Option<u64>,
+}
+
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct Params {
+    variants: Vec<Variant>,
+    /// The tunnelling monitor observes every this many steps.
+    tunnelling_every: u64,
+}
+
+fn repo_root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .parent()
+        .map(Path::to_path_buf)
+        .unwrap_or_else(|| PathBuf::from(".."))
+}
+
+fn fail(msg: String) -> SuiteError {
+    SuiteError::case(NAME, msg)
+}
+
+/// The projectile's history, sampled at the scene's output interval.
+#[derive(Clone, Debug, Default)]
+struct History {
+    t: Vec<Real>,
+    z: Vec<Real>,
+    vz: Vec<Real>,
+    fz: Vec<Real>,
+    /// Bodies in contact with the projectile.
+    contacts: Vec<Real>,
+}
+
+/// What one bed's run gave.
+struct BedRun {
+    history: History,
+    z0: Real,
+    v0: Real,
+    ke0: Real,
+    steps: u64,
+    particles: usize,
+    wall_time_s: Real,
+    /// Largest |energy balance| / initial kinetic energy of the projectile over the samples.
+    ledger_error: Real,
+    /// Non-finite values among the sampled quantities and the final state.
+    non_finite: u64,
+    /// Largest Minkowski overlap of any contact at the end of any step (m).
+    max_depth: Real,
+    /// Crossings found by the tunnelling monitor.
+    crossings: u64,
+    /// Highest point of the bed at the start (m).
+    bed_top: Real,
+}
+
+fn projectile_index(sim: &Simulation) -> Result<usize, SuiteError> {
+    sim.world
+        .names
+        .iter()
+        .position(|n| n == "projectile")
+        .ok_or_else(|| fail("no body named 'projectile'".into()))
+}
+
+/// Highest point of the bed (every body but the projectile) in the world's current state (m).
+fn world_bed_top(sim: &Simulation, projectile: usize) -> Real {
+    (0..sim.world.bodies.len())
+        .filter(|&i| i != projectile)
+        .map(|i| {
+            let pose = sim.world.pose(i);
+            match sim.world.shape(i) {
+                Shape::Polyhedron(p) => p
+                    .vertices()
+                    .iter()
+                    .map(|v| (pose * v).z)
+                    .fold(Real::NEG_INFINITY, Real::max),
+                Shape::Sphere(s) => pose.translation.vector.z + s.radius(),
+                Shape::Plane(_) => Real::NEG_INFINITY,
+            }
+        })
+        .fold(Real::NEG_INFINITY, Real::max)
+}
+
+/// Runs `steps` steps on one thread, sampling the projectile at the output interval, with the ledger,
+/// overlap and tunnelling monitors.
+fn run_bed(
+    mut sim: Simulation,
+    steps: u64,
+    tunnelling_every: u64,
+    label: &str,
+    ctx: &mut CaseContext,
+) -> Result<BedRun, SuiteError> {
+    let projectile = projectile_index(&sim)?;
+    let steps = steps.min(sim.steps);
+    let p = &sim.world.bodies[projectile];
+    let (z0, v0) = (p.position.z, p.velocity.norm());
+    let ke0 = p.translational_kinetic_energy();
+    let bed_top = world_bed_top(&sim, projectile);
+    let particles = sim.world.bodies.len();
+    let every = sim.output_every;
+    ctx.progress().stage(label, steps);
+    let progress = ctx.progress();
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .map_err(|e| fail(format!("one-thread pool: {e}")))?;
+    let mut history = History::default();
+    let mut ledger_error: Real = 0.0;
+    let mut non_finite = 0u64;
+    let mut max_depth: Real = 0.0;
+    let mut crossings = 0u64;
+    let mut monitor = crossings::CrossingMonitor::new(&sim.world);
+    let mut sample = |sim: &Simulation, history: &mut History| {
+        let b = &sim.world.bodies[projectile];
+        let fz = sim.world.loads.forces.get(projectile).map_or(0.0, |f| f.z);
+        let contacts = sim
+            .world
+            .contacts
+            .keys()
+            .iter()
+            .zip(sim.world.contacts.states())
+            .filter(|(k, s)| {
+                s.geometry.kind == ContactKind::Overlap
+                    && matches!(k, polydem::world::ContactKey::Body { a, b }
+                        if *a as usize == projectile || *b as usize == projectile)
+            })
+            .count() as Real;
+        let values = [sim.world.time, b.position.z, b.velocity.z, fz];
+        non_finite += values.iter().filter(|v| !v.is_finite()).count() as u64;
+        history.t.push(values[0]);
+        history.z.push(values[1]);
+        history.vz.push(values[2]);
+        history.fz.push(values[3]);
+        history.contacts.push(contacts);
+    };
+    let mut run_error = None;
+    let wall = pool.install(|| {
+        let mut scratch = StepScratch::default();
+        let start = Instant::now();
+        sample(&sim, &mut history);
+        for n in 1..=steps {
+            if let Err(e) = step(&sim.params, &mut sim.world, &mut scratch) {
+                run_error = Some(format!("step {n}: {e}"));
+                break;
+            }
+            for s in sim.world.contacts.states() {
+                if s.geometry.kind == ContactKind::Overlap {
+                    max_depth = max_depth.max(s.geometry.depth);
+                }
+            }
+            if n % tunnelling_every == 0 {
+                crossings += monitor.observe(&sim.world);
+            }
+            if n % every == 0 || n == steps {
+                sample(&sim, &mut history);
+                let err = (sim.world.energy().balance / ke0).abs();
+                ledger_error = ledger_error.max(if err.is_nan() { Real::INFINITY } else { err });
+            }
+            if n % 500 == 0 {
+                progress.inc(500);
+            }
+        }
+        start.elapsed().as_secs_f64()
+    });
+    if let Some(e) = run_error {
+        return Err(fail(format!("{label}: {e}")));
+    }
+    non_finite += sim
+        .world
+        .bodies
+        .iter()
+        .filter(|b| {
+            !(b.position.coords.iter().all(|v| v.is_finite())
+                && b.velocity.iter().all(|v| v.is_finite())
+                && b.angular_momentum.iter().all(|v| v.is_finite()))
+        })
+        .count() as u64;
+    Ok(BedRun {
+        history,
+        z0,
+        v0,
+        ke0,
+        steps,
+        particles,
+        wall_time_s: wall,
+        ledger_error,
+        non_finite,
+        max_depth,
+        crossings,
+        bed_top,
+    })
+}
+
+/// Compared quantities of one history.
+#[derive(Clone, Copy, Debug)]
+struct Metrics {
+    final_depth: Real,
+    max_depth: Real,
+    final_vz: Real,
+    peak_force: Real,
+    peak_time: Real,
+    first_contact: Real,
+    slow_time: Real,
+    impulse: Real,
+    mean_contacts: Real,
+}
+
+fn metrics(run: &BedRun) -> Metrics {
+    let h = &run.history;
+    let n = h.t.len();
+    let (mut peak_force, mut peak_time) = (Real::NEG_INFINITY, Real::NAN);
+    let (mut first_contact, mut slow_time) = (Real::NAN, Real::NAN);
+    let (mut impulse, mut max_depth) = (0.0, Real::NEG_INFINITY);
+    let (mut contact_sum, mut contact_samples) = (0.0, 0usize);
+    for i in 0..n {
+        if h.fz[i] > peak_force {
+            peak_force = h.fz[i];
+            peak_time = h.t[i];
+        }
+        if first_contact.is_nan() && h.fz[i] > 1e-6 {
+            first_contact = h.t[i];
+        }
+        if !first_contact.is_nan() {
+            contact_sum += h.contacts[i];
+            contact_samples += 1;
+        }
+        if slow_time.is_nan() && h.vz[i].abs() < 0.1 * run.v0 {
+            slow_time = h.t[i];
+        }
+        if i > 0 {
+            impulse += 0.5 * (h.fz[i] + h.fz[i - 1]) * (h.t[i] - h.t[i - 1]);
+        }
+        max_depth = max_depth.max(run.z0 - h.z[i]);
+    }
+    Metrics {
+        final_depth: run.z0 - h.z[n - 1],
+        max_depth,
+        final_vz: h.vz[n - 1],
+        peak_force,
+        peak_time,
+        first_contact,
+        slow_time,
+        impulse,
+        mean_contacts: contact_sum / contact_samples.max(1) as Real,
+    }
+}
+
+/// Largest Minkowski overlap of the initial polyhedral bed (m): every pair of bodies within reach, by the
+/// exact SAT oracle, and every body against the box's walls.
+fn initial_overlap(bodies: &[BedBody], side: Real) -> Result<Real, SuiteError> {
+    let placed = generate::place(bodies).map_err(fail)?;
+    let mut worst: Real = 0.0;
+    for (i, j) in generate::candidate_pairs(bodies, 0.0) {
+        let g = sat_polyhedra(
+            &generate::world_pose(&bodies[i], &placed[i]),
+            &placed[i].poly,
+            &generate::world_pose(&bodies[j], &placed[j]),
+            &placed[j].poly,
+        );
+        if g.kind == ContactKind::Overlap {
+            worst = worst.max(g.depth);
+        }
+    }
+    for b in bodies {
+        for w in generate::box_walls(side) {
+            worst = worst.max(generate::wall_depth(b, &w));
+        }
+    }
+    Ok(worst)
+}
+
+/// Overlap at which one Hertz contact stores the energy `w` (J): w = (8/15) E* √R* δ^(5/2). With `w` the
+/// projectile's initial kinetic energy and the softest pair (smallest E* and R*), no contact of the run can
+/// be deeper without energy coming from nowhere (the bed's own potential energy drop during a run is
+/// orders of magnitude smaller: it is settled).
+fn hertz_energy_overlap(w: Real, e_star: Real, r_star: Real) -> Real {
+    (15.0 * w / (8.0 * e_star * r_star.sqrt())).powf(0.4)
+}
+
+/// Density, Young's modulus and Poisson's ratio of material `name` of a scene file.
+fn scene_material(template: &str, name: &str) -> Result<(Real, ElasticMaterial), SuiteError> {
+    let table: toml::Table =
+        toml::from_str(template).map_err(|e| fail(format!("scene template: {e}")))?;
+    let m = table
+        .get("material")
+        .and_then(toml::Value::as_array)
+        .and_then(|a| {
+            a.iter()
+                .find(|m| m.get("name").and_then(toml::Value::as_str) == Some(name))
+        })
+        .ok_or_else(|| fail(format!("scene template: no material '{name}'")))?;
+    let f = |key: &str| {
+        m.get(key)
+            .and_then(toml::Value::as_float)
+            .ok_or_else(|| fail(format!("scene template: material '{name}' lacks {key}")))
+    };
+    let elastic = ElasticMaterial::new(f("young_modulus")?, f("poisson_ratio")?)
+        .map_err(|e| fail(format!("material '{name}': {e}")))?;
+    Ok((f("density")?, elastic))
+}
+
+fn rel(a: Real, b: Real) -> Real {
+    (a - b).abs() / (0.5 * (a.abs() + b.abs()))
+}
+
+impl Case for PolyhedraBed {
+    fn name(&self) -> &'static str {
+        NAME
+    }
+
+    fn data(&self) -> &'static str {
+        include_str!("../../cases/polyhedra_bed.toml")
+    }
+
+    fn run(
+        &self,
+        data: &CaseData,
+        profile: Profile,
+        ctx: &mut CaseContext,
+    ) -> Result<(), SuiteError> {
+        let p: Params = data.params(NAME, profile)?;
+        let volume_tol = data.tolerance(NAME, "volume_rel")?.value;
+        let ledger_tol = data.tolerance(NAME, "ledger_rel")?.value;
+        let mean_diameter = data.reference(NAME, "mean_bed_diameter")?.value;
+        let box_side = data.reference(NAME, "box_side")?.value;
+        let root = repo_root();
+        let spheres = generate::read_spheres(&root.join(SPHERE_FILE)).map_err(fail)?;
+        let state_header: Vec<String> = std::fs::read_to_string(root.join(STATE_FILE))
+            .map_err(SuiteError::io(root.join(STATE_FILE)))?
+            .lines()
+            .take_while(|l| l.starts_with('#'))
+            .map(|l| l.trim_start_matches('#').trim().to_owned())
+            .collect();
+        ctx.text(&format!(
+            "Every sphere of the settled sphere bed (`{SPHERE_FILE}`, 3000 spheres, radius 1.6–2.4 mm) is \
+             replaced by a random convex polyhedron of the same volume: the convex hull of {}–{} seeded \
+             random points on a sphere (dart throwing, no two closer than {} of their mean spacing, so no \
+             sliver), its centroid at the sphere's centre, scaled to (4/3)πr³; the points are isotropic, \
+             so the orientation is random. The polyhedra stick out of the spheres they replace (circumradius \
+             1.13–1.43 times the equal-volume radius) and overlapped their neighbours and the walls; they \
+             were not shrunk. The overlaps were removed by moving the centroids (the bed's centres \
+             stretched vertically by 1.2, then Gauss–Seidel sweeps separating each overlapping pair along \
+             the EPA normal), and the bed settled again under gravity with its own Hertz–Mindlin law in \
+             polydem, velocities dropped at the end (`validation/examples/generate_polyhedra_bed.rs`, \
+             `validation/src/cases/polyhedra_bed/generate.rs`). The settled state is `{STATE_FILE}`; its \
+             provenance:\n\n{}\n\n\
+             Both beds are then struck by the same steel sphere with the same laws, time step and sampling \
+             (the scene files `scenes/sphere_bed_*.toml`; the polyhedral scene is that file with the \
+             `[[body_file]]` of spheres replaced, written by the example's `scene` command). The projectile \
+             starts 0.5 mm above the highest point of its bed in both; depth is z0 − z from that start. \
+             The Hertz–Mindlin law of a polyhedron in polydem (`src/law/pair.rs`) is the sphere law with \
+             the Minkowski overlap δ_M as δ and, as R, the radius of the sphere of equal volume — here the \
+             radius of the sphere each polyhedron replaced — so a contact of two polyhedra has the \
+             stiffness of the two spheres they replaced at the same overlap, whatever the features in \
+             contact (vertex, edge or face): the shape changes where and along which normal the contacts \
+             act, not the law.",
+            generate::MIN_POINTS,
+            generate::MAX_POINTS,
+            generate::MIN_SPACING,
+            state_header
+                .iter()
+                .map(|l| format!("- {l}"))
+                .collect::<Vec<_>>()
+                .join("\n"),
+        ));
+        let mut summary_rows = Vec::new();
+        let mut speed_rows = Vec::new();
+        let mut paragraphs = Vec::new();
+        for variant in &p.variants {
+            let v = &variant.name;
+            let template_path = template_scene(v).map_err(fail)?;
+            let template = std::fs::read_to_string(root.join(template_path))
+                .map_err(SuiteError::io(root.join(template_path)))?;
+            let (text, bodies) = scene_for_variant(&root, v).map_err(fail)?;
+
+            // The generated bed: volumes and initial overlaps.
+            let placed = generate::place(&bodies).map_err(fail)?;
+            let volume_error = bodies
+                .iter()
+                .zip(&placed)
+                .map(|(b, pl)| {
+                    let sphere = 4.0 / 3.0 * std::f64::consts::PI * b.radius.powi(3);
+                    (pl.poly.mass_properties().volume / sphere - 1.0).abs()
+                })
+                .fold(0.0, Real::max);
+            let (bed_density, bed) = scene_material(&template, "bed")?;
+            let (_, steel) = scene_material(&template, "steel")?;
+            let r_min = spheres
+                .iter()
+                .map(|s| s.radius)
+                .fold(Real::INFINITY, Real::min);
+            let bed_mass: Real = spheres
+                .iter()
+                .map(|s| bed_density * 4.0 / 3.0 * std::f64::consts::PI * s.radius.powi(3))
+                .sum();
+            let e_bed = effective_young_modulus(&bed, &bed);
+            // The bed's whole weight on one contact of the two smallest grains: no static contact carries more.
+            let static_bound =
+                (bed_mass * 9.81 / (4.0 / 3.0 * e_bed * (0.5 * r_min).sqrt())).powf(2.0 / 3.0);
+            let t_gen = Instant::now();
+            let initial = initial_overlap(&bodies, box_side)?;
+            let t_gen = t_gen.elapsed().as_secs_f64();
+
+            let sim_poly = parse_scene(&text, Path::new(&format!("polyhedra_bed_{v}.toml")))
+                .map_err(|e| fail(e.to_string()))?;
+            let sim_sphere =
+                load_scene(&root.join(template_path)).map_err(|e| fail(e.to_string()))?;
+            let steps = variant.steps.unwrap_or(u64::MAX).min(sim_poly.steps);
+            let spheres_run = run_bed(
+                sim_sphere,
+                steps,
+                p.tunnelling_every,
+                &format!("{v} spheres"),
+                ctx,
+            )?;
+            let poly_run = run_bed(
+                sim_poly,
+                steps,
+                p.tunnelling_every,
+                &format!("{v} polyhedra"),
+                ctx,
+            )?;
+            let e_star_min = e_bed.min(effective_young_modulus(&bed, &steel));
+            let overlap_bound = hertz_energy_overlap(poly_run.ke0, e_star_min, 0.5 * r_min);
+            let t_end = *poly_run.history.t.last().unwrap_or(&0.0);
+
+            ctx.section(&format!("{v} (t ≤ {:.4} ms)", t_end * 1e3));
+            let (ms, mp) = (metrics(&spheres_run), metrics(&poly_run));
+            let solid_fraction = |top: Real| {
+                spheres
+                    .iter()
+                    .map(|s| 4.0 / 3.0 * std::f64::consts::PI * s.radius.powi(3))
+                    .sum::<Real>()
+                    / (box_side * box_side * top)
+            };
+            ctx.text(&format!(
+                "Scene `{template_path}` and its polyhedral version; {steps} steps (t ≤ {:.4} ms) of the \
+                 scene's {}. Both beds hold the same 3000 grain volumes; the sphere bed's top is at {:.2} mm \
+                 (solid fraction below the top {:.3}), the polyhedral bed's at {:.2} mm ({:.3}).",
+                t_end * 1e3,
+                spheres_run.steps.max(steps),
+                spheres_run.bed_top * 1e3,
+                solid_fraction(spheres_run.bed_top),
+                poly_run.bed_top * 1e3,
+                solid_fraction(poly_run.bed_top),
+            ));
+            let row = |q: &str, unit: &str, f: &dyn Fn(&Metrics) -> Real, scale: Real| {
+                let (a, b) = (f(&ms) * scale, f(&mp) * scale);
+                vec![
+                    format!("{q} [{unit}]"),
+                    CaseContext::fmt(a),
+                    CaseContext::fmt(b),
+                    CaseContext::fmt(b / a),
+                ]
+            };
+            let rows = vec![
+                row("final depth", "mm", &|m| m.final_depth, 1e3),
+                row("max depth", "mm", &|m| m.max_depth, 1e3),
+                row("final vertical velocity", "m/s", &|m| m.final_vz, 1.0),
+                row("peak contact force", "N", &|m| m.peak_force, 1.0),
+                row("time of peak force", "ms", &|m| m.peak_time, 1e3),
+                row("first contact", "ms", &|m| m.first_contact, 1e3),
+                row("speed below 10 % of v0 at", "ms", &|m| m.slow_time, 1e3),
+                row("vertical contact impulse", "N s", &|m| m.impulse, 1.0),
+                row(
+                    "mean projectile contacts after first contact",
+                    "-",
+                    &|m| m.mean_contacts,
+                    1.0,
+                ),
+            ];
+            ctx.table(
+                Some(&format!("{v}_table")),
+                &["quantity", "spheres", "polyhedra", "polyhedra / spheres"],
+                &rows,
+            )?;
+            let checks_rows = [("spheres", &spheres_run), ("polyhedra", &poly_run)]
+                .iter()
+                .map(|(bed, r)| {
+                    vec![
+                        (*bed).to_owned(),
+                        CaseContext::fmt(r.ledger_error),
+                        CaseContext::fmt(r.max_depth / mean_diameter),
+                        format!("{}", r.crossings),
+                        format!("{}", r.non_finite),
+                    ]
+                })
+                .collect::<Vec<_>>();
+            ctx.text(&format!(
+                "Checks on both runs (the rows below gate the polyhedral one): the energy ledger's largest \
+                 |balance| over the samples relative to the projectile's initial kinetic energy \
+                 ({:.4e} J); the largest Minkowski overlap of any contact at the end of any step; body \
+                 centres that went through another body or a wall (the definition of \
+                 `polydem::world::tunnelling`, candidates from a grid: `polyhedra_bed/crossings.rs`; observed \
+                 every {} steps); non-finite sampled values.",
+                poly_run.ke0, p.tunnelling_every
+            ));
+            ctx.table(
+                None,
+                &[
+                    "bed",
+                    "ledger |balance| / KE0",
+                    "max overlap [mean diameters]",
+                    "crossings",
+                    "non-finite values",
+                ],
+                &checks_rows,
+            )?;
+            ctx.check(
+                &format!("{v}_volume_rel_error"),
+                volume_error,
+                Target::at_most(volume_tol),
+                "1 (max over the 3000 polyhedra of |V / ((4/3)πr³) − 1|)",
+            );
+            ctx.check(
+                &format!("{v}_initial_max_overlap"),
+                initial / mean_diameter,
+                Target::at_most(static_bound / mean_diameter),
+                "mean bed diameters (exact SAT oracle and walls, settled bed; bound: Hertz overlap of the bed's whole weight on one contact of the two smallest grains)",
+            );
+            ctx.check(
+                &format!("{v}_non_finite_values"),
+                poly_run.non_finite as Real,
+                Target::equal(0.0),
+                "count",
+            );
+            ctx.check(
+                &format!("{v}_ledger_error"),
+                poly_run.ledger_error,
+                Target::at_most(ledger_tol),
+                "1 (max |balance| / projectile's initial kinetic energy)",
+            );
+            ctx.check(
+                &format!("{v}_max_overlap"),
+                poly_run.max_depth / mean_diameter,
+                Target::at_most(overlap_bound / mean_diameter),
+                "mean bed diameters (bound: one Hertz contact of the softest pair holding the projectile's whole kinetic energy)",
+            );
+            ctx.check(
+                &format!("{v}_tunnelling_crossings"),
+                poly_run.crossings as Real,
+                Target::equal(0.0),
+                "count",
+            );
+
+            // Plots: spheres and polyhedra overlaid.
+            let series = |run: &BedRun, label: &str, f: &dyn Fn(&BedRun, usize) -> Real| Series {
+                label: label.into(),
+                style: SeriesStyle::Line,
+                points: (0..run.history.t.len())
+                    .map(|i| (run.history.t[i] * 1e3, f(run, i)))
+                    .collect(),
+            };
+            for (quantity, y_label, pick) in [
+                (
+                    "depth",
+                    "depth z0 − z (mm)",
+                    &(|r: &BedRun, i: usize| (r.z0 - r.history.z[i]) * 1e3)
+                        as &dyn Fn(&BedRun, usize) -> Real,
+                ),
+                (
+                    "velocity",
+                    "vertical velocity (m/s)",
+                    &|r: &BedRun, i: usize| r.history.vz[i],
+                ),
+                (
+                    "force",
+                    "vertical contact force (N)",
+                    &|r: &BedRun, i: usize| r.history.fz[i],
+                ),
+            ] {
+                ctx.plot(&Plot {
+                    name: format!("{v}_{quantity}"),
+                    title: format!("{v}: projectile {quantity}, spheres vs polyhedra"),
+                    x_label: "t (ms)".into(),
+                    y_label: y_label.into(),
+                    x_log: false,
+                    y_log: false,
+                    series: vec![
+                        series(&spheres_run, "sphere bed", pick),
+                        series(&poly_run, "polyhedral bed (equal volumes)", pick),
+                    ],
+                    caption: format!(
+                        "Projectile {quantity} against time in the sphere bed and in the same bed of \
+                         polyhedra of equal volume (polydem, same law and step)."
+                    ),
+                })?;
+            }
+            paragraphs.push(format!(
+                "**{v}** (first {:.2} ms): in the polyhedral bed the projectile reaches a depth of {:.2} mm \
+                 against {:.2} mm in the sphere bed ({:+.0} %); its peak contact force is {:.3} N against \
+                 {:.3} N ({:+.0} %), at {:.3} ms against {:.3} ms; the vertical contact impulse is {:.4} N s \
+                 against {:.4} N s; its speed falls below 10 % of v0 at {} against {}; vertical velocity at \
+                 the end {:.3} m/s against {:.3} m/s; it touches {:.2} grains on average against {:.2}.",
+                t_end * 1e3,
+                mp.final_depth * 1e3,
+                ms.final_depth * 1e3,
+                100.0 * (mp.final_depth / ms.final_depth - 1.0),
+                mp.peak_force,
+                ms.peak_force,
+                100.0 * (mp.peak_force / ms.peak_force - 1.0),
+                mp.peak_time * 1e3,
+                ms.peak_time * 1e3,
+                mp.impulse,
+                ms.impulse,
+                if mp.slow_time.is_nan() { "—".to_owned() } else { format!("{:.3} ms", mp.slow_time * 1e3) },
+                if ms.slow_time.is_nan() { "— (not within the window)".to_owned() } else { format!("{:.3} ms", ms.slow_time * 1e3) },
+                mp.final_vz,
+                ms.final_vz,
+                mp.mean_contacts,
+                ms.mean_contacts,
+            ));
+            summary_rows.push(vec![
+                v.clone(),
+                format!("{:.3}", ms.final_depth * 1e3),
+                format!("{:.3}", mp.final_depth * 1e3),
+                format!("{:.3}", ms.peak_force),
+                format!("{:.3}", mp.peak_force),
+                format!("{:.3}", ms.final_vz),
+                format!("{:.3}", mp.final_vz),
+                format!("{:.3}", rel(ms.impulse, mp.impulse)),
+            ]);
+            for (bed, r) in [("spheres", &spheres_run), ("polyhedra", &poly_run)] {
+                speed_rows.push(vec![
+                    v.clone(),
+                    bed.to_owned(),
+                    format!("{}", r.steps),
+                    format!("{:.2}", r.wall_time_s),
+                    format!(
+                        "{:.3e}",
+                        r.particles as Real * r.steps as Real / r.wall_time_s
+                    ),
+                ]);
+            }
+            let _ = t_gen;
+        }
+        ctx.section("What the shape does");
+        ctx.text(&paragraphs.join("\n\n"));
+        ctx.table(
+            Some("summary"),
+            &[
+                "variant",
+                "final depth spheres [mm]",
+                "polyhedra [mm]",
+                "peak force spheres [N]",
+                "polyhedra [N]",
+                "final v_z spheres [m/s]",
+                "polyhedra [m/s]",
+                "impulse, relative difference",
+            ],
+            &summary_rows,
+        )?;
+        ctx.section("Cost (one thread, with the monitors)");
+        ctx.text(
+            "Wall time of the stepping loop including this case's monitors (overlap scan every step, \
+             tunnelling monitor), so not a speed figure of the engine; the machine is shared.",
+        );
+        ctx.table(
+            Some("cost"),
+            &[
+                "variant",
+                "bed",
+                "steps",
+                "wall time [s]",
+                "particle-steps/s",
+            ],
+            &speed_rows,
+        )?;
+        Ok(())
+    }
+}

@@ -1,0 +1,133 @@
+//! A crossing detector for large beds: the definition of `polydem::world::tunnelling` (a body's centre
+//! whose path between two observations, taken in the other body's frame, enters that body's solid from
+//! outside; or that goes from the free side of a wall to behind it), with the candidate pairs found in a
+//! uniform grid instead of the O(N²) scan of the engine's monitor, which costs ~0.1 s per observation on
+//! the 3000-body bed. It does not tell tunnelling from pass-through (both are failures here).
+
+use std::collections::HashMap;
+
+use polydem::math::{Point, Pose, Real};
+use polydem::shape::Shape;
+use polydem::world::World;
+
+/// The state kept between two observations.
+pub struct CrossingMonitor {
+    poses: Vec<Pose>,
+}
+
+/// Whether the segment p0 → p1 (in the shape's frame) meets the solid while p0 is outside it.
+fn segment_enters(shape: &Shape, p0: &Point, p1: &Point) -> bool {
+    match shape {
+        Shape::Polyhedron(poly) => {
+            let d = p1 - p0;
+            let (mut t_in, mut t_out): (Real, Real) = (0.0, 1.0);
+            let mut start_inside = true;
+            for f in 0..poly.num_faces() {
+                let n = poly.face_normal(f);
+                let slack = poly.face_offset(f) - n.dot(&p0.coords);
+                if slack < 0.0 {
+                    start_inside = false;
+                }
+                let rate = n.dot(&d);
+                if rate == 0.0 {
+                    if slack < 0.0 {
+                        return false;
+                    }
+                } else if rate < 0.0 {
+                    t_in = t_in.max(slack / rate);
+                } else {
+                    t_out = t_out.min(slack / rate);
+                }
+                if t_in > t_out {
+                    return false;
+                }
+            }
+            !start_inside
+        }
+        Shape::Sphere(s) => {
+            let r = s.radius();
+            if p0.coords.norm() <= r {
+                return false;
+            }
+            let d = p1 - p0;
+            let len2 = d.norm_squared();
+            let t = if len2 > 0.0 {
+                (-p0.coords.dot(&d) / len2).clamp(0.0, 1.0)
+            } else {
+                0.0
+            };
+            (p0.coords + t * d).norm() <= r
+        }
+        Shape::Plane(_) => false,
+    }
+}
+
+impl CrossingMonitor {
+    pub fn new(world: &World) -> Self {
+        Self {
+            poses: (0..world.bodies.len()).map(|i| world.pose(i)).collect(),
+        }
+    }
+
+    /// Crossings since the previous observation (or since [`CrossingMonitor::new`]).
+    pub fn observe(&mut self, world: &World) -> u64 {
+        let now: Vec<Pose> = (0..world.bodies.len()).map(|i| world.pose(i)).collect();
+        let n = now.len().min(self.poses.len());
+        let centre = |p: &Pose| Point::from(p.translation.vector);
+        let travel = (0..n)
+            .map(|i| (centre(&now[i]) - centre(&self.poses[i])).norm())
+            .fold(0.0, Real::max);
+        let r_max = world.radii.iter().copied().fold(0.0, Real::max);
+        // A pair can cross only if its centres came within r_max + travel of each other, so the cells
+        // of the current centres, 2 (r_max + travel) wide, hold every candidate in the 27 around a body.
+        let cell = 2.0 * (r_max + travel);
+        let key = |p: &Point| {
+            (
+                (p.x / cell).floor() as i64,
+                (p.y / cell).floor() as i64,
+                (p.z / cell).floor() as i64,
+            )
+        };
+        let mut grid: HashMap<(i64, i64, i64), Vec<usize>> = HashMap::new();
+        for (i, pose) in now.iter().enumerate().take(n) {
+            grid.entry(key(&centre(pose))).or_default().push(i);
+        }
+        let mut count = 0;
+        for i in 0..n {
+            if !world.bodies[i].is_dynamic() {
+                continue;
+            }
+            let (x0, x1) = (centre(&self.poses[i]), centre(&now[i]));
+            for wall in &world.walls {
+                if wall.signed_distance(&x0) >= 0.0 && wall.signed_distance(&x1) < 0.0 {
+                    count += 1;
+                }
+            }
+            let (kx, ky, kz) = key(&x1);
+            for dx in -1..=1 {
+                for dy in -1..=1 {
+                    for dz in -1..=1 {
+                        let Some(cands) = grid.get(&(kx + dx, ky + dy, kz + dz)) else {
+                            continue;
+                        };
+                        for &j in cands {
+                            if j == i {
+                                continue;
+                            }
+                            let r0 = self.poses[j].inverse_transform_point(&x0);
+                            let r1 = now[j].inverse_transform_point(&x1);
+                            if r0.coords.norm().min(r1.coords.norm()) > world.radii[j] + travel {
+                                continue;
+                            }
+                            if segment_enters(world.shape(j), &r0, &r1) {
+                                count += 1;
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        self.poses = now;
+        count
+    }
+}
