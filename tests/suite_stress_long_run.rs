@@ -21,10 +21,6 @@ const KNOWN_FAILURES: &[(&str, &str)] = &[
         "per-event energy errors accumulate like a random walk: over a short run the fitted line's change \
          is of the order of the scatter (1.4 and 4.8 on two trajectories)",
     ),
-    (
-        "walls_drift_fitted_change_over_scatter",
-        "first-order errors of flat wall landings (deepest-vertex contact) accumulate like a random walk",
-    ),
 ];
 
 #[test]
