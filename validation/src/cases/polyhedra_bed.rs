@@ -667,8 +667,8 @@ impl Case for PolyhedraBed {
                 "**{v}** (first {:.2} ms): in the polyhedral bed the projectile reaches a depth of {:.2} mm \
                  against {:.2} mm in the sphere bed ({:+.0} %); its peak contact force is {:.3} N against \
                  {:.3} N ({:+.0} %), at {:.3} ms against {:.3} ms; the vertical contact impulse is {:.4} N s \
-                 against {:.4} N s; its speed falls below 10 % of v0 at {} against {}; vertical velocity at \
-                 the end {:.3} m/s against {:.3} m/s; it touches {:.2} grains on average against {:.2}.",
+                 against {:.4} N s; {}; vertical velocity at the end {:.3} m/s against {:.3} m/s; it touches \
+                 {:.2} grains on average against {:.2}.",
                 t_end * 1e3,
                 mp.final_depth * 1e3,
                 ms.final_depth * 1e3,
@@ -680,8 +680,23 @@ impl Case for PolyhedraBed {
                 ms.peak_time * 1e3,
                 mp.impulse,
                 ms.impulse,
-                if mp.slow_time.is_nan() { "—".to_owned() } else { format!("{:.3} ms", mp.slow_time * 1e3) },
-                if ms.slow_time.is_nan() { "— (not within the window)".to_owned() } else { format!("{:.3} ms", ms.slow_time * 1e3) },
+                match (mp.slow_time.is_nan(), ms.slow_time.is_nan()) {
+                    (true, true) => "in neither bed does its speed fall below 10 % of v0 within the window"
+                        .to_owned(),
+                    (false, false) => format!(
+                        "its speed falls below 10 % of v0 at {:.3} ms against {:.3} ms",
+                        mp.slow_time * 1e3,
+                        ms.slow_time * 1e3
+                    ),
+                    (false, true) => format!(
+                        "its speed falls below 10 % of v0 at {:.3} ms, in the sphere bed not within the window",
+                        mp.slow_time * 1e3
+                    ),
+                    (true, false) => format!(
+                        "its speed stays above 10 % of v0 within the window, in the sphere bed it falls below at {:.3} ms",
+                        ms.slow_time * 1e3
+                    ),
+                },
                 mp.final_vz,
                 ms.final_vz,
                 mp.mean_contacts,
