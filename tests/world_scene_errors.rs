@@ -452,3 +452,84 @@ fn overflowing_angular_momentum_is_refused() {
         "body[0].angular_velocity",
     );
 }
+
+#[test]
+fn wall_depth_rule_and_band_are_read_and_bad_values_refused() {
+    use polydem::contact::wall_depth::WallDepth;
+    let (_, default) = load("wall_depth_default", VALID);
+    assert_eq!(
+        default.expect("valid scene").params.tolerances.wall_depth,
+        WallDepth::default()
+    );
+
+    let text = edit(
+        "steps_per_contact",
+        "steps_per_contact = 50\nwall_depth_band = 3.0e-4",
+    );
+    let (_, banded) = load("wall_depth_band", &text);
+    assert_eq!(
+        banded
+            .expect("scene with a band")
+            .params
+            .tolerances
+            .wall_depth,
+        WallDepth::Smoothed { band: 3.0e-4 }
+    );
+
+    let text = edit(
+        "steps_per_contact",
+        "steps_per_contact = 50\nwall_depth = \"deepest_vertex\"",
+    );
+    let (_, deepest) = load("wall_depth_deepest", &text);
+    assert_eq!(
+        deepest
+            .expect("scene with the deepest-vertex rule")
+            .params
+            .tolerances
+            .wall_depth,
+        WallDepth::DeepestVertex
+    );
+
+    let text = edit(
+        "steps_per_contact",
+        "steps_per_contact = 50\nwall_depth = \"centroid\"",
+    );
+    let (path, result) = load("wall_depth_unknown", &text);
+    let message = result
+        .expect_err("unknown wall_depth rule accepted")
+        .to_string();
+    assert_names(
+        &message,
+        &path,
+        line_of(&text, "wall_depth"),
+        "simulation.wall_depth",
+    );
+
+    let text = edit(
+        "steps_per_contact",
+        "steps_per_contact = 50\nwall_depth = \"deepest_vertex\"\nwall_depth_band = 1.0e-4",
+    );
+    let (path, result) = load("wall_depth_band_ignored", &text);
+    let message = result
+        .expect_err("band with the deepest-vertex rule accepted")
+        .to_string();
+    assert_names(
+        &message,
+        &path,
+        line_of(&text, "wall_depth_band"),
+        "simulation.wall_depth_band",
+    );
+
+    let text = edit(
+        "steps_per_contact",
+        "steps_per_contact = 50\nwall_depth_band = -1.0",
+    );
+    let (path, result) = load("wall_depth_band_negative", &text);
+    let message = result.expect_err("negative band accepted").to_string();
+    assert_names(
+        &message,
+        &path,
+        line_of(&text, "wall_depth_band"),
+        "simulation.wall_depth_band",
+    );
+}

@@ -11,6 +11,7 @@ use std::sync::Arc;
 
 use toml::Spanned;
 
+use crate::contact::wall_depth::WallDepth;
 use crate::dynamics::{Motion, PrincipalInertia, RigidBody, ViscousDamping};
 use crate::law::hertz_mindlin::{material_hertz_mindlin, ElasticMaterial, HertzMindlinOptions};
 use crate::law::pair::contact_radius;
@@ -20,7 +21,7 @@ use crate::shape::{ConvexPolyhedron, Plane, Shape, Sphere};
 use crate::world::{MaterialTable, StepParams, Wall, World};
 
 use super::body_file::read_sphere_table;
-use super::schema::{SceneFile, Vec3};
+use super::schema::{SceneFile, SimulationSection, Vec3};
 use super::time_step::{contact_time_and_limit, PairEstimate, TimeStepInfo, TimeStepIssue};
 
 /// Why a scene could not be read.
@@ -1005,6 +1006,7 @@ fn build(ctx: &Ctx, file: &SceneFile) -> Result<Simulation, SceneError> {
     }
     let mut params = StepParams::new(dt);
     params.damping = damping;
+    params.tolerances.wall_depth = wall_depth(ctx, sim)?;
     let steps = super::run::steps_to(end_time, dt);
     let output_every = ((output_interval / dt).round() as u64).max(1);
     Ok(Simulation {
@@ -1022,4 +1024,32 @@ fn build(ctx: &Ctx, file: &SceneFile) -> Result<Simulation, SceneError> {
         tracked,
         frames,
     })
+}
+
+/// `simulation.wall_depth` and `simulation.wall_depth_band`: how a polyhedron–wall contact turns the vertex
+/// depths into the law's overlap. A band given with the deepest-vertex rule is refused (it would be ignored).
+fn wall_depth(ctx: &Ctx, sim: &SimulationSection) -> Result<WallDepth, SceneError> {
+    let band = match &sim.wall_depth_band {
+        Some(b) => Some((ctx.positive(b, "simulation.wall_depth_band")?, b.span())),
+        None => None,
+    };
+    let rule = sim
+        .wall_depth
+        .as_ref()
+        .map(|r| (r.get_ref().as_str(), r.span()));
+    match (rule, band) {
+        (None | Some(("smoothed", _)), None) => Ok(WallDepth::default()),
+        (None | Some(("smoothed", _)), Some((band, _))) => Ok(WallDepth::Smoothed { band }),
+        (Some(("deepest_vertex", _)), None) => Ok(WallDepth::DeepestVertex),
+        (Some(("deepest_vertex", _)), Some((_, span))) => Err(ctx.invalid(
+            span,
+            "simulation.wall_depth_band",
+            "a band applies to wall_depth = \"smoothed\" only, not to \"deepest_vertex\"",
+        )),
+        (Some((other, span)), _) => Err(ctx.invalid(
+            span,
+            "simulation.wall_depth",
+            format!("must be \"smoothed\" or \"deepest_vertex\", got \"{other}\""),
+        )),
+    }
 }

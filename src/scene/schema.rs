@@ -53,6 +53,11 @@ pub struct SimulationSection {
     pub viscous_damping_rate: Option<Spanned<f64>>,
     /// Verlet skin of the broad phase (m); absent = 0.2 × the smallest bounding radius.
     pub skin: Option<Spanned<f64>>,
+    /// Overlap that a polyhedron–wall contact hands to the law: `"smoothed"` (default) or
+    /// `"deepest_vertex"` (see `crate::contact::wall_depth`).
+    pub wall_depth: Option<Spanned<String>>,
+    /// Band h of the smoothed wall depth as a fraction of the body's bounding diameter; absent = 1e-4.
+    pub wall_depth_band: Option<Spanned<f64>>,
 }
 
 /// `[[material]]`.
