@@ -120,8 +120,9 @@ fn overlapping_pairs(world: &World) -> HashSet<ContactKey> {
         .collect()
 }
 
-/// Whether the segment p0 → p1 (in the shape's frame) meets the solid, and p0 is outside it.
-fn segment_enters(shape: &Shape, p0: &Point, p1: &Point) -> bool {
+/// Whether the segment p0 → p1 (in the shape's frame) meets the solid, and p0 is outside it. Public so that
+/// monitors with another candidate search (the validation's grid monitor for large beds) share the test.
+pub fn segment_enters(shape: &Shape, p0: &Point, p1: &Point) -> bool {
     match shape {
         Shape::Polyhedron(poly) => {
             let d = p1 - p0;

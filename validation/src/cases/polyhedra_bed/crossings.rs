@@ -8,59 +8,12 @@
 use std::collections::{HashMap, HashSet};
 
 use polydem::math::{Point, Pose, Real};
-use polydem::shape::Shape;
+use polydem::world::tunnelling::segment_enters;
 use polydem::world::World;
 
 /// The state kept between two observations.
 pub struct CrossingMonitor {
     poses: Vec<Pose>,
-}
-
-/// Whether the segment p0 → p1 (in the shape's frame) meets the solid while p0 is outside it.
-fn segment_enters(shape: &Shape, p0: &Point, p1: &Point) -> bool {
-    match shape {
-        Shape::Polyhedron(poly) => {
-            let d = p1 - p0;
-            let (mut t_in, mut t_out): (Real, Real) = (0.0, 1.0);
-            let mut start_inside = true;
-            for f in 0..poly.num_faces() {
-                let n = poly.face_normal(f);
-                let slack = poly.face_offset(f) - n.dot(&p0.coords);
-                if slack < 0.0 {
-                    start_inside = false;
-                }
-                let rate = n.dot(&d);
-                if rate == 0.0 {
-                    if slack < 0.0 {
-                        return false;
-                    }
-                } else if rate < 0.0 {
-                    t_in = t_in.max(slack / rate);
-                } else {
-                    t_out = t_out.min(slack / rate);
-                }
-                if t_in > t_out {
-                    return false;
-                }
-            }
-            !start_inside
-        }
-        Shape::Sphere(s) => {
-            let r = s.radius();
-            if p0.coords.norm() <= r {
-                return false;
-            }
-            let d = p1 - p0;
-            let len2 = d.norm_squared();
-            let t = if len2 > 0.0 {
-                (-p0.coords.dot(&d) / len2).clamp(0.0, 1.0)
-            } else {
-                0.0
-            };
-            (p0.coords + t * d).norm() <= r
-        }
-        Shape::Plane(_) => false,
-    }
 }
 
 impl CrossingMonitor {
