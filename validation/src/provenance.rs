@@ -1,6 +1,6 @@
 //! Where a report comes from: commit, date, machine.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::process::Command;
 
 /// The facts that identify a run of the suite.
@@ -96,6 +96,13 @@ pub fn format_utc(secs: u64) -> String {
         (rem % 3600) / 60,
         rem % 60
     )
+}
+
+/// The workspace root (the parent of the validation crate), canonical when it can be resolved: where
+/// `reports/`, `reference/` and `scenes/` live.
+pub fn workspace_root() -> PathBuf {
+    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..");
+    root.canonicalize().unwrap_or(root)
 }
 
 #[cfg(test)]

@@ -15,6 +15,12 @@ pub fn fitted_order(x: &[Real], y: &[Real]) -> Real {
     sxy / sxx
 }
 
+/// Relative difference of two values against their mean magnitude, |a − b| / (½ (|a| + |b|)): symmetric,
+/// for comparing two runs where neither is the reference.
+pub fn relative_difference(a: Real, b: Real) -> Real {
+    (a - b).abs() / (0.5 * (a.abs() + b.abs()))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

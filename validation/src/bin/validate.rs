@@ -3,6 +3,7 @@
 //! Exit status: 0 when every checked row passed, 1 when a row failed or a case could not complete,
 //! 2 on usage errors.
 
+use polydem_validation::provenance::workspace_root;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -38,11 +39,6 @@ struct Cli {
     export_pairs: Option<PathBuf>,
     /// Cases to run (default: every case of the default run; see --list).
     cases: Vec<String>,
-}
-
-fn workspace_root() -> PathBuf {
-    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..");
-    root.canonicalize().unwrap_or(root)
 }
 
 fn main() -> ExitCode {

@@ -2,6 +2,7 @@
 //! `reports/perf/history.csv`; fails when a ratio regresses past the threshold against the last figure
 //! recorded on the same machine (cores + CPU model). Not part of the default run.
 
+use crate::provenance::workspace_root;
 use std::path::Path;
 
 use polydem::contact::ContactTolerances;
@@ -56,10 +57,6 @@ fn read_history(path: &Path) -> Result<Vec<Vec<String>>, SuiteError> {
         rows.push(rec.iter().map(str::to_string).collect::<Vec<_>>());
     }
     Ok(rows)
-}
-
-fn workspace_root() -> std::path::PathBuf {
-    std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..")
 }
 
 impl Case for Perf {

@@ -5,6 +5,8 @@
 pub mod crossings;
 pub mod generate;
 
+use crate::provenance::workspace_root;
+use crate::stats::relative_difference;
 use std::path::Path;
 
 use polydem::math::Real;
@@ -50,7 +52,6 @@ pub fn scene_for_variant(root: &Path, variant: &str) -> Result<(String, Vec<BedB
     Ok((text, bodies))
 }
 
-use std::path::PathBuf;
 use std::time::Instant;
 
 use polydem::contact::contact_polyhedron_polyhedron::sat_polyhedra;
@@ -86,13 +87,6 @@ struct Params {
     variants: Vec<Variant>,
     /// The tunnelling monitor observes every this many steps.
     tunnelling_every: u64,
-}
-
-fn repo_root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .parent()
-        .map(Path::to_path_buf)
-        .unwrap_or_else(|| PathBuf::from(".."))
 }
 
 fn fail(msg: String) -> SuiteError {
@@ -376,10 +370,6 @@ fn scene_material(template: &str, name: &str) -> Result<(Real, ElasticMaterial),
     Ok((f("density")?, elastic))
 }
 
-fn rel(a: Real, b: Real) -> Real {
-    (a - b).abs() / (0.5 * (a.abs() + b.abs()))
-}
-
 impl Case for PolyhedraBed {
     fn name(&self) -> &'static str {
         NAME
@@ -400,7 +390,7 @@ impl Case for PolyhedraBed {
         let ledger_tol = data.tolerance(NAME, "ledger_rel")?.value;
         let mean_diameter = data.reference(NAME, "mean_bed_diameter")?.value;
         let box_side = data.reference(NAME, "box_side")?.value;
-        let root = repo_root();
+        let root = workspace_root();
         let spheres = generate::read_spheres(&root.join(SPHERE_FILE)).map_err(fail)?;
         let state_header: Vec<String> = std::fs::read_to_string(root.join(STATE_FILE))
             .map_err(SuiteError::io(root.join(STATE_FILE)))?
@@ -710,7 +700,7 @@ impl Case for PolyhedraBed {
                 format!("{:.3}", mp.peak_force),
                 format!("{:.3}", ms.final_vz),
                 format!("{:.3}", mp.final_vz),
-                format!("{:.3}", rel(ms.impulse, mp.impulse)),
+                format!("{:.3}", relative_difference(ms.impulse, mp.impulse)),
             ]);
             for (bed, r) in [("spheres", &spheres_run), ("polyhedra", &poly_run)] {
                 speed_rows.push(vec![

@@ -10,6 +10,7 @@
 //! figure is the recorded run (`reference/yade/out/polyhedra_box.csv`, with its date) unless the full
 //! profile finds `yade` on the PATH, in which case YADE is re-run in the same suite run.
 
+use crate::provenance::workspace_root;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -49,10 +50,6 @@ struct CodeRun {
     cpu_s: Real,
     /// Where the figures come from (recorded file and date, or "this run").
     provenance: String,
-}
-
-fn workspace_root() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..")
 }
 
 fn fail(msg: String) -> SuiteError {

@@ -15,7 +15,9 @@
 //! error, and its recorded run stands in. The speed targets of issue 7 are checked in the full profile only
 //! (speed never gates `cargo test`).
 
-use std::path::{Path, PathBuf};
+use crate::provenance::workspace_root;
+use crate::stats::relative_difference;
+use std::path::Path;
 use std::time::Instant;
 
 use polydem::math::Real;
@@ -71,13 +73,6 @@ struct Recorded {
     wall_time_s: Real,
     steps: Real,
     particles: Real,
-}
-
-fn repo_root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .parent()
-        .map(Path::to_path_buf)
-        .unwrap_or_else(|| PathBuf::from(".."))
 }
 
 fn fail(msg: String) -> SuiteError {
@@ -154,7 +149,7 @@ fn installed(code: &str) -> bool {
 /// `NICE=0`) and reads the fresh output.
 fn rerun_reference(code: &str, variant: &str, dir: &Path) -> Result<Recorded, SuiteError> {
     std::fs::create_dir_all(dir).map_err(SuiteError::io(dir))?;
-    let script = repo_root().join(format!("reference/{code}/run.sh"));
+    let script = workspace_root().join(format!("reference/{code}/run.sh"));
     let output = std::process::Command::new("sh")
         .arg(&script)
         .arg(variant)
@@ -206,7 +201,7 @@ struct Run {
 
 /// Runs polydem on the variant's scene, sampling the projectile every output interval.
 fn run_polydem(variant: &Variant, ctx: &mut CaseContext) -> Result<Run, SuiteError> {
-    let path = repo_root().join(&variant.scene);
+    let path = workspace_root().join(&variant.scene);
     let mut sim = load_scene(&path).map_err(|e| fail(e.to_string()))?;
     if let Some(steps) = variant.steps {
         sim.steps = sim.steps.min(steps);
@@ -344,10 +339,6 @@ fn max_gap(a: &History, b: &History, t_end: Real) -> Result<Real, SuiteError> {
     Ok(gap)
 }
 
-fn rel(a: Real, b: Real) -> Real {
-    (a - b).abs() / (0.5 * (a.abs() + b.abs()))
-}
-
 impl Case for SphereBed {
     fn name(&self) -> &'static str {
         NAME
@@ -380,7 +371,7 @@ impl Case for SphereBed {
              below in this process.",
         );
         for (code, label) in [("yade", "YADE"), ("liggghts", "LIGGGHTS")] {
-            let date = read_recorded(&repo_root().join(format!(
+            let date = read_recorded(&workspace_root().join(format!(
                 "reference/{code}/out/{}.csv",
                 p.variants.first().map_or("", |v| v.name.as_str())
             )))
@@ -412,10 +403,10 @@ impl Case for SphereBed {
         let mut summary_rows = Vec::new();
         for variant in &p.variants {
             let yade = read_recorded(
-                &repo_root().join(format!("reference/yade/out/{}.csv", variant.name)),
+                &workspace_root().join(format!("reference/yade/out/{}.csv", variant.name)),
             )?;
             let liggghts = read_recorded(
-                &repo_root().join(format!("reference/liggghts/out/{}.csv", variant.name)),
+                &workspace_root().join(format!("reference/liggghts/out/{}.csv", variant.name)),
             )?;
             let ours = run_polydem(variant, ctx)?;
             // The reference codes right after polydem, on the same machine in the same suite run.
@@ -461,9 +452,9 @@ impl Case for SphereBed {
                     CaseContext::fmt(o),
                     CaseContext::fmt(y),
                     CaseContext::fmt(l),
-                    format!("{:.2} %", 100.0 * rel(o, y)),
-                    format!("{:.2} %", 100.0 * rel(o, l)),
-                    format!("{:.2} %", 100.0 * rel(y, l)),
+                    format!("{:.2} %", 100.0 * relative_difference(o, y)),
+                    format!("{:.2} %", 100.0 * relative_difference(o, l)),
+                    format!("{:.2} %", 100.0 * relative_difference(y, l)),
                 ]
             };
             let rows = vec![
@@ -501,7 +492,8 @@ impl Case for SphereBed {
 
             // Checks against the nearer code.
             let nearer = |f: &dyn Fn(&Metrics) -> Real| {
-                rel(f(&m_ours), f(&m_yade)).min(rel(f(&m_ours), f(&m_lig)))
+                relative_difference(f(&m_ours), f(&m_yade))
+                    .min(relative_difference(f(&m_ours), f(&m_lig)))
             };
             ctx.check(
                 &format!("{v}_depth_gap_to_nearer_code"),
@@ -527,7 +519,9 @@ impl Case for SphereBed {
             ctx.check(
                 &format!("{v}_final_depth_rel_to_nearer_code"),
                 nearer(&|m| m.final_depth),
-                Target::at_most(depth_tol.max(rel(m_yade.final_depth, m_lig.final_depth))),
+                Target::at_most(
+                    depth_tol.max(relative_difference(m_yade.final_depth, m_lig.final_depth)),
+                ),
                 "1 (bound: max of the tolerance and the YADE–LIGGGHTS spread)",
             );
             summary_rows.push(vec![
@@ -566,9 +560,9 @@ impl Case for SphereBed {
                         CaseContext::fmt(o),
                         CaseContext::fmt(y),
                         CaseContext::fmt(l),
-                        format!("{:.2} %", 100.0 * rel(o, y)),
-                        format!("{:.2} %", 100.0 * rel(o, l)),
-                        format!("{:.2} %", 100.0 * rel(y, l)),
+                        format!("{:.2} %", 100.0 * relative_difference(o, y)),
+                        format!("{:.2} %", 100.0 * relative_difference(o, l)),
+                        format!("{:.2} %", 100.0 * relative_difference(y, l)),
                     ]
                 };
                 let same = |f: &Option<Recorded>, r: &Recorded| -> Result<String, SuiteError> {
@@ -631,9 +625,11 @@ impl Case for SphereBed {
                 );
                 ctx.check(
                     &format!("{v}_final_depth_rel_to_nearer_code_this_run"),
-                    rel(m_ours.final_depth, m_fy.final_depth)
-                        .min(rel(m_ours.final_depth, m_fl.final_depth)),
-                    Target::at_most(depth_tol.max(rel(m_fy.final_depth, m_fl.final_depth))),
+                    relative_difference(m_ours.final_depth, m_fy.final_depth)
+                        .min(relative_difference(m_ours.final_depth, m_fl.final_depth)),
+                    Target::at_most(
+                        depth_tol.max(relative_difference(m_fy.final_depth, m_fl.final_depth)),
+                    ),
                     "1 (bound: max of the tolerance and the YADE–LIGGGHTS spread; this suite run)",
                 );
             }
