@@ -5,27 +5,15 @@
 
 use polydem::math::{Point, Pose};
 use polydem::rockfill::bed::{has_checkpoint, load_bed_info};
-use polydem::rockfill::config::ExperimentConfig;
 use polydem::rockfill::convergence::{run_convergence, ConvergenceParams, Sequence};
 use polydem::rockfill::experiment::{run_experiment_with, BedSource};
 use polydem::rockfill::penetration::{MonitorRow, PenetrationOptions};
 use polydem::rockfill::section::section_polygon;
 use polydem::rockfill::study::{run_study, StudyParams, StudyRun};
 
-/// The quick variant cut to a 1.2 m × 0.6 m × 0.6 m layer (about 25 rocks of 290 mm), as in
-/// tests/rockfill_experiment.rs.
-fn small() -> ExperimentConfig {
-    let mut c = ExperimentConfig::quick();
-    c.layer.length = 1.2;
-    c.layer.width = 0.6;
-    c.layer.height = 0.6;
-    c.packing.hold_time = 0.02;
-    c.packing.max_deposition_time = 1.0;
-    c.packing.settle_speed = 0.2;
-    c.packing.compaction_pressure = 1.0e4;
-    c.rock.seed = 3;
-    c
-}
+#[path = "support/rockfill_small.rs"]
+mod rockfill_small;
+use rockfill_small::small;
 
 fn temp_dir(tag: &str) -> std::path::PathBuf {
     let dir = std::env::temp_dir().join(format!("polydem_{tag}_{}", std::process::id()));

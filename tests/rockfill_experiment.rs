@@ -2,25 +2,14 @@
 //! closed to the measured level, the saved bed reloads to the same state, and the penetration run ends
 //! with the projectile through the layer, finite state and a closed ledger.
 
-use polydem::rockfill::config::ExperimentConfig;
 use polydem::rockfill::experiment::{generate_sample, run_experiment, BedSource};
 use polydem::rockfill::packing::{load_bed, loose_world, pack, save_bed, KEPT_WALLS};
 use polydem::rockfill::penetration::Outcome;
 use polydem::shape::Shape;
 
-/// The quick variant cut to a 1.2 m × 0.6 m × 0.6 m layer (about 25 rocks of 290 mm).
-fn small() -> ExperimentConfig {
-    let mut c = ExperimentConfig::quick();
-    c.layer.length = 1.2;
-    c.layer.width = 0.6;
-    c.layer.height = 0.6;
-    c.packing.hold_time = 0.02;
-    c.packing.max_deposition_time = 1.0;
-    c.packing.settle_speed = 0.2;
-    c.packing.compaction_pressure = 1.0e4;
-    c.rock.seed = 3;
-    c
-}
+#[path = "support/rockfill_small.rs"]
+mod rockfill_small;
+use rockfill_small::small;
 
 #[test]
 fn packed_bed_stays_in_the_container_and_reloads_bit_for_bit() {

@@ -1,0 +1,18 @@
+//! The small rockfill configuration shared by the rockfill tests (`tests/rockfill_*.rs`, included by path).
+
+use polydem::rockfill::config::ExperimentConfig;
+
+/// The quick variant cut to a 1.2 m × 0.6 m × 0.6 m layer (about 25 rocks of 290 mm), short hold and
+/// deposition, so that a whole experiment runs in about a second.
+pub fn small() -> ExperimentConfig {
+    let mut c = ExperimentConfig::quick();
+    c.layer.length = 1.2;
+    c.layer.width = 0.6;
+    c.layer.height = 0.6;
+    c.packing.hold_time = 0.02;
+    c.packing.max_deposition_time = 1.0;
+    c.packing.settle_speed = 0.2;
+    c.packing.compaction_pressure = 1.0e4;
+    c.rock.seed = 3;
+    c
+}
