@@ -18,8 +18,9 @@ use super::contact_sphere_polyhedron::contact_polytope_sphere;
 use super::contact_sphere_sphere::contact_sphere_sphere;
 use super::counters::QueryCounters;
 use super::epa::EpaScratch;
+use super::pair_smoothing::{smooth_pair_overlap, PairSmoothing};
 use super::tolerances::ContactTolerances;
-use super::ContactGeometry;
+use super::{ContactGeometry, ContactKind};
 use crate::math::{Point, Pose};
 use crate::shape::Shape;
 
@@ -77,16 +78,24 @@ pub fn query_with(
 ) -> Result<ContactGeometry, ContactError> {
     let centre = |pos: &Pose| Point::from(pos.translation.vector);
     let g = match (shape1, shape2) {
-        (Shape::Polyhedron(a), Shape::Polyhedron(b)) => query_polytopes_cached(
-            pos1,
-            a.as_ref(),
-            pos2,
-            b.as_ref(),
-            tol,
-            cache,
-            scratch,
-            counters,
-        ),
+        (Shape::Polyhedron(a), Shape::Polyhedron(b)) => {
+            let g = query_polytopes_cached(
+                pos1,
+                a.as_ref(),
+                pos2,
+                b.as_ref(),
+                tol,
+                cache,
+                scratch,
+                counters,
+            );
+            match tol.pair_smoothing {
+                PairSmoothing::Smoothed { band } if g.kind == ContactKind::Overlap => {
+                    smooth_pair_overlap(pos1, a.as_ref(), pos2, b.as_ref(), &g, band)
+                }
+                _ => g,
+            }
+        }
         (Shape::Polyhedron(a), Shape::Sphere(s)) => contact_polytope_sphere(
             pos1,
             a.as_ref(),

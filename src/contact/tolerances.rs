@@ -33,6 +33,10 @@ pub struct ContactTolerances {
     /// The overlap a polyhedron–wall contact hands to the law (default: the smoothed depth with a band of
     /// 1e-4 L; see [`super::wall_depth`]). Not a tolerance of the status, which is always exact.
     pub wall_depth: super::wall_depth::WallDepth,
+    /// The overlap a polyhedron–polyhedron contact hands to the law through [`super::query_with`]
+    /// (default: smoothed with a band of 1e-4 L; see [`super::pair_smoothing`]). The geometric queries
+    /// (`query_polytopes_cached`, `query_polyhedra*`, the oracles) always answer the exact overlap.
+    pub pair_smoothing: super::pair_smoothing::PairSmoothing,
 }
 
 impl Default for ContactTolerances {
@@ -44,6 +48,7 @@ impl Default for ContactTolerances {
             gjk_max_iterations: 128,
             epa_max_iterations: 256,
             wall_depth: Default::default(),
+            pair_smoothing: Default::default(),
         }
     }
 }

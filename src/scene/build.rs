@@ -11,6 +11,7 @@ use std::sync::Arc;
 
 use toml::Spanned;
 
+use crate::contact::pair_smoothing::PairSmoothing;
 use crate::contact::wall_depth::WallDepth;
 use crate::dynamics::{Motion, PrincipalInertia, RigidBody, ViscousDamping};
 use crate::law::hertz_mindlin::{material_hertz_mindlin, ElasticMaterial, HertzMindlinOptions};
@@ -1007,6 +1008,7 @@ fn build(ctx: &Ctx, file: &SceneFile) -> Result<Simulation, SceneError> {
     let mut params = StepParams::new(dt);
     params.damping = damping;
     params.tolerances.wall_depth = wall_depth(ctx, sim)?;
+    params.tolerances.pair_smoothing = pair_smoothing(ctx, sim)?;
     let steps = super::run::steps_to(end_time, dt);
     let output_every = ((output_interval / dt).round() as u64).max(1);
     Ok(Simulation {
@@ -1050,6 +1052,34 @@ fn wall_depth(ctx: &Ctx, sim: &SimulationSection) -> Result<WallDepth, SceneErro
             span,
             "simulation.wall_depth",
             format!("must be \"smoothed\" or \"deepest_vertex\", got \"{other}\""),
+        )),
+    }
+}
+
+/// `simulation.pair_smoothing` and `simulation.pair_smoothing_band`: the overlap a polyhedron–polyhedron
+/// contact hands to the law. A band given with the exact overlap is refused (it would be ignored).
+fn pair_smoothing(ctx: &Ctx, sim: &SimulationSection) -> Result<PairSmoothing, SceneError> {
+    let band = match &sim.pair_smoothing_band {
+        Some(b) => Some((ctx.positive(b, "simulation.pair_smoothing_band")?, b.span())),
+        None => None,
+    };
+    let rule = sim
+        .pair_smoothing
+        .as_ref()
+        .map(|r| (r.get_ref().as_str(), r.span()));
+    match (rule, band) {
+        (None | Some(("smoothed", _)), None) => Ok(PairSmoothing::default()),
+        (None | Some(("smoothed", _)), Some((band, _))) => Ok(PairSmoothing::Smoothed { band }),
+        (Some(("exact", _)), None) => Ok(PairSmoothing::Exact),
+        (Some(("exact", _)), Some((_, span))) => Err(ctx.invalid(
+            span,
+            "simulation.pair_smoothing_band",
+            "a band applies to pair_smoothing = \"smoothed\" only, not to \"exact\"",
+        )),
+        (Some((other, span)), _) => Err(ctx.invalid(
+            span,
+            "simulation.pair_smoothing",
+            format!("must be \"smoothed\" or \"exact\", got \"{other}\""),
         )),
     }
 }

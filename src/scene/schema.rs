@@ -58,6 +58,11 @@ pub struct SimulationSection {
     pub wall_depth: Option<Spanned<String>>,
     /// Band h of the smoothed wall depth as a fraction of the body's bounding diameter; absent = 1e-4.
     pub wall_depth_band: Option<Spanned<f64>>,
+    /// Overlap that a polyhedron–polyhedron contact hands to the law: `"smoothed"` (default) or `"exact"`
+    /// (see `crate::contact::pair_smoothing`).
+    pub pair_smoothing: Option<Spanned<String>>,
+    /// Band h of the smoothed pair overlap as a fraction of the smaller bounding diameter; absent = 1e-4.
+    pub pair_smoothing_band: Option<Spanned<f64>>,
 }
 
 /// `[[material]]`.

@@ -169,6 +169,15 @@ fn long_run(
     sim.params.tolerances.wall_depth = polydem::contact::WallDepth::Smoothed {
         band: p.speed * (lightest / p.normal_stiffness).sqrt() / size,
     };
+    // The same rule for polyhedron pairs (`polydem::contact::pair_smoothing`), whose band is relative to the
+    // smaller body of the pair: relative to the smallest body size, every pair gets at least that band.
+    let smallest = (0..sim.world.bodies.len())
+        .filter(|&i| sim.world.bodies[i].is_dynamic())
+        .map(|i| sim.world.length_scale(i))
+        .fold(Real::INFINITY, Real::min);
+    sim.params.tolerances.pair_smoothing = polydem::contact::PairSmoothing::Smoothed {
+        band: p.speed * (lightest / p.normal_stiffness).sqrt() / smallest,
+    };
     let extent = Vector::new(
         p.lattice[0] as Real,
         p.lattice[1] as Real,
