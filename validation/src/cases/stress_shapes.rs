@@ -7,7 +7,10 @@
 
 use std::sync::Arc;
 
-use polydem::contact::{sat_polyhedra, ContactGeometry, ContactKind, ContactTolerances};
+use polydem::contact::{
+    query_polyhedra_with, sat_polyhedra, ContactGeometry, ContactKind, ContactTolerances, EpaScratch,
+    PairCache, PairSmoothing, QueryCounters,
+};
 use polydem::math::{Point, Pose, Real, Rotation, Vector};
 use polydem::scene::Simulation;
 use polydem::shape::{ConvexPolyhedron, Shape};
@@ -58,8 +61,14 @@ struct OracleStats {
     pairs: u64,
     overlapping: u64,
     wrong_status: u64,
-    /// Largest |depth − depth_SAT| / size over pairs both call overlapping.
+    /// Largest |depth − depth_SAT| / size of the exact query (GJK/EPA, the narrow phase before the law's
+    /// smoothing) over pairs the store and SAT both call overlapping.
     depth_error: Real,
+    /// Largest (depth − depth_SAT) / size of the depth the law saw (the stored geometry, smoothed by
+    /// `polydem::contact::pair_smoothing`): it must never exceed the exact overlap.
+    law_excess: Real,
+    /// Largest (depth_SAT − depth) / h of the law's depth, h the pair's smoothing band (0 if exact).
+    law_shortfall_over_band: Real,
 }
 
 fn compare_with_oracle(sim: &Simulation, stats: &mut OracleStats) {
@@ -92,8 +101,25 @@ fn compare_with_oracle(sim: &Simulation, stats: &mut OracleStats) {
             if oracle.kind == ContactKind::Overlap {
                 stats.overlapping += 1;
                 if let Some((ContactKind::Overlap, g)) = engine_kind {
-                    stats.depth_error =
-                        stats.depth_error.max((g.depth - oracle.depth).abs() / size);
+                    let exact = query_polyhedra_with(
+                        &w.pose(i),
+                        a,
+                        &w.pose(j),
+                        b,
+                        &sim.params.tolerances,
+                        &mut PairCache::default(),
+                        &mut EpaScratch::default(),
+                        &mut QueryCounters::default(),
+                    );
+                    stats.depth_error = stats
+                        .depth_error
+                        .max((exact.depth - oracle.depth).abs() / size);
+                    stats.law_excess = stats.law_excess.max((g.depth - oracle.depth) / size);
+                    if let PairSmoothing::Smoothed { band } = sim.params.tolerances.pair_smoothing {
+                        let h = band * w.length_scale(i).min(w.length_scale(j));
+                        stats.law_shortfall_over_band =
+                            stats.law_shortfall_over_band.max((oracle.depth - g.depth) / h);
+                    }
                 }
             }
         }
@@ -330,6 +356,7 @@ impl Case for StressShapes {
     ) -> Result<(), SuiteError> {
         let p: Params = data.params(CASE, profile)?;
         let tol_depth = data.tolerance(CASE, "depth_error")?.value;
+        let tol_shortfall = data.tolerance(CASE, "law_depth_shortfall_over_band")?.value;
         let tol_walls = data.tolerance(CASE, "energy_error_max_walls")?.value;
         let tol_free = data.tolerance(CASE, "energy_error_max_free")?.value;
         let mut rng = ChaCha8Rng::seed_from_u64(p.seed);
@@ -359,7 +386,25 @@ impl Case for StressShapes {
         ctx.progress().inc(1);
 
         // Mass ratio: cubes of one size, densities ρ and ρ/ratio, alternating.
-        let sim = mass_ratio_scene(&p).build(CASE, "mass_ratio")?;
+        let mut sim = mass_ratio_scene(&p).build(CASE, "mass_ratio")?;
+        // The smoothing bands of walls and pairs by the rule of `polydem::contact::wall_depth` (h = the
+        // scene's characteristic overlap): the peak overlap V √(m/k) of a light cube struck at the heavy
+        // cube's speed, relative to the cube size (one size here).
+        let light = sim
+            .world
+            .bodies
+            .iter()
+            .map(|b| b.mass)
+            .fold(Real::INFINITY, Real::min);
+        let heavy_speed = sim
+            .world
+            .bodies
+            .iter()
+            .map(|b| b.velocity.norm())
+            .fold(0.0, Real::max);
+        let band = heavy_speed * (light / p.normal_stiffness).sqrt() / sim.world.length_scale(0);
+        sim.params.tolerances.wall_depth = polydem::contact::WallDepth::Smoothed { band };
+        sim.params.tolerances.pair_smoothing = PairSmoothing::Smoothed { band };
         let masses: Vec<Real> = sim.world.bodies.iter().map(|b| b.mass).collect();
         let ratio = masses.iter().cloned().fold(0.0, Real::max)
             / masses.iter().cloned().fold(Real::INFINITY, Real::min);
@@ -413,6 +458,18 @@ impl Case for StressShapes {
                 &format!("{n}_depth_error_vs_sat"),
                 r.oracle.depth_error,
                 Target::at_most(tol_depth),
+                "1",
+            );
+            ctx.check(
+                &format!("{n}_law_depth_excess_over_sat"),
+                r.oracle.law_excess,
+                Target::at_most(tol_depth),
+                "1",
+            );
+            ctx.check(
+                &format!("{n}_law_depth_shortfall_over_band"),
+                r.oracle.law_shortfall_over_band,
+                Target::at_most(tol_shortfall),
                 "1",
             );
             ctx.check(
