@@ -24,6 +24,8 @@ materials = ["rock", "rock"]
 law = "linear"
 normal_stiffness = 1.0e6
 restitution = 0.5
+tangential_stiffness = 5.0e5
+friction = 0.5
 
 [[shape]]
 name = "tetra"
