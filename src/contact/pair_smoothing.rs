@@ -401,10 +401,7 @@ mod tests {
             .iter()
             .map(|v| (rot * v).z)
             .fold(Real::INFINITY, Real::min);
-        let pose_b = Pose::from_parts(
-            Translation::new(0.05, -0.02, 0.1 - lowest - sink),
-            rot.into(),
-        );
+        let pose_b = Pose::from_parts(Translation::new(0.05, -0.02, 0.1 - lowest - sink), rot);
         (slab, Pose::identity(), cube, pose_b)
     }
 

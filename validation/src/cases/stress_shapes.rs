@@ -8,8 +8,8 @@
 use std::sync::Arc;
 
 use polydem::contact::{
-    query_polyhedra_with, sat_polyhedra, ContactGeometry, ContactKind, ContactTolerances, EpaScratch,
-    PairCache, PairSmoothing, QueryCounters,
+    query_polyhedra_with, sat_polyhedra, ContactGeometry, ContactKind, ContactTolerances,
+    EpaScratch, PairCache, PairSmoothing, QueryCounters,
 };
 use polydem::math::{Point, Pose, Real, Rotation, Vector};
 use polydem::scene::Simulation;
@@ -117,8 +117,9 @@ fn compare_with_oracle(sim: &Simulation, stats: &mut OracleStats) {
                     stats.law_excess = stats.law_excess.max((g.depth - oracle.depth) / size);
                     if let PairSmoothing::Smoothed { band } = sim.params.tolerances.pair_smoothing {
                         let h = band * w.length_scale(i).min(w.length_scale(j));
-                        stats.law_shortfall_over_band =
-                            stats.law_shortfall_over_band.max((oracle.depth - g.depth) / h);
+                        stats.law_shortfall_over_band = stats
+                            .law_shortfall_over_band
+                            .max((oracle.depth - g.depth) / h);
                     }
                 }
             }
