@@ -307,3 +307,54 @@ fn damped_ledger_with_a_moving_wall_and_a_cube_converges_at_second_order() {
         50.0,
     );
 }
+
+/// Sphere bed a (`scenes/sphere_bed_a_hertz_5ms.toml`, 3000 spheres, Hertz–Mindlin with e = 0.5/0.4,
+/// μ = 0.3/0.2, force limit, tangential dashpot), first 3 ms at the scene's Δt = 2 µs, Δt/2 and Δt/4,
+/// with the scene's friction and with μ = 0: prints the final balance, the largest |balance| and the
+/// booked terms (J). A measurement, not a gate (seconds to a minute per run):
+/// `cargo test --release --test world_ledger_damping -- --ignored --nocapture`.
+#[test]
+#[ignore]
+fn sphere_bed_a_ledger_over_the_first_3_ms() {
+    let path =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/sphere_bed_a_hertz_5ms.toml");
+    for frictionless in [true, false] {
+        for refinement in [1u32, 2, 4] {
+            let mut sim = polydem::scene::load_scene(&path).expect("scene");
+            if frictionless {
+                let n = sim.world.materials.len() as u32;
+                for a in 0..n {
+                    for b in 0..n {
+                        if let Some(m) = sim.world.materials.model(a, b).copied() {
+                            let mut m = m;
+                            m.tangential = TangentialLaw::None;
+                            sim.world.materials.set_model(a, b, m);
+                        }
+                    }
+                }
+            }
+            let mut params = sim.params;
+            params.dt /= refinement as Real;
+            let steps = (3e-3 / params.dt).round() as usize;
+            let mut scratch = StepScratch::default();
+            let mut worst: Real = 0.0;
+            for _ in 0..steps {
+                step(&params, &mut sim.world, &mut scratch).expect("step");
+                worst = worst.max(sim.world.energy().balance.abs());
+            }
+            let e = sim.world.energy();
+            eprintln!(
+                "sphere bed a, {}, dt = {:.3e} s: balance {:.4e} J, max |balance| {:.4e} J; damping {:.4e}, \
+                 friction {:.4e}, stiffness work {:.4e}, external {:.4e} J",
+                if frictionless { "mu = 0" } else { "scene friction" },
+                params.dt,
+                e.balance,
+                worst,
+                e.dissipated_damping,
+                e.dissipated_friction,
+                e.tangential_stiffness_work,
+                e.external_work
+            );
+        }
+    }
+}
