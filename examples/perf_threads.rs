@@ -77,7 +77,11 @@ fn build(name: &str) -> Result<bed::Bed, String> {
             b
         }
         "spheres" => bed::build(&spec(1)),
-        _ => return Err(format!("unknown scene {name} (poly, poly_projectile, spheres)")),
+        _ => {
+            return Err(format!(
+                "unknown scene {name} (poly, poly_projectile, spheres)"
+            ))
+        }
     })
 }
 
@@ -116,7 +120,12 @@ fn state_bits(w: &World) -> Vec<u64> {
         .collect()
 }
 
-fn run(world: &World, params: &StepParams, steps: usize, threads: usize) -> (World, StepCounters, Duration, Duration) {
+fn run(
+    world: &World,
+    params: &StepParams,
+    steps: usize,
+    threads: usize,
+) -> (World, StepCounters, Duration, Duration) {
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
         .build()

@@ -41,6 +41,14 @@ pub const DEFAULT_MIN_CANDIDATES: usize = 4096;
 /// 300 ms: the fork/joins cost more than the work. Below ~10^4 bodies the integration stays serial.
 pub const DEFAULT_MIN_BODIES: usize = 20_000;
 
+/// Weight of a dynamic body with unequal principal moments in the integration's work
+/// ([`integration_work`]): its rotation splitting (three sub-rotations per drift) costs about this many
+/// sphere kicks and drifts. Measured with `examples/perf_threads.rs` (2026-11-21, 1 thread, load ~10, so
+/// both inflated alike): 10^4 spinning polyhedra 3.3 ms of integration per step, 10^4 spheres 0.74 ms
+/// (ratio 4.4, the spheres' time including their cheaper isotropic turn): 4, so that from 5000 tumbling
+/// polyhedra on the integration runs in parallel (10^4 spheres stay below [`DEFAULT_MIN_BODIES`]).
+pub const ANISOTROPIC_WEIGHT: usize = 4;
+
 /// When the step uses more than one thread. Threads come from rayon's current pool (the global pool, or
 /// the one a caller `install`s); the results do not depend on the choice.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
@@ -140,4 +148,76 @@ where
             f(i, t);
         }
     }
+}
+
+/// Calls `f(i, &mut items[i])` for every item, in parallel when `parallel`, and returns the first item (in
+/// item order) for which `f` returned an error, with that error. Every item is visited whatever fails, so
+/// the items end in the same state for any number of threads.
+pub fn for_each_item_checked<T, E, F>(parallel: bool, items: &mut [T], f: F) -> Option<(usize, E)>
+where
+    T: Send,
+    E: Send,
+    F: Fn(usize, &mut T) -> Option<E> + Sync + Send,
+{
+    if parallel && rayon::current_num_threads() > 1 {
+        let min_len = items
+            .len()
+            .div_ceil(rayon::current_num_threads() * CHUNKS_PER_THREAD);
+        items
+            .par_iter_mut()
+            .with_min_len(min_len.max(1))
+            .enumerate()
+            .filter_map(|(i, t)| f(i, t).map(|e| (i, e)))
+            .min_by_key(|(i, _)| *i)
+    } else {
+        let mut first = None;
+        for (i, t) in items.iter_mut().enumerate() {
+            if let Some(e) = f(i, t) {
+                first.get_or_insert((i, e));
+            }
+        }
+        first
+    }
+}
+
+/// Fills `out[i] = f(i)` for every `i` in `0..out.len()`, in parallel when `parallel` (each slot written
+/// once, by its own item: the same values for any number of threads).
+pub fn fill_items<T, F>(parallel: bool, out: &mut [T], f: F)
+where
+    T: Send,
+    F: Fn(usize) -> T + Sync + Send,
+{
+    for_each_item(parallel, out, |i, slot| *slot = f(i));
+}
+
+/// Calls `f(i, &mut a[i], &mut b[i])` for every item, in parallel when `parallel` (work split by rayon; `f`
+/// must not depend on the order).
+pub fn for_each_item_pair<A, B, F>(parallel: bool, a: &mut [A], b: &mut [B], f: F)
+where
+    A: Send,
+    B: Send,
+    F: Fn(usize, &mut A, &mut B) + Sync + Send,
+{
+    debug_assert_eq!(a.len(), b.len());
+    if parallel && rayon::current_num_threads() > 1 {
+        let min_len = a
+            .len()
+            .div_ceil(rayon::current_num_threads() * CHUNKS_PER_THREAD);
+        a.par_iter_mut()
+            .zip(b.par_iter_mut())
+            .with_min_len(min_len.max(1))
+            .enumerate()
+            .for_each(|(i, (x, y))| f(i, x, y));
+    } else {
+        for (i, (x, y)) in a.iter_mut().zip(b.iter_mut()).enumerate() {
+            f(i, x, y);
+        }
+    }
+}
+
+/// The integration's work in units of a sphere's kick and drift, compared with
+/// [`Parallelism::min_bodies`]: `bodies` plus [`ANISOTROPIC_WEIGHT`] − 1 more per dynamic body with unequal
+/// principal moments.
+pub fn integration_work(bodies: usize, anisotropic: usize) -> usize {
+    bodies + (ANISOTROPIC_WEIGHT - 1) * anisotropic
 }
