@@ -546,10 +546,11 @@ fn evaluate_loads(
     loads.elastic_potential = 0.0;
     loads.damping_power = 0.0;
     loads.friction_dissipation = 0.0;
-    // Forces and torques on the bodies, summed in candidate order: serially by a scatter over the
-    // candidates (in the loop below); in parallel per body over its pairs (the same additions in the same
-    // order: the same bits).
-    if parallel {
+    // Forces and torques on the bodies, summed in candidate order: on one thread by a scatter over the
+    // candidates (in the loop below: one sequential pass); on several per body over its pairs (the same
+    // additions in the same order: the same bits; it reads each result twice, so it pays only in parallel).
+    let gather = parallel && rayon::current_num_threads() > 1;
+    if gather {
         let adjacency = world.contacts.body_adjacency(n);
         let evaluated = &scratch.evaluated;
         for_each_item_pair(
@@ -576,7 +577,7 @@ fn evaluate_loads(
         }
         let r = &e.response;
         match *key {
-            ContactKey::Body { a, b } if !parallel => {
+            ContactKey::Body { a, b } if !gather => {
                 loads.forces[a as usize] -= r.force_on_b;
                 loads.torques[a as usize] += r.torque_on_a;
                 loads.forces[b as usize] += r.force_on_b;
@@ -585,7 +586,7 @@ fn evaluate_loads(
             ContactKey::Body { .. } => {}
             ContactKey::Wall { body, wall } => {
                 loads.wall_forces[wall as usize] -= r.force_on_b;
-                if !parallel {
+                if !gather {
                     loads.forces[body as usize] += r.force_on_b;
                     loads.torques[body as usize] += r.torque_on_b;
                 }
