@@ -51,12 +51,14 @@ pub fn rows_before<'a>(
     let mut lines = text.lines();
     match lines.next() {
         Some(first) if first == header => {}
-        Some(first) => return Err((
-            1,
-            format!(
+        Some(first) => {
+            return Err((
+                1,
+                format!(
                 "header \"{first}\" is not the expected \"{header}\": not an output of this run"
             ),
-        )),
+            ))
+        }
         None => return Err((1, "empty file: no header".into())),
     }
     let mut kept = Vec::new();
