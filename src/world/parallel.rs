@@ -1,12 +1,20 @@
 //! Deterministic data parallelism for the step: per-item work on rayon's current thread pool, results in
 //! item order, whatever the number of threads.
 //!
-//! The step's parallel stages (narrow phase, laws, integration) compute one independent result per item
-//! (candidate pair or body) and write it into that item's own slot; nothing is summed across items in
-//! parallel. Every sum over items (forces on a body, energy terms, counters that feed physics) is taken
-//! afterwards, serially, in the fixed item order. A per-item result is a function of the item's inputs only
-//! (the per-chunk scratch holds nothing that matters after a query), so the state after a step is the same
-//! bit for bit for 1, 2 or N threads — `tests/world_parallel.rs` proves it.
+//! The step's parallel stages (narrow phase and laws, the per-body force sums, the integration with the
+//! finiteness checks, the broad phase's pair search) compute one independent result per item (candidate
+//! pair or body) and write it into that item's own slot; nothing is summed across items in parallel. The
+//! force on a body is the sum over the body's own pairs, taken by that body's item in the fixed candidate
+//! order (the rows of [`crate::world::contact_store::BodyAdjacency`]); the sums over all candidates (energy
+//! terms, counters that feed physics) are taken serially in candidate order. A per-item result is a
+//! function of the item's inputs only (the per-chunk scratch holds nothing that matters after a query), so
+//! the state after a step is the same bit for bit for 1, 2 or N threads, and the same as the serial path's
+//! — `tests/world_parallel.rs` proves it. Errors found per item (a failed query, a non-finite body) are
+//! reported for the first failing item in item order.
+//!
+//! Per step there are four parallel regions when everything is above the thresholds: first half kick and
+//! drift; narrow phase and laws (fused); force sums; second half kick and checks (fused). The broad phase's
+//! search adds one on the steps that rebuild the grid.
 //!
 //! Work is split into contiguous chunks of items, a few per thread ([`CHUNKS_PER_THREAD`]), each with its
 //! own [`Worker`] scratch (EPA buffers and narrow-phase counters) taken from a vector kept in the step's
@@ -14,9 +22,11 @@
 //! its first failing item and the error of the lowest failing chunk wins, which is the first failing item
 //! in item order.
 //!
-//! Small scenes run serially: below [`Parallelism::min_candidates`] candidates (or
-//! [`Parallelism::min_bodies`] bodies for the integration) the fork/join overhead of rayon (a few µs per
-//! stage) exceeds the work; see [`DEFAULT_MIN_CANDIDATES`] for the measurement behind the defaults.
+//! Small scenes run serially: below [`Parallelism::min_candidates`] candidates (narrow phase, laws, force
+//! sums) or [`Parallelism::min_bodies`] units of integration work ([`integration_work`]: a body with
+//! unequal principal moments counts [`ANISOTROPIC_WEIGHT`]) the fork/join overhead of rayon (tens of µs per
+//! region on a 2-core VM) exceeds the work; see [`DEFAULT_MIN_CANDIDATES`] for the measurement behind the
+//! defaults.
 
 use rayon::prelude::*;
 
@@ -36,9 +46,11 @@ pub const CHUNKS_PER_THREAD: usize = 8;
 /// threshold of 128, measured at a load average of ~10, made the 1000-body box slower on two threads.)
 pub const DEFAULT_MIN_CANDIDATES: usize = 4096;
 
-/// Default [`Parallelism::min_bodies`]: 20 000 bodies. A half kick and drift cost only ~16 ns per body
-/// (same runs: 5000 bodies, integration 160 ms over 2000 steps serial), while the two-thread version took
-/// 300 ms: the fork/joins cost more than the work. Below ~10^4 bodies the integration stays serial.
+/// Default [`Parallelism::min_bodies`]: 20 000 units of integration work ([`integration_work`]). A half
+/// kick and drift cost only ~16 ns per body at rest or nearly (same runs: 5000 bodies, integration 160 ms
+/// over 2000 steps serial), while the two-thread version took 300 ms: the fork/joins cost more than the
+/// work. Tumbling polyhedra cost several times more ([`ANISOTROPIC_WEIGHT`]), so 10^4 spheres integrate
+/// serially and 5000 polyhedra in parallel.
 pub const DEFAULT_MIN_BODIES: usize = 20_000;
 
 /// Weight of a dynamic body with unequal principal moments in the integration's work
@@ -56,7 +68,8 @@ pub const ANISOTROPIC_WEIGHT: usize = 4;
 pub struct Parallelism {
     /// Narrow phase and laws run in parallel from this many candidates on.
     pub min_candidates: usize,
-    /// The integration runs in parallel from this many bodies on.
+    /// The integration runs in parallel from this much work on ([`integration_work`]: bodies, a body with
+    /// unequal principal moments counting [`ANISOTROPIC_WEIGHT`]).
     pub min_bodies: usize,
 }
 

@@ -9,10 +9,12 @@
 //!   4. narrow phase      contact store synced to the candidate list; one contact query per candidate
 //!   5. laws              ContactModel::evaluate per overlapping candidate (tangential history in the store);
 //!                        4 and 5 run fused, one pass over the candidates (the store entry is in cache)
-//!   6. accumulate        per-body sums of forces and torques in candidate order (fixed, deterministic)
+//!   6. accumulate        per-body sums of forces and torques in candidate order (fixed, deterministic:
+//!                        a scatter on one thread, a gather per body over its pairs on several)
 //!  6b. (sleeping on) wake the sleeping islands touched by moving bodies or walls
 //!   7. second half kick  v, L ← v, L + ½Δt (F_{n+1}, p_{n+1})
 //!   8. checks            non-finite state → StepError naming body and step; deep overlaps → StepReport
+//!                        (7 and the body checks of 8 run fused, one pass over the bodies)
 //!  8b. (sleeping on) calm counters, islands, bodies falling asleep (see [`super::sleeping`])
 //!   9. ledger, counters
 //! ```
@@ -21,10 +23,11 @@
 //! half-step velocities, as [`crate::dynamics::integrator`] documents.
 //!
 //! The candidate order is a function of the state only (the broad phase's sorted pairs, then body–wall
-//! pairs by body and wall). Stages 4 and 5 (one query and one law evaluation per candidate) and the
-//! integration (1–2, 7; one body at a time) run on rayon's current thread pool when the scene is large
-//! enough ([`Parallelism`]); each computes a result per item into that item's own slot, and stage 6 sums
-//! the per-candidate results serially in candidate order, so a run is bit-identical for any number of
+//! pairs by body and wall). Stages 4 and 5 (one query and one law evaluation per candidate), the force sums
+//! of stage 6 (one body at a time, over its pairs in candidate order) and the integration (1–2, 7–8; one
+//! body at a time) run on rayon's current thread pool when the scene is large enough ([`Parallelism`]);
+//! each computes a result per item into that item's own slot, and the sums over all candidates (energy
+//! terms, report) are taken serially in candidate order, so a run is bit-identical for any number of
 //! threads (see [`super::parallel`]; `tests/world_parallel.rs`).
 
 use std::time::{Duration, Instant};
@@ -128,7 +131,10 @@ pub struct StepCounters {
     /// summaries keep their columns.
     pub laws: Duration,
     pub accumulate: Duration,
+    /// Stages 1–2 and 7–8 (the checks run fused with the second half kick).
     pub integrate: Duration,
+    /// Zero since the checks run fused with the second half kick (their time is in `integrate`); kept so
+    /// that the summaries keep their columns.
     pub checks: Duration,
     /// Broad-phase grid rebuilds.
     pub broad_rebuilds: u64,
