@@ -15,7 +15,10 @@
 //!
 //! ```text
 //! cargo run --release --example perf_threads -- [--steps N] [--warm-up N] [--threads 1,2] [--scenes poly,poly_projectile,spheres]
+//!     [--min-candidates N] [--min-bodies N]
 //! ```
+//! The last two replace the parallel thresholds of the step ([`polydem::world::Parallelism`]; the results
+//! are the same bits either way), to re-measure them.
 //! (`scenes/perf/run_threads.sh` runs it with the defaults.)
 
 #[path = "../tests/support/bed.rs"]
@@ -30,6 +33,8 @@ struct Options {
     warm_up: usize,
     threads: Vec<usize>,
     scenes: Vec<String>,
+    min_candidates: Option<usize>,
+    min_bodies: Option<usize>,
 }
 
 fn parse() -> Result<Options, String> {
@@ -38,6 +43,8 @@ fn parse() -> Result<Options, String> {
         warm_up: 100,
         threads: vec![1, 2],
         scenes: vec!["poly".into(), "poly_projectile".into(), "spheres".into()],
+        min_candidates: None,
+        min_bodies: None,
     };
     let mut args = std::env::args().skip(1);
     while let Some(a) = args.next() {
@@ -52,6 +59,16 @@ fn parse() -> Result<Options, String> {
                     .collect::<Result<_, _>>()?
             }
             "--scenes" => o.scenes = value()?.split(',').map(str::to_owned).collect(),
+            "--min-candidates" => {
+                o.min_candidates = Some(
+                    value()?
+                        .parse()
+                        .map_err(|e| format!("--min-candidates: {e}"))?,
+                )
+            }
+            "--min-bodies" => {
+                o.min_bodies = Some(value()?.parse().map_err(|e| format!("--min-bodies: {e}"))?)
+            }
             _ => return Err(format!("unknown argument {a}")),
         }
     }
@@ -160,14 +177,21 @@ fn main() {
                 std::process::exit(2);
             }
         };
+        if let Some(n) = o.min_candidates {
+            b.params.parallel.min_candidates = n;
+        }
+        if let Some(n) = o.min_bodies {
+            b.params.parallel.min_bodies = n;
+        }
         let mut scratch = StepScratch::default();
         for _ in 0..o.warm_up {
             step(&b.params, &mut b.world, &mut scratch).expect("warm-up step");
         }
         let bodies = b.world.bodies.len();
         println!(
-            "== {name}: {bodies} bodies, {} steps from the state after {} warm-up steps (dt {:.3e} s)",
-            o.steps, o.warm_up, b.params.dt
+            "== {name}: {bodies} bodies, {} steps from the state after {} warm-up steps (dt {:.3e} s; \
+             parallel from {} candidates, {} integration units)",
+            o.steps, o.warm_up, b.params.dt, b.params.parallel.min_candidates, b.params.parallel.min_bodies
         );
         let mut reference: Option<(usize, Vec<u64>, f64)> = None;
         for &threads in &o.threads {
