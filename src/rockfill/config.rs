@@ -110,6 +110,52 @@ pub struct ImpactParams {
     pub disturbed_threshold: Real,
 }
 
+/// Sleeping in the experiment's runs ([`crate::world::sleeping`]): a numerical device, not a physical
+/// parameter, so the section and each of its keys may be left out; the defaults are the engine's thresholds
+/// and sleeping off, which reproduces the runs made before sleeping existed.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Deserialize, serde::Serialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct SleepingConfig {
+    /// Penetration run: the packed bed starts asleep, each rock with the load of the bed's last evaluation
+    /// as its rest load, and a rock wakes when the projectile (or a woken neighbour, or the removal of the
+    /// left and right walls) changes its load by more than `rest_force` of its weight.
+    pub penetration: bool,
+    /// Packing: rocks at rest fall asleep during deposition and hold (the moving top wall wakes the rocks
+    /// it touches, and their neighbours through their loads).
+    pub packing: bool,
+    /// [`crate::world::SleepParams::rest_speed`] (fraction of √(|g| d)).
+    pub rest_speed: Real,
+    /// [`crate::world::SleepParams::rest_force`] (fraction of the weight).
+    pub rest_force: Real,
+    /// [`crate::world::SleepParams::steps`].
+    pub steps: u32,
+}
+
+impl Default for SleepingConfig {
+    fn default() -> Self {
+        let engine = crate::world::SleepParams::default();
+        Self {
+            penetration: false,
+            packing: false,
+            rest_speed: engine.rest_speed,
+            rest_force: engine.rest_force,
+            steps: engine.steps,
+        }
+    }
+}
+
+impl SleepingConfig {
+    /// The engine's sleeping parameters, on when `enabled`.
+    pub fn params(&self, enabled: bool) -> crate::world::SleepParams {
+        crate::world::SleepParams {
+            enabled,
+            rest_speed: self.rest_speed,
+            rest_force: self.rest_force,
+            steps: self.steps,
+        }
+    }
+}
+
 /// Everything the experiment needs.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields)]
@@ -120,6 +166,9 @@ pub struct ExperimentConfig {
     pub packing: PackingParams,
     pub impact: ImpactParams,
     pub projectile: ProjectileParams,
+    /// Optional (see [`SleepingConfig`]).
+    #[serde(default)]
+    pub sleeping: SleepingConfig,
 }
 
 /// The full-scale experiment (the file `scenes/rockfill/paper.toml`, compiled in).
@@ -201,6 +250,8 @@ impl ExperimentConfig {
             ("packing.viscous_rate", self.packing.viscous_rate),
             ("packing.hold_time", self.packing.hold_time),
             ("impact.arrival_time", self.impact.arrival_time),
+            ("sleeping.rest_speed", self.sleeping.rest_speed),
+            ("sleeping.rest_force", self.sleeping.rest_force),
         ];
         let invalid = |field, value, reason| ConfigError::Invalid {
             path: path.to_owned(),
