@@ -14,7 +14,7 @@
 //!
 //! Local waking, on a column of 40 spheres standing on the floor (every contact carries the weight above it,
 //! so the column is one connected group in which every body touches the next), struck on top by a steel
-//! sphere, from an exact equilibrium with every sphere asleep:
+//! sphere, from an exact equilibrium, with every sphere put to sleep after the first step:
 //! - the wake front: each sphere wakes within one pulse travel time per sphere of the step at which, in the
 //!   run without sleeping, its load first departs from equilibrium by the wake threshold; the woken spheres
 //!   are always a top segment of the column; the striker's velocity agrees with the run without sleeping
@@ -265,18 +265,21 @@ struct ColumnRun {
     sleeping_body_steps: u64,
 }
 
-/// Runs the struck column for `steps` steps, all spheres asleep from the start when `sleeping`.
+/// Runs the struck column for one step and then `steps` steps, all spheres asleep after the first step when
+/// `sleeping`.
 fn strike_column(sleeping: bool, steps: usize) -> ColumnRun {
     let (mut world, mut params, p) = column();
     let sleep = SleepParams::on();
+    let mut scratch = StepScratch::default();
+    // One step awake in both runs, so that the contacts have been evaluated (their forces are what the
+    // sleeping spheres keep).
+    step(&params, &mut world, &mut scratch).expect("first step");
     if sleeping {
         params.sleeping = sleep;
-        // The column is in exact equilibrium: the rest loads of an unevaluated world are zero.
-        let n = sleeping::put_to_sleep(&mut world, 0..COLUMN);
+        let n = sleeping::put_to_sleep(&sleep, &mut world, 0..COLUMN);
         assert_eq!(n, COLUMN, "every sphere of the column falls asleep");
     }
     let g = world.gravity.norm();
-    let mut scratch = StepScratch::default();
     let mut first = vec![None; COLUMN];
     let mut top_segment = true;
     let mut counters = StepCounters::default();

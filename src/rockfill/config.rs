@@ -129,6 +129,11 @@ pub struct SleepingConfig {
     pub rest_force: Real,
     /// [`crate::world::SleepParams::steps`].
     pub steps: u32,
+    /// [`crate::world::SleepParams::wake_contact_fraction`]: in a compacted bed every contact carries many
+    /// rock weights, so a threshold of a fraction of the weight is a fraction of a per mille of the contact
+    /// forces, and the explicit step's one-contact-per-step precursor of any disturbance then wakes the whole
+    /// bed within tens of steps.
+    pub wake_contact_fraction: Real,
 }
 
 impl Default for SleepingConfig {
@@ -140,6 +145,7 @@ impl Default for SleepingConfig {
             rest_speed: engine.rest_speed,
             rest_force: engine.rest_force,
             steps: engine.steps,
+            wake_contact_fraction: engine.wake_contact_fraction,
         }
     }
 }
@@ -152,6 +158,7 @@ impl SleepingConfig {
             rest_speed: self.rest_speed,
             rest_force: self.rest_force,
             steps: self.steps,
+            wake_contact_fraction: self.wake_contact_fraction,
         }
     }
 }
@@ -253,6 +260,16 @@ impl ExperimentConfig {
             ("sleeping.rest_speed", self.sleeping.rest_speed),
             ("sleeping.rest_force", self.sleeping.rest_force),
         ];
+        if !(self.sleeping.wake_contact_fraction.is_finite()
+            && self.sleeping.wake_contact_fraction >= 0.0)
+        {
+            return Err(ConfigError::Invalid {
+                path: path.to_owned(),
+                field: "sleeping.wake_contact_fraction",
+                value: self.sleeping.wake_contact_fraction,
+                reason: "must be finite and non-negative",
+            });
+        }
         let invalid = |field, value, reason| ConfigError::Invalid {
             path: path.to_owned(),
             field,

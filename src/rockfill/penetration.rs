@@ -248,7 +248,7 @@ pub struct PenetrationReport {
     pub asleep_fraction: Real,
 }
 
-/// Removes the left and right walls and adds the projectile with its tip `speed × arrival_time` ahead of
+/// With `sleeping.penetration`, puts every rock to sleep ([`sleeping::put_to_sleep`]). Removes the left and right walls and adds the projectile with its tip `speed × arrival_time` ahead of
 /// the centre of the left face, moving along +x. Returns the projectile's body index.
 pub fn add_projectile(
     config: &ExperimentConfig,
@@ -260,6 +260,15 @@ pub fn add_projectile(
             walls: world.walls.len(),
             expected: KEPT_WALLS + 2,
         });
+    }
+    if config.sleeping.penetration {
+        // The packed bed is at rest: every rock falls asleep against the walls it was packed in, so that
+        // removing the left and right walls wakes the rocks they held (see `crate::world::sleeping`).
+        sleeping::put_to_sleep(
+            &config.sleeping.params(true),
+            world,
+            0..world.bodies.len(),
+        );
     }
     world.walls.truncate(KEPT_WALLS);
     world.loads.current = false;
@@ -337,12 +346,6 @@ pub fn penetrate_with(
         + world.bodies[index].rotational_kinetic_energy();
     // The ledger restarts here: removing walls and adding the projectile changed the energy outside it.
     world.ledger = EnergyLedger::default();
-    if params.sleeping.enabled {
-        // The packed bed is at rest: every rock starts asleep, with the loads of the bed's last evaluation
-        // (against the walls that were just removed) as its rest loads (see `crate::world::sleeping`).
-        let rocks: Vec<usize> = (0..world.bodies.len()).filter(|&i| i != index).collect();
-        sleeping::put_to_sleep(world, rocks);
-    }
     let mut counters = StepCounters::default();
     let t0 = world.time;
     let length = projectile.params.length;

@@ -345,7 +345,7 @@ pub fn step(
 
     // 6b. Sleeping bodies disturbed by this evaluation wake before the second half kick.
     if params.sleeping.enabled {
-        report.counters.woken += sleeping::wake_disturbed(&params.sleeping, world);
+        report.counters.woken += sleeping::wake_disturbed(world);
     }
 
     // 7. Second half kick.
