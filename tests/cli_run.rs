@@ -336,3 +336,112 @@ fn restart_through_the_cli_continues_to_the_same_final_rows() {
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// A restart into the directory of the earlier run continues its outputs: the CSV series equal the straight
+/// run's byte for byte, and each `.pvd` lists the same frames. The restart rewinds: it starts from the
+/// earlier run's first checkpoint (at an output time), not its last, so the earlier rows and frames after
+/// that point are replaced.
+#[test]
+fn restart_into_the_same_directory_continues_the_csv_and_vtk_series() {
+    let dir = out_dir("restart-same-dir");
+    let scene = scene_path("settling_box.toml");
+    let os = |s: &str| std::ffi::OsString::from(s);
+    let straight = dir.join("straight");
+    let resumed = dir.join("resumed");
+    let run = |args: &[&std::ffi::OsStr]| {
+        let o = polydem(args);
+        assert!(
+            o.status.success(),
+            "{args:?}: {}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+    };
+    let vtk = ["--vtk-interval", "0.05"].map(os);
+    run(&[
+        &os("run"),
+        scene.as_os_str(),
+        &os("--out"),
+        straight.as_os_str(),
+        &os("--end-time"),
+        &os("0.2"),
+        &vtk[0],
+        &vtk[1],
+        &os("--quiet"),
+    ]);
+    // Checkpoints every 5 output intervals: the 6th row's time is 5 intervals in whole steps.
+    let energy = std::fs::read_to_string(straight.join("energy.csv")).unwrap();
+    let five_outputs = energy.lines().nth(6).unwrap().split(',').next().unwrap();
+    run(&[
+        &os("run"),
+        scene.as_os_str(),
+        &os("--out"),
+        resumed.as_os_str(),
+        &os("--end-time"),
+        &os("0.16"),
+        &os("--checkpoint-interval"),
+        &os(five_outputs),
+        &vtk[0],
+        &vtk[1],
+        &os("--quiet"),
+    ]);
+    let first_checkpoint = std::fs::read_dir(resumed.join("checkpoints"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .min()
+        .expect("checkpoints");
+    run(&[
+        &os("run"),
+        &os("--restart"),
+        first_checkpoint.as_os_str(),
+        &os("--out"),
+        resumed.as_os_str(),
+        &os("--end-time"),
+        &os("0.2"),
+        &vtk[0],
+        &vtk[1],
+        &os("--quiet"),
+    ]);
+    for csv in ["bodies.csv", "energy.csv", "walls.csv"] {
+        let a = std::fs::read_to_string(straight.join(csv)).unwrap();
+        let b = std::fs::read_to_string(resumed.join(csv)).unwrap();
+        assert!(
+            a == b,
+            "{csv}: the continued series differs from the straight run's ({} against {} lines; \
+             restart from {})",
+            b.lines().count(),
+            a.lines().count(),
+            first_checkpoint.display()
+        );
+    }
+    // The restart writes a frame at its start (documented), here between two frames of the interval.
+    let start_step = first_checkpoint
+        .file_stem()
+        .and_then(|s| s.to_str())
+        .and_then(|s| s.strip_prefix("step_"))
+        .expect("checkpoint named step_<step>.pdck");
+    for pvd in ["polyhedra.pvd", "walls.pvd"] {
+        let a = std::fs::read_to_string(straight.join(pvd)).unwrap();
+        let b = std::fs::read_to_string(resumed.join(pvd)).unwrap();
+        let start_frame = format!("_{start_step}.vtu");
+        let without_start: String = b
+            .lines()
+            .filter(|line| !line.contains(&start_frame))
+            .map(|line| format!("{line}\n"))
+            .collect();
+        assert_eq!(
+            b.lines().count(),
+            a.lines().count() + 1,
+            "{pvd}: one frame more than the straight run (the restart's start)"
+        );
+        assert_eq!(
+            a, without_start,
+            "{pvd}: the continued collection lists other frames"
+        );
+        assert_eq!(
+            a.matches("<DataSet").count(),
+            5,
+            "{pvd}: frames at 0, 0.05, …, 0.2"
+        );
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}

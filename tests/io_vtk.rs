@@ -6,7 +6,9 @@
 
 use std::path::{Path, PathBuf};
 
-use polydem::io::vtk::{VtkFormat, VtkWriter, VTK_POLYGON, VTK_VERTEX};
+use polydem::io::vtk::{
+    VtkCompression, VtkEncoding, VtkFormat, VtkPrecision, VtkWriter, VTK_POLYGON, VTK_VERTEX,
+};
 use polydem::math::{Point, Vector};
 use polydem::scene::{parse_scene, Simulation};
 use polydem::shape::Shape;
@@ -80,38 +82,120 @@ fn connectivity(p: &UnstructuredGridPiece) -> (Vec<u64>, Vec<u64>) {
     }
 }
 
-fn close(label: &str, got: &[f64], expected: &Vector, scale: f64) {
+/// Checks a vector read back: within 1e-12 × `scale` for Float64 frames; for Float32 frames (`rounding` =
+/// 2^-24, the relative error of rounding to the nearest f32) each component may further differ by
+/// `rounding` × its magnitude (plus f32's smallest normal, for values that underflow).
+fn close(rounding: f64, label: &str, got: &[f64], expected: &Vector, scale: f64) {
     let got = Vector::new(got[0], got[1], got[2]);
-    assert!(
-        (got - expected).norm() <= 1e-12 * scale,
-        "{label}: read {got:?}, expected {expected:?}, tolerance 1e-12 × {scale}"
-    );
+    let floor = if rounding > 0.0 {
+        f32::MIN_POSITIVE as f64
+    } else {
+        0.0
+    };
+    for k in 0..3 {
+        let tolerance = 1e-12 * scale + rounding * expected[k].abs() + floor;
+        assert!(
+            (got[k] - expected[k]).abs() <= tolerance,
+            "{label}: read {got:?}, expected {expected:?}, component {k} off by {:e}, tolerance {tolerance:e} \
+             (1e-12 × {scale} + {rounding:e} × |expected|)",
+            (got[k] - expected[k]).abs()
+        );
+    }
 }
 
 #[test]
 fn binary_frames_parse_back_with_the_world_geometry_and_fields() {
-    frames_parse_back_with_the_world_geometry_and_fields(VtkFormat::Binary);
+    frames_parse_back_with_the_world_geometry_and_fields(VtkFormat::Binary.into());
 }
 
 #[test]
 fn ascii_frames_parse_back_with_the_world_geometry_and_fields() {
-    frames_parse_back_with_the_world_geometry_and_fields(VtkFormat::Ascii);
+    frames_parse_back_with_the_world_geometry_and_fields(VtkFormat::Ascii.into());
 }
 
-fn frames_parse_back_with_the_world_geometry_and_fields(format: VtkFormat) {
+#[test]
+fn uncompressed_binary_frames_parse_back_exactly() {
+    frames_parse_back_with_the_world_geometry_and_fields(VtkEncoding {
+        compression: VtkCompression::None,
+        ..VtkEncoding::default()
+    });
+}
+
+#[test]
+fn float32_frames_parse_back_within_f32_rounding() {
+    for encoding in [
+        VtkEncoding {
+            precision: VtkPrecision::Float32,
+            ..VtkEncoding::default()
+        },
+        VtkEncoding {
+            precision: VtkPrecision::Float32,
+            compression: VtkCompression::None,
+            ..VtkEncoding::default()
+        },
+        VtkEncoding {
+            precision: VtkPrecision::Float32,
+            ..VtkFormat::Ascii.into()
+        },
+    ] {
+        frames_parse_back_with_the_world_geometry_and_fields(encoding);
+    }
+}
+
+#[test]
+fn compressed_ascii_is_refused() {
+    let sim = scene();
+    let dir = temp_dir("compressed-ascii");
+    let err = VtkWriter::new(
+        &dir,
+        &sim.world,
+        VtkEncoding {
+            format: VtkFormat::Ascii,
+            compression: VtkCompression::Zlib,
+            ..VtkEncoding::default()
+        },
+    )
+    .expect_err("compressed ASCII must be refused");
+    assert!(err.to_string().contains("binary format only"), "{err}");
+}
+
+fn frames_parse_back_with_the_world_geometry_and_fields(encoding: VtkEncoding) {
+    let rounding = match encoding.precision {
+        VtkPrecision::Float64 => 0.0,
+        VtkPrecision::Float32 => f64::powi(2.0, -24),
+    };
+    let close = |label: &str, got: &[f64], expected: &Vector, scale: f64| {
+        close(rounding, label, got, expected, scale)
+    };
     let mut sim = scene();
-    let dir = temp_dir(&format!("frames-{format:?}"));
-    let mut writer = VtkWriter::new(&dir, &sim.world, format).expect("writer");
+    let dir = temp_dir(&format!(
+        "frames-{:?}-{:?}-{:?}",
+        encoding.format, encoding.precision, encoding.compression
+    ));
+    let mut writer = VtkWriter::new(&dir, &sim.world, encoding).expect("writer");
     let first = std::fs::read_to_string({
         writer.write_frame(&sim.world).expect("frame at t = 0");
         dir.join("vtk/polyhedra_000000000.vtu")
     })
     .unwrap();
-    let expected_format = match format {
+    let expected_format = match encoding.format {
         VtkFormat::Ascii => "format=\"ascii\"",
         VtkFormat::Binary => "format=\"binary\"",
     };
-    assert!(first.contains(expected_format), "{format:?} frame");
+    assert!(first.contains(expected_format), "{encoding:?} frame");
+    let expected_type = match encoding.precision {
+        VtkPrecision::Float64 => "type=\"Float64\" Name=\"Points\"",
+        VtkPrecision::Float32 => "type=\"Float32\" Name=\"Points\"",
+    };
+    assert!(
+        first.contains(expected_type),
+        "{encoding:?} frame: {expected_type}"
+    );
+    assert_eq!(
+        first.contains("compressor=\"vtkZLibDataCompressor\""),
+        encoding.compression == VtkCompression::Zlib,
+        "{encoding:?} frame: compressor attribute"
+    );
     sim.steps = 8000;
     sim.run(|_| Ok(()), |_, _| Ok(())).expect("run");
     writer
@@ -234,7 +318,12 @@ fn frames_parse_back_with_the_world_geometry_and_fields(format: VtkFormat) {
             &b.angular_velocity(),
             b.angular_velocity().norm().max(1e-300),
         );
-        assert_eq!((radius[k], diameter[k]), (0.02, 0.04), "sphere {i}");
+        let stored = |x: f64| if rounding > 0.0 { x as f32 as f64 } else { x };
+        assert_eq!(
+            (radius[k], diameter[k]),
+            (stored(0.02), stored(0.04)),
+            "sphere {i}"
+        );
     }
 
     // Walls: each polygon on its plane, on the free side of the other walls, force as in the world.
@@ -258,16 +347,18 @@ fn frames_parse_back_with_the_world_geometry_and_fields(format: VtkFormat) {
                 wall_points[3 * v + 1],
                 wall_points[3 * v + 2],
             );
+            // Float32 frames move each coordinate by up to 2^-24 of its magnitude.
+            let tolerance = 1e-12 + 2.0 * rounding * x.coords.norm();
             let d = wall.signed_distance(&x);
             assert!(
-                d.abs() <= 1e-12,
-                "wall {k} vertex {x:?} at distance {d} from its plane"
+                d.abs() <= tolerance,
+                "wall {k} vertex {x:?} at distance {d} from its plane, tolerance {tolerance:e}"
             );
             for (j, other) in world.walls.iter().enumerate() {
                 let dj = other.signed_distance(&x);
                 assert!(
-                    dj >= -1e-12,
-                    "wall {k} vertex {x:?} lies behind wall {j} by {dj}"
+                    dj >= -tolerance,
+                    "wall {k} vertex {x:?} lies behind wall {j} by {dj}, tolerance {tolerance:e}"
                 );
             }
         }
@@ -323,5 +414,82 @@ fn a_world_without_spheres_or_walls_writes_only_the_polyhedra_series() {
         };
         faces(0) + faces(1)
     });
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// The `(time, file)` entries of a `.pvd`, read with an XML parser independent of the writer's.
+fn pvd_entries(path: &Path) -> Vec<(f64, String)> {
+    let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let doc = roxmltree::Document::parse(&text).expect("pvd is XML");
+    doc.root_element()
+        .descendants()
+        .filter(|n| n.has_tag_name("DataSet"))
+        .map(|n| {
+            (
+                n.attribute("timestep").unwrap().parse().unwrap(),
+                n.attribute("file").unwrap().to_owned(),
+            )
+        })
+        .collect()
+}
+
+#[test]
+fn a_restarted_run_continues_the_series_of_the_earlier_run() {
+    // The earlier run: frames at steps 0, 100 and 200.
+    let dir = temp_dir("resume");
+    let mut straight = scene();
+    let mut writer = VtkWriter::new(&dir, &straight.world, VtkFormat::Binary).unwrap();
+    let mut frames = Vec::new();
+    for target in [0u64, 100, 200] {
+        straight.steps = target;
+        straight.run(|_| Ok(()), |_, _| Ok(())).expect("run");
+        writer.write_frame(&straight.world).unwrap();
+        frames.push((straight.world.time, format!("vtk/spheres_{target:09}.vtu")));
+    }
+    assert_eq!(pvd_entries(&dir.join("spheres.pvd")), frames);
+
+    // A restart from step 100 (the same state, reached again) keeps frame 0, rewrites 100 and 200.
+    let mut restarted = scene();
+    restarted.steps = 100;
+    restarted.run(|_| Ok(()), |_, _| Ok(())).expect("run");
+    let mut resumed = VtkWriter::resume(&dir, &restarted.world, VtkFormat::Binary).unwrap();
+    resumed.write_frame(&restarted.world).unwrap();
+    assert_eq!(
+        pvd_entries(&dir.join("spheres.pvd")),
+        frames[..2].to_vec(),
+        "after the restart's first frame: the earlier frame 0, then the restart's frame 100"
+    );
+    restarted.steps = 200;
+    restarted.run(|_| Ok(()), |_, _| Ok(())).expect("run");
+    resumed.write_frame(&restarted.world).unwrap();
+    for series in ["polyhedra", "spheres", "walls"] {
+        let entries = pvd_entries(&dir.join(format!("{series}.pvd")));
+        let times: Vec<f64> = entries.iter().map(|(t, _)| *t).collect();
+        let expected: Vec<f64> = frames.iter().map(|(t, _)| *t).collect();
+        assert_eq!(times, expected, "{series}.pvd times after the restart");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn a_restart_beside_a_foreign_pvd_is_refused_with_file_and_line() {
+    let dir = temp_dir("resume-foreign");
+    let sim = scene();
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(
+        dir.join("walls.pvd"),
+        "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\">\n<Collection>\n\
+         <DataSet timestep=\"soon\" file=\"vtk/walls_000000010.vtu\"/>\n</Collection>\n</VTKFile>\n",
+    )
+    .unwrap();
+    let err = VtkWriter::resume(&dir, &sim.world, VtkFormat::Binary).expect_err("foreign .pvd");
+    let message = err.to_string();
+    assert!(
+        message.contains("walls.pvd:4") && message.contains("soon"),
+        "error should name the file, line 4 and the bad timestep: {message}"
+    );
+    std::fs::write(dir.join("walls.pvd"), "not xml at all\n").unwrap();
+    let err = VtkWriter::resume(&dir, &sim.world, VtkFormat::Binary).expect_err("not a .pvd");
+    assert!(err.to_string().contains("walls.pvd:1"), "{err}");
     let _ = std::fs::remove_dir_all(&dir);
 }

@@ -7,6 +7,7 @@
 //! - [`checkpoint`]: the versioned binary checkpoint of a whole simulation, for restarts.
 
 pub mod checkpoint;
+pub mod csv_continue;
 pub mod csv_output;
 pub mod pairs_jsonl;
 pub mod run_summary;

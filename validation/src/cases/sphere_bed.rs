@@ -339,6 +339,42 @@ fn max_gap(a: &History, b: &History, t_end: Real) -> Result<Real, SuiteError> {
     Ok(gap)
 }
 
+/// The rows of a comparison table: each quantity for polydem, YADE and LIGGGHTS (in that order in
+/// `metrics`) with the three pairwise relative differences, then the depth-history gaps (`gaps`: polydem–YADE,
+/// polydem–LIGGGHTS, YADE–LIGGGHTS, in mean bed diameters).
+fn comparison_rows(metrics: [&Metrics; 3], gaps: [Real; 3]) -> Vec<Vec<String>> {
+    let row = |q: &str, unit: &str, f: &dyn Fn(&Metrics) -> Real, scale: Real| {
+        let [o, y, l] = metrics.map(|m| f(m) * scale);
+        vec![
+            format!("{q} [{unit}]"),
+            CaseContext::fmt(o),
+            CaseContext::fmt(y),
+            CaseContext::fmt(l),
+            format!("{:.2} %", 100.0 * relative_difference(o, y)),
+            format!("{:.2} %", 100.0 * relative_difference(o, l)),
+            format!("{:.2} %", 100.0 * relative_difference(y, l)),
+        ]
+    };
+    let mut gap_row = vec![
+        "max depth-history gap [mean bed diameters]".to_owned(),
+        "-".into(),
+        "-".into(),
+        "-".into(),
+    ];
+    gap_row.extend(gaps.map(CaseContext::fmt));
+    vec![
+        row("final depth", "mm", &|m| m.final_depth, 1e3),
+        row("max depth", "mm", &|m| m.max_depth, 1e3),
+        row("final vertical velocity", "m/s", &|m| m.final_vz, 1.0),
+        row("peak contact force", "N", &|m| m.peak_force, 1.0),
+        row("time of peak force", "ms", &|m| m.peak_time, 1e3),
+        row("first contact", "ms", &|m| m.first_contact, 1e3),
+        row("speed below 10 % of v0 at", "ms", &|m| m.slow_time, 1e3),
+        row("vertical contact impulse", "N s", &|m| m.impulse, 1.0),
+        gap_row,
+    ]
+}
+
 impl Case for SphereBed {
     fn name(&self) -> &'static str {
         NAME
@@ -445,37 +481,10 @@ impl Case for SphereBed {
                  diameter.",
                 variant.scene, ours.max_overlap_ratio
             ));
-            let row = |q: &str, unit: &str, f: &dyn Fn(&Metrics) -> Real, scale: Real| {
-                let (o, y, l) = (f(&m_ours) * scale, f(&m_yade) * scale, f(&m_lig) * scale);
-                vec![
-                    format!("{q} [{unit}]"),
-                    CaseContext::fmt(o),
-                    CaseContext::fmt(y),
-                    CaseContext::fmt(l),
-                    format!("{:.2} %", 100.0 * relative_difference(o, y)),
-                    format!("{:.2} %", 100.0 * relative_difference(o, l)),
-                    format!("{:.2} %", 100.0 * relative_difference(y, l)),
-                ]
-            };
-            let rows = vec![
-                row("final depth", "mm", &|m| m.final_depth, 1e3),
-                row("max depth", "mm", &|m| m.max_depth, 1e3),
-                row("final vertical velocity", "m/s", &|m| m.final_vz, 1.0),
-                row("peak contact force", "N", &|m| m.peak_force, 1.0),
-                row("time of peak force", "ms", &|m| m.peak_time, 1e3),
-                row("first contact", "ms", &|m| m.first_contact, 1e3),
-                row("speed below 10 % of v0 at", "ms", &|m| m.slow_time, 1e3),
-                row("vertical contact impulse", "N s", &|m| m.impulse, 1.0),
-                vec![
-                    "max depth-history gap [mean bed diameters]".into(),
-                    "-".into(),
-                    "-".into(),
-                    "-".into(),
-                    CaseContext::fmt(gap_py / mean_diameter),
-                    CaseContext::fmt(gap_pl / mean_diameter),
-                    CaseContext::fmt(gap_yl / mean_diameter),
-                ],
-            ];
+            let rows = comparison_rows(
+                [&m_ours, &m_yade, &m_lig],
+                [gap_py, gap_pl, gap_yl].map(|g| g / mean_diameter),
+            );
             ctx.table(
                 Some(&format!("{v}_table")),
                 &[
@@ -553,18 +562,6 @@ impl Case for SphereBed {
                 let gap_fyl = max_gap(&fy.history, &fl.history, t_end)?;
                 let gap_pfy = max_gap(h, &fy.history, t_end)?;
                 let gap_pfl = max_gap(h, &fl.history, t_end)?;
-                let row = |q: &str, unit: &str, f: &dyn Fn(&Metrics) -> Real, scale: Real| {
-                    let (o, y, l) = (f(&m_ours) * scale, f(&m_fy) * scale, f(&m_fl) * scale);
-                    vec![
-                        format!("{q} [{unit}]"),
-                        CaseContext::fmt(o),
-                        CaseContext::fmt(y),
-                        CaseContext::fmt(l),
-                        format!("{:.2} %", 100.0 * relative_difference(o, y)),
-                        format!("{:.2} %", 100.0 * relative_difference(o, l)),
-                        format!("{:.2} %", 100.0 * relative_difference(y, l)),
-                    ]
-                };
                 let same = |f: &Option<Recorded>, r: &Recorded| -> Result<String, SuiteError> {
                     Ok(match f {
                         Some(f) => CaseContext::fmt(
@@ -573,32 +570,19 @@ impl Case for SphereBed {
                         None => "-".into(),
                     })
                 };
-                let rows = vec![
-                    row("final depth", "mm", &|m| m.final_depth, 1e3),
-                    row("max depth", "mm", &|m| m.max_depth, 1e3),
-                    row("final vertical velocity", "m/s", &|m| m.final_vz, 1.0),
-                    row("peak contact force", "N", &|m| m.peak_force, 1.0),
-                    row("speed below 10 % of v0 at", "ms", &|m| m.slow_time, 1e3),
-                    row("vertical contact impulse", "N s", &|m| m.impulse, 1.0),
-                    vec![
-                        "max depth-history gap [mean bed diameters]".into(),
-                        "-".into(),
-                        "-".into(),
-                        "-".into(),
-                        CaseContext::fmt(gap_pfy / mean_diameter),
-                        CaseContext::fmt(gap_pfl / mean_diameter),
-                        CaseContext::fmt(gap_fyl / mean_diameter),
-                    ],
-                    vec![
-                        "max gap to the recorded run of the same code [mean bed diameters]".into(),
-                        "-".into(),
-                        same(&fresh_yade, &yade)?,
-                        same(&fresh_lig, &liggghts)?,
-                        "-".into(),
-                        "-".into(),
-                        "-".into(),
-                    ],
-                ];
+                let mut rows = comparison_rows(
+                    [&m_ours, &m_fy, &m_fl],
+                    [gap_pfy, gap_pfl, gap_fyl].map(|g| g / mean_diameter),
+                );
+                rows.push(vec![
+                    "max gap to the recorded run of the same code [mean bed diameters]".into(),
+                    "-".into(),
+                    same(&fresh_yade, &yade)?,
+                    same(&fresh_lig, &liggghts)?,
+                    "-".into(),
+                    "-".into(),
+                    "-".into(),
+                ]);
                 ctx.text(&format!(
                     "Against the reference runs of this suite run ({}, {}):",
                     label(&fresh_yade, "YADE"),
