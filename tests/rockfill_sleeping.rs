@@ -19,7 +19,8 @@ use rockfill_small::small;
 
 #[test]
 fn penetration_with_a_sleeping_bed_keeps_the_residual_speed() {
-    let dir = std::env::temp_dir().join(format!("polydem_rockfill_sleeping_{}", std::process::id()));
+    let dir =
+        std::env::temp_dir().join(format!("polydem_rockfill_sleeping_{}", std::process::id()));
     std::fs::remove_dir_all(&dir).ok();
     let options = PenetrationOptions::default();
     let mut quiet = |_: &str, _: String| {};
@@ -83,7 +84,11 @@ fn penetration_with_a_sleeping_bed_keeps_the_residual_speed() {
         a.asleep_fraction
     );
     let (rs, rl) = (&straight.penetration.rows, &s.rows);
-    assert_eq!(rs.len(), rl.len(), "steps straight after packing vs from the saved bed");
+    assert_eq!(
+        rs.len(),
+        rl.len(),
+        "steps straight after packing vs from the saved bed"
+    );
     for (k, (x, y)) in rs.iter().zip(rl).enumerate() {
         assert!(
             x == y,

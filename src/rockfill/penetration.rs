@@ -28,8 +28,8 @@ use crate::dynamics::{Motion, RigidBody, ViscousDamping};
 use crate::math::{Point, Pose, Real, Vector};
 use crate::shape::Shape;
 use crate::world::{
-    sleeping, step, ContactKey, EnergyLedger, StepCounters, StepError, StepParams, StepScratch, World,
-    WorldError,
+    sleeping, step, ContactKey, EnergyLedger, StepCounters, StepError, StepParams, StepScratch,
+    World, WorldError,
 };
 
 /// Why a penetration run failed.
@@ -264,11 +264,7 @@ pub fn add_projectile(
     if config.sleeping.penetration {
         // The packed bed is at rest: every rock falls asleep against the walls it was packed in, so that
         // removing the left and right walls wakes the rocks they held (see `crate::world::sleeping`).
-        sleeping::put_to_sleep(
-            &config.sleeping.params(true),
-            world,
-            0..world.bodies.len(),
-        );
+        sleeping::put_to_sleep(&config.sleeping.params(true), world, 0..world.bodies.len());
     }
     world.walls.truncate(KEPT_WALLS);
     world.loads.current = false;

@@ -78,8 +78,8 @@
 //! reproduce exact dynamics (the validation cases) does not use it.
 
 use crate::contact::ContactKind;
-use crate::law::ContactKinematics;
 use crate::dynamics::Motion;
+use crate::law::ContactKinematics;
 use crate::math::{Real, Vector};
 
 use super::contact_store::{ContactKey, ContactState};
@@ -617,8 +617,10 @@ impl FrozenLoads {
             return true;
         }
         self.sums.clear();
-        self.sums
-            .resize(world.bodies.len(), (Vector::zeros(), Vector::zeros(), false));
+        self.sums.resize(
+            world.bodies.len(),
+            (Vector::zeros(), Vector::zeros(), false),
+        );
         for (k, (&key, entry)) in world
             .contacts
             .keys()
