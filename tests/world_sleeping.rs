@@ -341,7 +341,7 @@ fn wake_front_follows_the_pulse_down_a_sleeping_column() {
     );
     let reached = awake.first.iter().filter(|f| f.is_some()).count();
     assert!(
-        reached >= 5 && reached < COLUMN - 5,
+        (5..COLUMN - 5).contains(&reached),
         "the pulse reached {reached} of {COLUMN} spheres in {COLUMN_STEPS} steps: the test needs a front \
          inside the column"
     );
