@@ -55,13 +55,13 @@ fn run_writes_the_documented_csv_files_and_summary() {
     let mut lines = energy.lines();
     assert_eq!(
         lines.next(),
-        Some("t,translational_kinetic,rotational_kinetic,elastic_potential,gravitational_potential,dissipated_damping,dissipated_friction,dissipated_viscous,external_work,balance")
+        Some("t,translational_kinetic,rotational_kinetic,elastic_potential,gravitational_potential,dissipated_damping,dissipated_friction,dissipated_viscous,external_work,tangential_stiffness_work,balance")
     );
     let rows: Vec<Vec<f64>> = lines
         .map(|l| l.split(',').map(|x| x.parse().expect("number")).collect())
         .collect();
     assert_eq!(rows.len() as u64, outputs, "rows in energy.csv");
-    assert_eq!(rows[0][9], 0.0, "the balance starts at zero");
+    assert_eq!(rows[0][10], 0.0, "the balance starts at zero");
     let walls = std::fs::read_to_string(out.join("walls.csv")).expect("walls.csv");
     assert_eq!(walls.lines().next(), Some("t,wall,fx,fy,fz"));
     assert_eq!(

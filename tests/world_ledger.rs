@@ -145,11 +145,13 @@ fn oblique_spinning_bounce(per_contact: Real) -> (Real, Real) {
 }
 
 /// The friction work of the ledger is the discrete work of the tangential spring (src/law/tangential.rs).
-/// Measured on this bounce (|balance| / friction work): 1.7e-2 at t_c/50, 2.6e-3 at t_c/100, 8.4e-5 at
-/// t_c/200, 5.2e-5, 3.7e-5 and 2.8e-6 at t_c/400…1600. The earlier rectangle rule (μF_n × slip) left 6 % of
-/// the friction work of the same kind of bounce unaccounted at t_c/83, converging at first order. Gate: the
-/// issue's single-contact tolerance, 1e-4, from t_c/200 on, and at least second-order improvement (16×)
-/// from t_c/50 to t_c/200.
+/// Measured on this bounce (|balance| / friction work): 1.1e-4 at t_c/50, 4.0e-6 at t_c/100, 2.0e-6 at
+/// t_c/200, 1.2e-7, 1.7e-8 and 1.6e-9 at t_c/400…1600, since the ledger books the release of the spring
+/// in the step the contact opens and the work of the last spring force with the lever arms the integrator
+/// applied it with (src/world/energy.rs); before that: 1.7e-2, 2.6e-3, 8.4e-5, 5.2e-5, 3.7e-5, 2.8e-6.
+/// The earlier rectangle rule (μF_n × slip) left 6 % of the friction work of the same kind of bounce
+/// unaccounted at t_c/83, converging at first order. Gate: the single-contact tolerance, 1e-4,
+/// from t_c/200 on, and at least second-order improvement (16×) from t_c/50 to t_c/200.
 #[test]
 fn friction_work_closes_the_ledger_of_a_spinning_bounce() {
     let mut coarse = None;

@@ -53,10 +53,17 @@ pub struct ContactResponse {
     /// Tangential spring energy ½ k_t |u|² (J).
     pub tangential_potential: Real,
     /// Power dissipated by the normal damping, f_d δ̇ (W, ≥ 0 unless the force limit clamps it), plus that
-    /// of a tangential dashpot.
+    /// of a tangential dashpot, at this evaluation (the ledger books the work of `damping_force` instead,
+    /// see [`crate::world::energy`]).
     pub damping_power: Real,
+    /// The velocity-dependent part of `force_on_b` (N): the normal damping n f_d (as clamped by the force
+    /// limit) plus the tangential dashpot.
+    pub damping_force: Vector,
     /// Friction work dissipated during this step (J, ≥ 0).
     pub friction_dissipation: Real,
+    /// Work of the change of the tangential stiffness during this step (J, either sign; see
+    /// [`super::tangential`]): energy the Mindlin law puts into its stored tangential energy.
+    pub tangential_stiffness_work: Real,
     /// True when the Coulomb cap was active.
     pub sliding: bool,
 }
@@ -99,8 +106,10 @@ impl ContactModel {
             friction_dissipation,
             sliding,
             tangential_power,
+            dashpot_force,
+            tangential_stiffness_work,
         ) = match self.tangential {
-            TangentialLaw::None => (Vector::zeros(), 0.0, 0.0, false, 0.0),
+            TangentialLaw::None => (Vector::zeros(), 0.0, 0.0, false, 0.0, Vector::zeros(), 0.0),
             law => {
                 let (stiffness, friction) = law.stiffness_and_friction(overlap);
                 let dashpot = match law {
@@ -126,6 +135,8 @@ impl ContactModel {
                     r.friction_dissipation,
                     r.sliding,
                     r.damping_power,
+                    r.damping_force,
+                    r.stiffness_work,
                 )
             }
         };
@@ -140,7 +151,9 @@ impl ContactModel {
             normal_potential: self.normal.potential(overlap),
             tangential_potential,
             damping_power: damping * overlap_rate + tangential_power,
+            damping_force: n * damping + dashpot_force,
             friction_dissipation,
+            tangential_stiffness_work,
             sliding,
         }
     }

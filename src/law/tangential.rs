@@ -23,6 +23,23 @@
 //! Spring energy: ½ k_t |u|² (exact for a constant k_t; for the Mindlin k_t ∝ δ^(1/2) it is the usual
 //! instantaneous estimate, as YADE's `shearEnergy`).
 //!
+//! # Work of the stiffness change (Mindlin)
+//! When k_t follows the overlap, the force F_t = −k_t(δ) u is not the gradient of ½ k_t |u|²: continuously,
+//! d(½ k_t |u|²) = k_t u·du + ½ |u|² dk_t, and only the first part is work done by the bodies on the
+//! spring. The second is energy the law itself puts into (dk_t > 0) or takes out of (dk_t < 0) the stored
+//! tangential energy, of either sign, and it is neither friction nor a potential (summed over a contact
+//! that opens and closes again it does not vanish). Discretely, with the force −k_t^n u_n applied for the
+//! first half of the step and −k_t^(n+1) u_(n+1) for the second, the balance of one step is exact with
+//!   W_k = ½ (k_t^(n+1) − k_t^n) u_prev·u_trial
+//! (u_prev the rotated previous displacement, u_trial = u_prev + v_t Δt): work of the bodies on the spring
+//! ½ (k_t^n u_prev + k_t^(n+1) u)·Δu = change of ½ k_t |u|² + D − W_k. The law reports W_k as
+//! [`TangentialResponse::stiffness_work`] and keeps k_t^n in the history; the ledger books it as its own
+//! term ([`crate::world::EnergyLedger::tangential_stiffness_work`]). For a constant k_t it is zero.
+//!
+//! When a contact opens, the spring force of its last evaluation still acts for half a step; the
+//! separation is booked by [`release_spring`] as one more evaluation with no normal force (so the cap
+//! takes u to zero) and the stiffness at zero overlap (k_t for a constant spring, 0 for Mindlin).
+//!
 //! Pair order: the history belongs to the ordered pair (A, B). If the caller swaps the order, n and u change
 //! sign: use [`TangentialHistory::swapped`].
 
@@ -36,6 +53,9 @@ pub struct TangentialHistory {
     pub displacement: Vector,
     /// The contact normal (A → B) the displacement was last expressed in; zero for a new contact.
     pub normal: Vector,
+    /// The stiffness k_t (N/m) the displacement was last evaluated with; zero for a new contact (see
+    /// the module docs: the work of the stiffness change needs the previous k_t).
+    pub stiffness: Real,
 }
 
 impl TangentialHistory {
@@ -44,6 +64,7 @@ impl TangentialHistory {
         Self {
             displacement: -self.displacement,
             normal: -self.normal,
+            stiffness: self.stiffness,
         }
     }
 }
@@ -123,6 +144,11 @@ pub struct TangentialResponse {
     pub spring_energy: Real,
     /// Power dissipated by the tangential dashpot, c_t |v_t|² (W, ≥ 0; zero without one or when sliding).
     pub damping_power: Real,
+    /// The dashpot's part of `force`, −c_t v_t (N; zero without one or when sliding).
+    pub damping_force: Vector,
+    /// Work of the stiffness change in this step, ½ (k_t − k_t,prev) u_prev·u_trial (J, either sign; zero
+    /// for a constant k_t; see the module docs).
+    pub stiffness_work: Real,
 }
 
 /// Rotates the displacement `u` expressed against `old_normal` into the plane perpendicular to `new_normal`
@@ -193,6 +219,7 @@ pub fn incremental_spring_damped(
 ) -> TangentialResponse {
     let u_previous = rotate_into_tangent_plane(&history.displacement, &history.normal, normal);
     let mut u = u_previous + tangential_velocity * dt;
+    let stiffness_work = 0.5 * (stiffness - history.stiffness) * u_previous.dot(&u);
     let mut force = -stiffness * u;
     let cap = friction * normal_force.max(0.0);
     let magnitude = force.norm();
@@ -214,19 +241,47 @@ pub fn incremental_spring_damped(
         u = u_capped;
     }
     let mut damping_power = 0.0;
+    let mut damping_force = Vector::zeros();
     if !sliding && damping > 0.0 {
-        force -= damping * tangential_velocity;
+        damping_force = -damping * tangential_velocity;
+        force += damping_force;
         damping_power = damping * tangential_velocity.norm_squared();
     }
     history.displacement = u;
     history.normal = *normal;
+    history.stiffness = stiffness;
     TangentialResponse {
         force,
         sliding,
         friction_dissipation,
         spring_energy: 0.5 * stiffness * u.norm_squared(),
         damping_power,
+        damping_force,
+        stiffness_work,
     }
+}
+
+/// The step in which a contact opens: the spring of `history` (force −k_t,prev u on B for the first half
+/// of the step) is released as by one more evaluation with no normal force and the stiffness
+/// `end_stiffness` (the law's k_t at zero overlap). `relative_velocity` is v_B − v_A at the half step at
+/// the last contact point; its part along the stored normal is dropped. Returns (friction dissipation,
+/// stiffness work) in J, as [`TangentialResponse`]; the history is reset.
+pub fn release_spring(
+    end_stiffness: Real,
+    relative_velocity: &Vector,
+    dt: Real,
+    history: &mut TangentialHistory,
+) -> (Real, Real) {
+    let u_previous = history.displacement;
+    let n = history.normal;
+    let v_t = relative_velocity - n * relative_velocity.dot(&n);
+    let u_trial = u_previous + v_t * dt;
+    let overlap = u_previous.dot(&u_trial);
+    // The cap is zero: u goes to 0, D = ½ k_end (u_prev + 0)·(u_trial − 0).
+    let friction_dissipation = 0.5 * end_stiffness * overlap;
+    let stiffness_work = 0.5 * (end_stiffness - history.stiffness) * overlap;
+    *history = TangentialHistory::default();
+    (friction_dissipation, stiffness_work)
 }
 
 #[cfg(test)]
@@ -320,6 +375,7 @@ mod tests {
         let h = TangentialHistory {
             displacement: Vector::new(1e-6, 2e-6, 0.0),
             normal: Vector::new(0.0, 0.0, 1.0),
+            stiffness: 3e4,
         };
         let s = h.swapped();
         assert_eq!(s.displacement, -h.displacement);

@@ -55,6 +55,9 @@ pub struct ContactState {
     pub geometry: ContactGeometry,
     /// The force on B of the last evaluation (N); A received its opposite.
     pub force_on_b: Vector,
+    /// The velocity-dependent part of `force_on_b` (damping and tangential dashpot, N): the energy ledger
+    /// books the damping work of a step from it and the next evaluation's (see [`super::energy`]).
+    pub damping_force: Vector,
 }
 
 impl ContactState {
@@ -75,6 +78,7 @@ impl ContactState {
                 status: SolverStatus::Exact,
             },
             force_on_b: Vector::zeros(),
+            damping_force: Vector::zeros(),
         }
     }
 
@@ -85,6 +89,7 @@ impl ContactState {
             history: self.history.swapped(),
             geometry: swap_pair(&self.geometry),
             force_on_b: -self.force_on_b,
+            damping_force: -self.damping_force,
             ..*self
         }
     }

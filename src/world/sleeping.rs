@@ -273,7 +273,10 @@ fn freeze(params: &SleepParams, world: &mut World, fell: &[bool]) {
             continue;
         }
         let force = static_force(world, k);
-        world.contacts.states_mut()[k].force_on_b = force;
+        let state = &mut world.contacts.states_mut()[k];
+        state.force_on_b = force;
+        // What acts while frozen has no damping part (the energy ledger books the last damping force).
+        state.damping_force = Vector::zeros();
     }
     let sleep = &mut world.sleep;
     for (i, body) in world.bodies.iter().enumerate() {

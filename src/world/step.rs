@@ -42,7 +42,7 @@ use crate::math::{Point, Real, Vector};
 use crate::shape::Shape;
 
 use super::contact_store::{ContactKey, ContactState};
-use super::energy::viscous_power;
+use super::energy::{viscous_power, ContactWork, LastForces};
 use super::parallel::{for_each_chunked, for_each_item, Parallelism, Worker};
 use super::skips::{self, Skips};
 use super::sleeping::{self, SleepParams};
@@ -287,7 +287,6 @@ pub fn step(
         }
     }
     let external_power_start = world.loads.external_power;
-    let damping_power_start = world.loads.damping_power;
     // Without global damping the viscous power is zero: no pass over the bodies.
     let damped = params.damping != ViscousDamping::None;
     let viscous = |world: &World| {
@@ -375,8 +374,9 @@ pub fn step(
     // 9. Ledger and counters.
     let viscous_end = viscous(world);
     let ledger = &mut world.ledger;
-    ledger.dissipated_damping += 0.5 * (damping_power_start + world.loads.damping_power) * dt;
+    ledger.dissipated_damping += world.loads.damping_work;
     ledger.dissipated_friction += world.loads.friction_dissipation;
+    ledger.tangential_stiffness_work += world.loads.tangential_stiffness_work;
     ledger.dissipated_viscous += 0.5 * (viscous_start + viscous_end) * dt;
     ledger.external_work += 0.5 * (external_power_start + world.loads.external_power) * dt;
     world.time += dt;
@@ -492,15 +492,19 @@ fn evaluate_loads(
                 // Kept from its last evaluation and summed in `scratch.frozen` (stage 6).
                 out.frozen = true;
                 out.overlapping = false;
+                // Frozen bodies do not move: no work.
+                out.work = ContactWork::default();
                 return Ok(());
             }
+            // The last contact point, for the ledger of a pair that opens in this step.
+            let previous_point = state.geometry.point;
             narrow_phase(params, world_ref, key, state, worker).map_err(|source| {
                 StepError::Contact {
                     step: step_index,
                     source,
                 }
             })?;
-            contact_law(&pair, key, state, out)
+            contact_law(&pair, key, state, &previous_point, out)
         },
     );
     for worker in &mut scratch.workers {
@@ -531,8 +535,9 @@ fn evaluate_loads(
     loads.wall_forces.clear();
     loads.wall_forces.resize(world.walls.len(), Vector::zeros());
     loads.elastic_potential = 0.0;
-    loads.damping_power = 0.0;
+    loads.damping_work = 0.0;
     loads.friction_dissipation = 0.0;
+    loads.tangential_stiffness_work = 0.0;
     // The frozen contacts, summed once while the sleeping set and the store's pairs stay the same.
     if world.sleep.sleeping > 0 {
         let f = &scratch.frozen;
@@ -553,6 +558,10 @@ fn evaluate_loads(
     }
     for (key, e) in scratch.candidates.iter().zip(&scratch.evaluated) {
         counters.frozen_pairs += e.frozen as u64;
+        // Ledger terms: written for every candidate (a pair that opens in this step books its release).
+        loads.damping_work += e.work.damping;
+        loads.friction_dissipation += e.work.friction;
+        loads.tangential_stiffness_work += e.work.stiffness;
         if !e.overlapping {
             // A separated pair contributes nothing (its response slot is stale).
             continue;
@@ -581,8 +590,6 @@ fn evaluate_loads(
             }
         }
         loads.elastic_potential += r.normal_potential + r.tangential_potential;
-        loads.damping_power += r.damping_power;
-        loads.friction_dissipation += r.friction_dissipation;
     }
     counters.contacts += report.contacts as u64;
     // Power delivered to the system by everything that moves without responding to forces.
@@ -607,11 +614,13 @@ fn evaluate_loads(
     Ok(())
 }
 
-/// The result of stage 5 for one candidate. The flags are written for every candidate; the other fields
-/// only when `overlapping` (a separated pair contributes nothing, and no stage reads them).
+/// The result of stage 5 for one candidate. The flags and `work` are written for every candidate; the
+/// other fields only when `overlapping` (a separated pair contributes no force, and no stage reads them).
 #[derive(Clone, Copy, Debug, Default)]
 struct Evaluated {
     response: ContactResponse,
+    /// The ledger terms of this step (nonzero for a separated pair only in the step it opens).
+    work: ContactWork,
     /// Whether the shapes overlap (the law produced a force).
     overlapping: bool,
     /// Whether the pair is frozen (kept from its last evaluation; see [`super::sleeping`]).
@@ -658,6 +667,19 @@ impl PairInputs<'_> {
             body.angular_velocity()
         };
         body.velocity + omega.cross(&(point - body.position))
+    }
+
+    /// v_B − v_A (m/s) at `point` for the pair `key` (A a wall: its prescribed velocity), with each
+    /// body's lever arm taken from its centre `back` seconds earlier (x − back·v: the centre before this
+    /// step's drift when `back` = Δt, so the lever arm with which the last forces were applied).
+    fn relative_velocity(&self, key: ContactKey, point: &Point, back: Real) -> Vector {
+        let at = |i: usize| self.velocity_at(i, &(point + back * self.world.bodies[i].velocity));
+        match key {
+            ContactKey::Body { a, b } => at(b as usize) - at(a as usize),
+            ContactKey::Wall { body, wall } => {
+                at(body as usize) - self.world.walls[wall as usize].velocity
+            }
+        }
     }
 }
 
@@ -774,12 +796,14 @@ fn narrow_phase(
 }
 
 /// Stage 5 for one candidate: the pair's contact model on the geometry of stage 4 (stored in `state`),
-/// updating the tangential history and the stored force; the result goes to `out`.
+/// updating the tangential history and the stored forces; the result goes to `out`. `previous_point` is
+/// the contact point of the pair's last evaluation (the ledger of a pair that opens needs it).
 #[inline]
 fn contact_law(
     pair: &PairInputs,
     key: ContactKey,
     state: &mut ContactState,
+    previous_point: &Point,
     out: &mut Evaluated,
 ) -> Result<(), StepError> {
     out.frozen = false;
@@ -787,12 +811,39 @@ fn contact_law(
         geometry: g,
         history,
         force_on_b,
+        damping_force,
         ..
     } = state;
     if g.kind != ContactKind::Overlap {
+        out.work = ContactWork::default();
+        let previous = LastForces {
+            damping_force: *damping_force,
+            history: *history,
+        };
+        if !previous.is_zero() {
+            // The pair opened in this step: its last forces acted for the first half kick.
+            let world = pair.world;
+            let (shape_a, mat_a, b) = match key {
+                ContactKey::Body { a, b } => (
+                    Some(world.shape(a as usize)),
+                    world.material_of[a as usize],
+                    b,
+                ),
+                ContactKey::Wall { body, wall } => {
+                    (None, world.walls[wall as usize].material, body)
+                }
+            };
+            let b = b as usize;
+            let model = pair
+                .model(mat_a, world.material_of[b])?
+                .for_shapes(shape_a, world.shape(b));
+            let relative_velocity = pair.relative_velocity(key, previous_point, pair.dt);
+            out.work = ContactWork::of_release(&model, &previous, &relative_velocity, pair.dt);
+        }
         // The law resets the history of a pair that does not overlap.
         *history = Default::default();
         *force_on_b = Vector::zeros();
+        *damping_force = Vector::zeros();
         out.overlapping = false;
         return Ok(());
     }
@@ -833,8 +884,27 @@ fn contact_law(
         dt: pair.dt,
     };
     let model = model.for_shapes(a_body.map(|a| world.shape(a)), world.shape(b));
+    let previous = LastForces {
+        damping_force: *damping_force,
+        history: *history,
+    };
     out.response = model.evaluate(g, &kinematics, history);
+    out.work = if previous.is_zero() {
+        ContactWork::of_new_contact(&out.response, &kinematics.relative_velocity, pair.dt)
+    } else {
+        // The last forces were applied with the lever arms of the last contact point.
+        let previous_velocity = pair.relative_velocity(key, previous_point, pair.dt);
+        ContactWork::of_evaluation(
+            &previous,
+            &previous_velocity,
+            &g.normal,
+            &out.response,
+            &kinematics.relative_velocity,
+            pair.dt,
+        )
+    };
     *force_on_b = out.response.force_on_b;
+    *damping_force = out.response.damping_force;
     out.overlapping = true;
     out.depth = g.depth;
     out.overlap_ratio = g.depth / scale;

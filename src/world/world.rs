@@ -136,10 +136,13 @@ pub struct Loads {
     pub wall_forces: Vec<Vector>,
     /// Σ of the elastic potentials (normal power law and tangential spring) of all contacts (J).
     pub elastic_potential: Real,
-    /// Σ of the damping powers f_d δ̇ (W, ≥ 0 for dissipation).
-    pub damping_power: Real,
+    /// Σ of the damping work dissipated during the step that produced these loads (J; see
+    /// [`super::energy`]).
+    pub damping_work: Real,
     /// Σ of the friction work dissipated during the step that produced these loads (J).
     pub friction_dissipation: Real,
+    /// Σ of the work of the tangential stiffness change during the step that produced these loads (J).
+    pub tangential_stiffness_work: Real,
     /// Power (W) the non-dynamic bodies and the walls deliver to the system through contacts.
     pub external_power: Real,
     /// Whether these loads belong to the current state (false before the first evaluation).
