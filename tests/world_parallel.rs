@@ -132,3 +132,59 @@ fn one_two_and_four_threads_give_bit_identical_states() {
         );
     }
 }
+
+/// The checks run fused with the second half kick, body by body on several threads: the error must still
+/// name the first non-finite body in body order, whatever the thread count.
+#[test]
+fn the_first_non_finite_body_is_reported_for_any_thread_count() {
+    let spec = bed::BedSpec {
+        gap: 0.0,
+        speed: 2.0,
+        ..bed::BedSpec::rocks([6, 6, 8], 4, 20261121)
+    };
+    let run = |threads: Option<usize>| {
+        let mut bed = bed::build(&spec);
+        bed.params.parallel = match threads {
+            None => Parallelism {
+                min_candidates: usize::MAX,
+                min_bodies: usize::MAX,
+            },
+            Some(_) => Parallelism {
+                min_candidates: 0,
+                min_bodies: 0,
+            },
+        };
+        // Two bodies far apart in body order go bad; the later one in a different chunk of the parallel pass.
+        bed.world.bodies[250].velocity.x = f64::NAN;
+        bed.world.bodies[37].angular_momentum.y = f64::INFINITY;
+        let go = move || {
+            let mut world = bed.world;
+            let mut scratch = StepScratch::default();
+            step(&bed.params, &mut world, &mut scratch)
+        };
+        match threads {
+            None => go(),
+            Some(n) => rayon::ThreadPoolBuilder::new()
+                .num_threads(n)
+                .build()
+                .expect("thread pool")
+                .install(go),
+        }
+    };
+    let serial =
+        run(None).expect_err("a NaN velocity and an infinite angular momentum must fail the step");
+    match &serial {
+        polydem::world::StepError::NonFinite { body, .. } => assert_eq!(
+            *body, 37,
+            "the serial step must report body 37 (the first bad one), got {serial}"
+        ),
+        other => panic!("expected a non-finite error for body 37, got {other}"),
+    }
+    for threads in [1, 2, 4] {
+        let parallel = run(Some(threads)).expect_err("the parallel step must fail too");
+        assert_eq!(
+            parallel, serial,
+            "{threads} threads: the error differs from the serial step's"
+        );
+    }
+}

@@ -239,9 +239,12 @@ impl BroadPhase {
         }
 
         // Each pair is examined in the first cell of the overlap of both ranges only. Bodies are independent
-        // here: large scenes search in parallel chunks of bodies, concatenated in body order (the sort below
-        // makes the list the same for any chunking).
+        // here: large scenes search in parallel chunks of bodies, concatenated in body order (the same list
+        // for any chunking).
+        // Each body's pairs are sorted as found (a few per body), so the lists concatenated in body order
+        // are sorted: no sort of the whole list.
         let search = |i: usize, out: &mut Vec<Pair>| {
+            let found_before = out.len();
             let range_i = &self.body_cells[i];
             for_each_cell(range_i, |c| {
                 let k = grid.linear(c);
@@ -272,6 +275,7 @@ impl BroadPhase {
                     }
                 }
             });
+            out[found_before..].sort_unstable();
         };
         let n = centres.len();
         if n >= PARALLEL_SEARCH_MIN_BODIES && rayon::current_num_threads() > 1 {
@@ -299,7 +303,7 @@ impl BroadPhase {
             }
             self.pairs = pairs;
         }
-        self.pairs.sort_unstable();
+        debug_assert!(self.pairs.windows(2).all(|w| w[0] < w[1]));
     }
 
     /// A grid over the inflated boxes of all bodies, with the median inflated diameter as cell size.
@@ -471,7 +475,7 @@ mod tests {
     fn parallel_pair_search_equals_brute_force() {
         // Above PARALLEL_SEARCH_MIN_BODIES, in a pool of 2 threads (the parallel path) and of 1.
         let (centres, radii) = random_scene(3, PARALLEL_SEARCH_MIN_BODIES + 900, 4.0, 0.04, 0.06);
-        for threads in [1, 2] {
+        for threads in [1, 2, 4] {
             rayon::ThreadPoolBuilder::new()
                 .num_threads(threads)
                 .build()

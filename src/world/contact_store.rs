@@ -25,6 +25,13 @@
 //! candidate with a stored entry keeps it, a new candidate gets a fresh one, and an entry whose pair left the
 //! candidate list is dropped in the same pass. It is one linear merge, with no hashing, so the store is
 //! plain sorted data that serialises and compares bit for bit.
+//!
+//! # Pairs of a body
+//! [`ContactStore::body_adjacency`] lists, for every body, the store entries it takes part in, in key order
+//! (compressed rows: [`BodyAdjacency`]). The step sums the forces on each body over its row — the same
+//! additions in the same order as a scatter over the candidates, so the same bits — with the bodies in
+//! parallel. The rows are derived from the keys only: built on first use after a sync that changed the
+//! keys, kept while the keys stay (between broad-phase rebuilds), never serialised.
 
 use crate::contact::{swap_pair, ContactGeometry, ContactKind, PairCache, SolverStatus};
 use crate::law::TangentialHistory;
@@ -114,6 +121,72 @@ pub struct ContactStore {
     next_keys: Vec<ContactKey>,
     #[serde(skip)]
     next_states: Vec<ContactState>,
+    /// The rows of [`body_adjacency`](Self::body_adjacency), derived from `keys` (not part of the state).
+    #[serde(skip)]
+    adjacency: BodyAdjacency,
+}
+
+/// For every body, the store entries (= candidates after a sync) it takes part in, in key order: entry `k`
+/// of body `i`'s row `entries[start[i]..start[i + 1]]` is an entry index, with [`BodyAdjacency::SIDE_A`]
+/// set when the body is side A of a body pair (it receives the opposite of the force on B and the torque on
+/// A); a body–wall pair lists the body as side B.
+#[derive(Clone, Debug, Default)]
+pub struct BodyAdjacency {
+    /// Whether the rows match the store's keys (false after a sync that changed them).
+    valid: bool,
+    bodies: usize,
+    pub start: Vec<u32>,
+    pub entries: Vec<u32>,
+}
+
+impl BodyAdjacency {
+    /// Flag of an entry in which the body is side A.
+    pub const SIDE_A: u32 = 1 << 31;
+
+    /// The row of body `i`.
+    #[inline]
+    pub fn row(&self, i: usize) -> &[u32] {
+        &self.entries[self.start[i] as usize..self.start[i + 1] as usize]
+    }
+
+    /// Builds the rows of `keys` for `bodies` bodies (every key's bodies must be below `bodies`).
+    fn build(&mut self, keys: &[ContactKey], bodies: usize) {
+        assert!(
+            keys.len() < Self::SIDE_A as usize,
+            "contact store: {} entries do not fit the adjacency's 31-bit indices",
+            keys.len()
+        );
+        self.start.clear();
+        self.start.resize(bodies + 1, 0);
+        let sides = |key: &ContactKey| match *key {
+            ContactKey::Body { a, b } => [Some(a), Some(b)],
+            ContactKey::Wall { body, .. } => [None, Some(body)],
+        };
+        for key in keys {
+            for body in sides(key).into_iter().flatten() {
+                self.start[body as usize + 1] += 1;
+            }
+        }
+        for i in 0..bodies {
+            self.start[i + 1] += self.start[i];
+        }
+        self.entries.clear();
+        self.entries.resize(self.start[bodies] as usize, 0);
+        let mut fill = self.start.clone();
+        for (k, key) in keys.iter().enumerate() {
+            let [a, b] = sides(key);
+            if let Some(a) = a {
+                self.entries[fill[a as usize] as usize] = k as u32 | Self::SIDE_A;
+                fill[a as usize] += 1;
+            }
+            if let Some(b) = b {
+                self.entries[fill[b as usize] as usize] = k as u32;
+                fill[b as usize] += 1;
+            }
+        }
+        self.bodies = bodies;
+        self.valid = true;
+    }
 }
 
 /// Two stores are equal when they hold the same entries (the merge scratch does not count).
@@ -170,6 +243,7 @@ impl ContactStore {
             self.next_states.push(state);
         }
         counts.dropped += self.keys.len() - old;
+        self.adjacency.valid = false;
         std::mem::swap(&mut self.keys, &mut self.next_keys);
         std::mem::swap(&mut self.states, &mut self.next_states);
         counts
@@ -185,6 +259,15 @@ impl ContactStore {
 
     pub fn states_mut(&mut self) -> &mut [ContactState] {
         &mut self.states
+    }
+
+    /// For every one of `bodies` bodies, the entries it takes part in, in key order (built here if the keys
+    /// changed since the last call; see the module docs).
+    pub fn body_adjacency(&mut self, bodies: usize) -> &BodyAdjacency {
+        if !self.adjacency.valid || self.adjacency.bodies != bodies {
+            self.adjacency.build(&self.keys, bodies);
+        }
+        &self.adjacency
     }
 
     /// The step of the last [`sync`](Self::sync): every entry was in the candidate list at that step.
@@ -237,6 +320,39 @@ mod tests {
         assert_eq!((kept.since_step, store.last_touched()), (0, 5));
         assert_eq!(store.get(&k(1, 3)).expect("new entry").since_step, 5);
         assert!(store.get(&k(0, 2)).is_none());
+    }
+
+    #[test]
+    fn adjacency_lists_each_body_s_entries_in_key_order_and_follows_syncs() {
+        let mut store = ContactStore::default();
+        let k = |a, b| ContactKey::Body { a, b };
+        let w = |body, wall| ContactKey::Wall { body, wall };
+        store.sync(&[k(0, 1), k(0, 2), k(1, 2), w(1, 0), w(2, 1)], 0);
+        let side_a = BodyAdjacency::SIDE_A;
+        let rows = |s: &mut ContactStore, n| {
+            let adj = s.body_adjacency(n);
+            (0..n).map(|i| adj.row(i).to_vec()).collect::<Vec<_>>()
+        };
+        assert_eq!(
+            rows(&mut store, 4),
+            vec![
+                vec![side_a, 1 | side_a],
+                vec![0, 2 | side_a, 3],
+                vec![1, 2, 4],
+                vec![]
+            ]
+        );
+        // A sync that changes the keys rebuilds the rows; one that keeps them keeps them.
+        store.sync(&[k(1, 3), w(0, 0)], 1);
+        assert_eq!(
+            rows(&mut store, 4),
+            vec![vec![1], vec![side_a], vec![], vec![0]]
+        );
+        store.sync(&[k(1, 3), w(0, 0)], 2);
+        assert_eq!(
+            rows(&mut store, 4),
+            vec![vec![1], vec![side_a], vec![], vec![0]]
+        );
     }
 
     #[test]

@@ -1,12 +1,20 @@
 //! Deterministic data parallelism for the step: per-item work on rayon's current thread pool, results in
 //! item order, whatever the number of threads.
 //!
-//! The step's parallel stages (narrow phase, laws, integration) compute one independent result per item
-//! (candidate pair or body) and write it into that item's own slot; nothing is summed across items in
-//! parallel. Every sum over items (forces on a body, energy terms, counters that feed physics) is taken
-//! afterwards, serially, in the fixed item order. A per-item result is a function of the item's inputs only
-//! (the per-chunk scratch holds nothing that matters after a query), so the state after a step is the same
-//! bit for bit for 1, 2 or N threads — `tests/world_parallel.rs` proves it.
+//! The step's parallel stages (narrow phase and laws, the per-body force sums, the integration with the
+//! finiteness checks, the broad phase's pair search) compute one independent result per item (candidate
+//! pair or body) and write it into that item's own slot; nothing is summed across items in parallel. The
+//! force on a body is the sum over the body's own pairs, taken by that body's item in the fixed candidate
+//! order (the rows of [`crate::world::contact_store::BodyAdjacency`]); the sums over all candidates (energy
+//! terms, counters that feed physics) are taken serially in candidate order. A per-item result is a
+//! function of the item's inputs only (the per-chunk scratch holds nothing that matters after a query), so
+//! the state after a step is the same bit for bit for 1, 2 or N threads, and the same as the serial path's
+//! — `tests/world_parallel.rs` proves it. Errors found per item (a failed query, a non-finite body) are
+//! reported for the first failing item in item order.
+//!
+//! Per step there are four parallel regions when everything is above the thresholds: first half kick and
+//! drift; narrow phase and laws (fused); force sums; second half kick and checks (fused). The broad phase's
+//! search adds one on the steps that rebuild the grid.
 //!
 //! Work is split into contiguous chunks of items, a few per thread ([`CHUNKS_PER_THREAD`]), each with its
 //! own [`Worker`] scratch (EPA buffers and narrow-phase counters) taken from a vector kept in the step's
@@ -14,9 +22,11 @@
 //! its first failing item and the error of the lowest failing chunk wins, which is the first failing item
 //! in item order.
 //!
-//! Small scenes run serially: below [`Parallelism::min_candidates`] candidates (or
-//! [`Parallelism::min_bodies`] bodies for the integration) the fork/join overhead of rayon (a few µs per
-//! stage) exceeds the work; see [`DEFAULT_MIN_CANDIDATES`] for the measurement behind the defaults.
+//! Small scenes run serially: below [`Parallelism::min_candidates`] candidates (narrow phase, laws, force
+//! sums) or [`Parallelism::min_bodies`] units of integration work ([`integration_work`]: a body with
+//! unequal principal moments counts [`ANISOTROPIC_WEIGHT`]) the fork/join overhead of rayon (tens of µs per
+//! region on a 2-core VM) exceeds the work; see [`DEFAULT_MIN_CANDIDATES`] for the measurement behind the
+//! defaults.
 
 use rayon::prelude::*;
 
@@ -36,10 +46,20 @@ pub const CHUNKS_PER_THREAD: usize = 8;
 /// threshold of 128, measured at a load average of ~10, made the 1000-body box slower on two threads.)
 pub const DEFAULT_MIN_CANDIDATES: usize = 4096;
 
-/// Default [`Parallelism::min_bodies`]: 20 000 bodies. A half kick and drift cost only ~16 ns per body
-/// (same runs: 5000 bodies, integration 160 ms over 2000 steps serial), while the two-thread version took
-/// 300 ms: the fork/joins cost more than the work. Below ~10^4 bodies the integration stays serial.
+/// Default [`Parallelism::min_bodies`]: 20 000 units of integration work ([`integration_work`]). A half
+/// kick and drift cost only ~16 ns per body at rest or nearly (same runs: 5000 bodies, integration 160 ms
+/// over 2000 steps serial), while the two-thread version took 300 ms: the fork/joins cost more than the
+/// work. Tumbling polyhedra cost several times more ([`ANISOTROPIC_WEIGHT`]), so 10^4 spheres integrate
+/// serially and 5000 polyhedra in parallel.
 pub const DEFAULT_MIN_BODIES: usize = 20_000;
+
+/// Weight of a dynamic body with unequal principal moments in the integration's work
+/// ([`integration_work`]): its rotation splitting (three sub-rotations per drift) costs about this many
+/// sphere kicks and drifts. Measured with `examples/perf_threads.rs` (2026-11-21, 1 thread, load ~10, so
+/// both inflated alike): 10^4 spinning polyhedra 3.3 ms of integration per step, 10^4 spheres 0.74 ms
+/// (ratio 4.4, the spheres' time including their cheaper isotropic turn): 4, so that from 5000 tumbling
+/// polyhedra on the integration runs in parallel (10^4 spheres stay below [`DEFAULT_MIN_BODIES`]).
+pub const ANISOTROPIC_WEIGHT: usize = 4;
 
 /// When the step uses more than one thread. Threads come from rayon's current pool (the global pool, or
 /// the one a caller `install`s); the results do not depend on the choice.
@@ -48,7 +68,8 @@ pub const DEFAULT_MIN_BODIES: usize = 20_000;
 pub struct Parallelism {
     /// Narrow phase and laws run in parallel from this many candidates on.
     pub min_candidates: usize,
-    /// The integration runs in parallel from this many bodies on.
+    /// The integration runs in parallel from this much work on ([`integration_work`]: bodies, a body with
+    /// unequal principal moments counting [`ANISOTROPIC_WEIGHT`]).
     pub min_bodies: usize,
 }
 
@@ -140,4 +161,76 @@ where
             f(i, t);
         }
     }
+}
+
+/// Calls `f(i, &mut items[i])` for every item, in parallel when `parallel`, and returns the first item (in
+/// item order) for which `f` returned an error, with that error. Every item is visited whatever fails, so
+/// the items end in the same state for any number of threads.
+pub fn for_each_item_checked<T, E, F>(parallel: bool, items: &mut [T], f: F) -> Option<(usize, E)>
+where
+    T: Send,
+    E: Send,
+    F: Fn(usize, &mut T) -> Option<E> + Sync + Send,
+{
+    if parallel && rayon::current_num_threads() > 1 {
+        let min_len = items
+            .len()
+            .div_ceil(rayon::current_num_threads() * CHUNKS_PER_THREAD);
+        items
+            .par_iter_mut()
+            .with_min_len(min_len.max(1))
+            .enumerate()
+            .filter_map(|(i, t)| f(i, t).map(|e| (i, e)))
+            .min_by_key(|(i, _)| *i)
+    } else {
+        let mut first = None;
+        for (i, t) in items.iter_mut().enumerate() {
+            if let Some(e) = f(i, t) {
+                first.get_or_insert((i, e));
+            }
+        }
+        first
+    }
+}
+
+/// Fills `out[i] = f(i)` for every `i` in `0..out.len()`, in parallel when `parallel` (each slot written
+/// once, by its own item: the same values for any number of threads).
+pub fn fill_items<T, F>(parallel: bool, out: &mut [T], f: F)
+where
+    T: Send,
+    F: Fn(usize) -> T + Sync + Send,
+{
+    for_each_item(parallel, out, |i, slot| *slot = f(i));
+}
+
+/// Calls `f(i, &mut a[i], &mut b[i])` for every item, in parallel when `parallel` (work split by rayon; `f`
+/// must not depend on the order).
+pub fn for_each_item_pair<A, B, F>(parallel: bool, a: &mut [A], b: &mut [B], f: F)
+where
+    A: Send,
+    B: Send,
+    F: Fn(usize, &mut A, &mut B) + Sync + Send,
+{
+    debug_assert_eq!(a.len(), b.len());
+    if parallel && rayon::current_num_threads() > 1 {
+        let min_len = a
+            .len()
+            .div_ceil(rayon::current_num_threads() * CHUNKS_PER_THREAD);
+        a.par_iter_mut()
+            .zip(b.par_iter_mut())
+            .with_min_len(min_len.max(1))
+            .enumerate()
+            .for_each(|(i, (x, y))| f(i, x, y));
+    } else {
+        for (i, (x, y)) in a.iter_mut().zip(b.iter_mut()).enumerate() {
+            f(i, x, y);
+        }
+    }
+}
+
+/// The integration's work in units of a sphere's kick and drift, compared with
+/// [`Parallelism::min_bodies`]: `bodies` plus [`ANISOTROPIC_WEIGHT`] − 1 more per dynamic body with unequal
+/// principal moments.
+pub fn integration_work(bodies: usize, anisotropic: usize) -> usize {
+    bodies + (ANISOTROPIC_WEIGHT - 1) * anisotropic
 }

@@ -9,10 +9,12 @@
 //!   4. narrow phase      contact store synced to the candidate list; one contact query per candidate
 //!   5. laws              ContactModel::evaluate per overlapping candidate (tangential history in the store);
 //!                        4 and 5 run fused, one pass over the candidates (the store entry is in cache)
-//!   6. accumulate        per-body sums of forces and torques in candidate order (fixed, deterministic)
+//!   6. accumulate        per-body sums of forces and torques in candidate order (fixed, deterministic:
+//!                        a scatter on one thread, a gather per body over its pairs on several)
 //!  6b. (sleeping on) wake the sleeping islands touched by moving bodies or walls
 //!   7. second half kick  v, L ← v, L + ½Δt (F_{n+1}, p_{n+1})
 //!   8. checks            non-finite state → StepError naming body and step; deep overlaps → StepReport
+//!                        (7 and the body checks of 8 run fused, one pass over the bodies)
 //!  8b. (sleeping on) calm counters, islands, bodies falling asleep (see [`super::sleeping`])
 //!   9. ledger, counters
 //! ```
@@ -21,10 +23,11 @@
 //! half-step velocities, as [`crate::dynamics::integrator`] documents.
 //!
 //! The candidate order is a function of the state only (the broad phase's sorted pairs, then body–wall
-//! pairs by body and wall). Stages 4 and 5 (one query and one law evaluation per candidate) and the
-//! integration (1–2, 7; one body at a time) run on rayon's current thread pool when the scene is large
-//! enough ([`Parallelism`]); each computes a result per item into that item's own slot, and stage 6 sums
-//! the per-candidate results serially in candidate order, so a run is bit-identical for any number of
+//! pairs by body and wall). Stages 4 and 5 (one query and one law evaluation per candidate), the force sums
+//! of stage 6 (one body at a time, over its pairs in candidate order) and the integration (1–2, 7–8; one
+//! body at a time) run on rayon's current thread pool when the scene is large enough ([`Parallelism`]);
+//! each computes a result per item into that item's own slot, and the sums over all candidates (energy
+//! terms, report) are taken serially in candidate order, so a run is bit-identical for any number of
 //! threads (see [`super::parallel`]; `tests/world_parallel.rs`).
 
 use std::time::{Duration, Instant};
@@ -40,9 +43,13 @@ use crate::law::{ContactKinematics, ContactModel, ContactResponse, DampingLaw, T
 use crate::math::{Point, Real, Vector};
 use crate::shape::Shape;
 
+use super::contact_store::BodyAdjacency;
 use super::contact_store::{ContactKey, ContactState};
 use super::energy::{viscous_power, ContactWork, LastForces};
-use super::parallel::{for_each_chunked, for_each_item, Parallelism, Worker};
+use super::parallel::{
+    for_each_chunked, for_each_item, for_each_item_checked, for_each_item_pair, integration_work,
+    Parallelism, Worker,
+};
 use super::skips::{self, Skips};
 use super::sleeping::{self, SleepParams};
 use super::world::World;
@@ -99,6 +106,9 @@ pub struct StepScratch {
     dynamic: Vec<bool>,
     /// Whether some body has a prescribed motion (its power enters the ledger).
     any_prescribed: bool,
+    /// Dynamic bodies with unequal principal moments at the last evaluation of the loads: they cost the
+    /// integration several times a sphere (only the choice serial/parallel depends on it, never a result).
+    anisotropic: usize,
     /// The contact model of each material pair with the skips applied.
     models: Vec<Option<ContactModel>>,
     candidates: Vec<ContactKey>,
@@ -121,7 +131,10 @@ pub struct StepCounters {
     /// summaries keep their columns.
     pub laws: Duration,
     pub accumulate: Duration,
+    /// Stages 1–2 and 7–8 (the checks run fused with the second half kick).
     pub integrate: Duration,
+    /// Zero since the checks run fused with the second half kick (their time is in `integrate`); kept so
+    /// that the summaries keep their columns.
     pub checks: Duration,
     /// Broad-phase grid rebuilds.
     pub broad_rebuilds: u64,
@@ -302,7 +315,8 @@ pub fn step(
 
     // 1–2. First half kick with the kept loads, drift.
     let t = Instant::now();
-    let parallel_bodies = world.bodies.len() >= params.parallel.min_bodies;
+    let parallel_bodies =
+        integration_work(world.bodies.len(), scratch.anisotropic) >= params.parallel.min_bodies;
     let (loads, asleep) = (&world.loads, &world.sleep);
     let skip = params.skips;
     let splitting = match params.rotation {
@@ -350,21 +364,27 @@ pub fn step(
             sleeping::wake_touched(world, &mut scratch.islands, &mut scratch.ready);
     }
 
-    // 7. Second half kick.
+    // 7–8. Second half kick, then the checks of the same body, in one pass (the first non-finite body in
+    // body order is reported, for any number of threads).
     let t = Instant::now();
+    let parallel_bodies =
+        integration_work(world.bodies.len(), scratch.anisotropic) >= params.parallel.min_bodies;
     let (loads, asleep) = (&world.loads, &world.sleep);
-    for_each_item(parallel_bodies, &mut world.bodies, |i, body| {
-        if asleep.is_asleep(i) || (skip.non_dynamic_pairs && is_at_rest_fixed(body)) {
-            return;
+    let non_finite = for_each_item_checked(parallel_bodies, &mut world.bodies, |i, body| {
+        if !(asleep.is_asleep(i) || (skip.non_dynamic_pairs && is_at_rest_fixed(body))) {
+            integrator.second_half_kick(body, &loads.forces[i], &loads.torques[i], dt);
         }
-        integrator.second_half_kick(body, &loads.forces[i], &loads.torques[i], dt);
+        non_finite_quantity(body, &loads.forces[i], &loads.torques[i])
     });
     report.counters.integrate += t.elapsed();
-
-    // 8. Checks.
-    let t = Instant::now();
-    check_finite(world)?;
-    report.counters.checks += t.elapsed();
+    if let Some((body, quantity)) = non_finite {
+        return Err(StepError::NonFinite {
+            step: world.step_index + 1,
+            body,
+            name: world.names[body].clone(),
+            quantity,
+        });
+    }
 
     // 8b. Sleeping: calm counters, islands, falling asleep and waking (serial, in body order).
     if params.sleeping.enabled {
@@ -406,10 +426,20 @@ fn evaluate_loads(
 
     // 3. Broad phase.
     let t = Instant::now();
+    // Per-body inputs of the stages below, in one pass over the bodies: centres (broad phase), whether
+    // dynamic (pair loops: a flag instead of a random access to a whole body per pair), whether some motion
+    // is prescribed (ledger), and the anisotropic count (the integration's parallel choice).
     scratch.centres.clear();
-    scratch
-        .centres
-        .extend(world.bodies.iter().map(|b| b.position));
+    scratch.dynamic.clear();
+    scratch.any_prescribed = false;
+    scratch.anisotropic = 0;
+    for b in &world.bodies {
+        let dynamic = b.is_dynamic();
+        scratch.centres.push(b.position);
+        scratch.dynamic.push(dynamic);
+        scratch.any_prescribed |= matches!(b.motion, Motion::Prescribed { .. });
+        scratch.anisotropic += (dynamic && !is_isotropic(&b.inertia.0)) as usize;
+    }
     if !params.skips.verlet_skin {
         world
             .broad_phase
@@ -423,16 +453,6 @@ fn evaluate_loads(
     }
     scratch.candidates.clear();
     let skip_non_dynamic = params.skips.non_dynamic_pairs;
-    // Per-body flags and angular velocities, read by the pair loops below: one pass over the bodies instead
-    // of a random access to a whole body (or two frame changes for ω) per pair.
-    scratch.dynamic.clear();
-    scratch
-        .dynamic
-        .extend(world.bodies.iter().map(|b| b.is_dynamic()));
-    scratch.any_prescribed = world
-        .bodies
-        .iter()
-        .any(|b| matches!(b.motion, Motion::Prescribed { .. }));
     let dynamic = &scratch.dynamic;
     for &(a, b) in world.broad_phase.pairs() {
         if !skip_non_dynamic || dynamic[a as usize] || dynamic[b as usize] {
@@ -535,6 +555,20 @@ fn evaluate_loads(
     loads.damping_work = 0.0;
     loads.friction_dissipation = 0.0;
     loads.tangential_stiffness_work = 0.0;
+    // Forces and torques on the bodies, summed in candidate order: on one thread by a scatter over the
+    // candidates (in the loop below: one sequential pass); on several per body over its pairs (the same
+    // additions in the same order: the same bits; it reads each result twice, so it pays only in parallel).
+    let gather = parallel && rayon::current_num_threads() > 1;
+    if gather {
+        let adjacency = world.contacts.body_adjacency(n);
+        let evaluated = &scratch.evaluated;
+        for_each_item_pair(
+            true,
+            &mut loads.forces,
+            &mut loads.torques,
+            |i, force, torque| sum_body_loads(adjacency, evaluated, i, force, torque),
+        );
+    }
     for (key, e) in scratch.candidates.iter().zip(&scratch.evaluated) {
         counters.frozen_pairs += e.frozen as u64;
         // Ledger terms: written for every candidate (a pair that opens in this step books its release).
@@ -556,16 +590,19 @@ fn evaluate_loads(
         }
         let r = &e.response;
         match *key {
-            ContactKey::Body { a, b } => {
+            ContactKey::Body { a, b } if !gather => {
                 loads.forces[a as usize] -= r.force_on_b;
                 loads.torques[a as usize] += r.torque_on_a;
                 loads.forces[b as usize] += r.force_on_b;
                 loads.torques[b as usize] += r.torque_on_b;
             }
+            ContactKey::Body { .. } => {}
             ContactKey::Wall { body, wall } => {
                 loads.wall_forces[wall as usize] -= r.force_on_b;
-                loads.forces[body as usize] += r.force_on_b;
-                loads.torques[body as usize] += r.torque_on_b;
+                if !gather {
+                    loads.forces[body as usize] += r.force_on_b;
+                    loads.torques[body as usize] += r.torque_on_b;
+                }
             }
         }
         loads.elastic_potential += r.normal_potential + r.tangential_potential;
@@ -591,6 +628,34 @@ fn evaluate_loads(
     loads.current = true;
     counters.accumulate += t.elapsed();
     Ok(())
+}
+
+/// Stage 6 for body `i`: the sum of the forces and torques of its overlapping pairs, in candidate order
+/// (side A receives the opposite of the force on B and the torque on A).
+#[inline]
+fn sum_body_loads(
+    adjacency: &BodyAdjacency,
+    evaluated: &[Evaluated],
+    i: usize,
+    force: &mut Vector,
+    torque: &mut Vector,
+) {
+    let (mut f, mut t) = (Vector::zeros(), Vector::zeros());
+    for &entry in adjacency.row(i) {
+        let e = &evaluated[(entry & !BodyAdjacency::SIDE_A) as usize];
+        if !e.overlapping {
+            continue;
+        }
+        if entry & BodyAdjacency::SIDE_A != 0 {
+            f -= e.response.force_on_b;
+            t += e.response.torque_on_a;
+        } else {
+            f += e.response.force_on_b;
+            t += e.response.torque_on_b;
+        }
+    }
+    *force = f;
+    *torque = t;
 }
 
 /// The result of stage 5 for one candidate. The flags and `work` are written for every candidate; the
@@ -981,33 +1046,26 @@ fn frozen_response(
     Ok(())
 }
 
-/// Stage 8: every dynamic body's state and loads are finite.
-fn check_finite(world: &World) -> Result<(), StepError> {
+/// Stage 8 for one body: the first non-finite quantity of its loads and state, if any.
+fn non_finite_quantity(
+    body: &crate::dynamics::RigidBody,
+    force: &Vector,
+    torque: &Vector,
+) -> Option<&'static str> {
     let finite = |v: &Vector| v.iter().all(|x| x.is_finite());
-    for (i, body) in world.bodies.iter().enumerate() {
-        let quantity = if !finite(&world.loads.forces[i]) {
-            Some("contact force")
-        } else if !finite(&world.loads.torques[i]) {
-            Some("contact torque")
-        } else if !finite(&body.position.coords) {
-            Some("position")
-        } else if !finite(&body.velocity) {
-            Some("velocity")
-        } else if !body.orientation.coords.iter().all(|x| x.is_finite()) {
-            Some("orientation")
-        } else if !finite(&body.angular_momentum) {
-            Some("angular momentum")
-        } else {
-            None
-        };
-        if let Some(quantity) = quantity {
-            return Err(StepError::NonFinite {
-                step: world.step_index + 1,
-                body: i,
-                name: world.names[i].clone(),
-                quantity,
-            });
-        }
+    if !finite(force) {
+        Some("contact force")
+    } else if !finite(torque) {
+        Some("contact torque")
+    } else if !finite(&body.position.coords) {
+        Some("position")
+    } else if !finite(&body.velocity) {
+        Some("velocity")
+    } else if !body.orientation.coords.iter().all(|x| x.is_finite()) {
+        Some("orientation")
+    } else if !finite(&body.angular_momentum) {
+        Some("angular momentum")
+    } else {
+        None
     }
-    Ok(())
 }

@@ -1,0 +1,233 @@
+//! Throughput of the step on 1 and 2 threads (issue 4): the quiet-machine re-measurement.
+//!
+//! Three seeded scenes of 10^4 bodies in a box of five walls (built by `tests/support/bed.rs`, the same
+//! builder as the engine tests and `benches/step.rs`), dropped from a tight lattice with random velocities
+//! and spins so that they collapse and settle under gravity:
+//! - `poly`: 10^4 random convex polyhedra, every body its own hull (14 points on a randomly stretched
+//!   sphere, like `reference/polyhedra_box/make_scene.py` but ten times as many bodies);
+//! - `poly_projectile`: the same bed struck by a 0.25 m steel sphere at 10 m/s;
+//! - `spheres`: 10^4 spheres, same box and law.
+//!
+//! Each scene is warmed up (so that the lattice is in contact), then the same stretch of steps is run from
+//! the warm state once per thread count. Printed per run: wall time, process CPU time (getrusage, all
+//! threads), particle-steps/s and contacts/s (wall), the stage timers of the step, the load average, and
+//! whether the final state is bit-identical to the first thread count's.
+//!
+//! ```text
+//! cargo run --release --example perf_threads -- [--steps N] [--warm-up N] [--threads 1,2] [--scenes poly,poly_projectile,spheres]
+//!     [--min-candidates N] [--min-bodies N]
+//! ```
+//! The last two replace the parallel thresholds of the step ([`polydem::world::Parallelism`]; the results
+//! are the same bits either way), to re-measure them.
+//! (`scenes/perf/run_threads.sh` runs it with the defaults.)
+
+#[path = "../tests/support/bed.rs"]
+mod bed;
+
+use std::time::{Duration, Instant};
+
+use polydem::world::{step, StepCounters, StepParams, StepScratch, World};
+
+struct Options {
+    steps: usize,
+    warm_up: usize,
+    threads: Vec<usize>,
+    scenes: Vec<String>,
+    min_candidates: Option<usize>,
+    min_bodies: Option<usize>,
+}
+
+fn parse() -> Result<Options, String> {
+    let mut o = Options {
+        steps: 200,
+        warm_up: 100,
+        threads: vec![1, 2],
+        scenes: vec!["poly".into(), "poly_projectile".into(), "spheres".into()],
+        min_candidates: None,
+        min_bodies: None,
+    };
+    let mut args = std::env::args().skip(1);
+    while let Some(a) = args.next() {
+        let mut value = || args.next().ok_or(format!("{a} needs a value"));
+        match a.as_str() {
+            "--steps" => o.steps = value()?.parse().map_err(|e| format!("--steps: {e}"))?,
+            "--warm-up" => o.warm_up = value()?.parse().map_err(|e| format!("--warm-up: {e}"))?,
+            "--threads" => {
+                o.threads = value()?
+                    .split(',')
+                    .map(|s| s.parse().map_err(|e| format!("--threads: {e}")))
+                    .collect::<Result<_, _>>()?
+            }
+            "--scenes" => o.scenes = value()?.split(',').map(str::to_owned).collect(),
+            "--min-candidates" => {
+                o.min_candidates = Some(
+                    value()?
+                        .parse()
+                        .map_err(|e| format!("--min-candidates: {e}"))?,
+                )
+            }
+            "--min-bodies" => {
+                o.min_bodies = Some(value()?.parse().map_err(|e| format!("--min-bodies: {e}"))?)
+            }
+            _ => return Err(format!("unknown argument {a}")),
+        }
+    }
+    Ok(o)
+}
+
+/// The scene `name`, not yet warmed up.
+fn build(name: &str) -> Result<bed::Bed, String> {
+    let spec = |sphere_every| bed::BedSpec {
+        gap: 0.0,
+        speed: 1.0,
+        // Every polyhedron its own hull.
+        hull_shapes: if sphere_every == 1 { 1 } else { 10_000 },
+        ..bed::BedSpec::rocks([25, 25, 16], sphere_every, 20261121)
+    };
+    Ok(match name {
+        "poly" => bed::build(&spec(0)),
+        "poly_projectile" => {
+            let mut b = bed::build(&spec(0));
+            // Starts 1 cm above the lattice: it strikes during the warm-up and ploughs on through the
+            // measured steps.
+            bed::add_projectile(&mut b, 0.125, 7800.0, 0.01, 10.0);
+            b
+        }
+        "spheres" => bed::build(&spec(1)),
+        _ => {
+            return Err(format!(
+                "unknown scene {name} (poly, poly_projectile, spheres)"
+            ))
+        }
+    })
+}
+
+/// Process CPU time (user + system, all threads).
+fn cpu_time() -> Duration {
+    // SAFETY: getrusage only writes into the struct we pass.
+    let mut usage: libc::rusage = unsafe { std::mem::zeroed() };
+    let rc = unsafe { libc::getrusage(libc::RUSAGE_SELF, &mut usage) };
+    if rc != 0 {
+        return Duration::ZERO;
+    }
+    let tv = |t: libc::timeval| Duration::new(t.tv_sec as u64, 1000 * t.tv_usec as u32);
+    tv(usage.ru_utime) + tv(usage.ru_stime)
+}
+
+fn load_average() -> String {
+    std::fs::read_to_string("/proc/loadavg")
+        .map(|s| s.split_whitespace().take(3).collect::<Vec<_>>().join(" "))
+        .unwrap_or_else(|_| "?".into())
+}
+
+/// The bits of every body's state, for the identity check between thread counts.
+fn state_bits(w: &World) -> Vec<u64> {
+    w.bodies
+        .iter()
+        .flat_map(|b| {
+            b.position
+                .coords
+                .iter()
+                .chain(b.velocity.iter())
+                .chain(b.orientation.coords.iter())
+                .chain(b.angular_momentum.iter())
+                .map(|x| x.to_bits())
+                .collect::<Vec<_>>()
+        })
+        .collect()
+}
+
+fn run(
+    world: &World,
+    params: &StepParams,
+    steps: usize,
+    threads: usize,
+) -> (World, StepCounters, Duration, Duration) {
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .expect("thread pool");
+    let mut world = world.clone();
+    let mut scratch = StepScratch::default();
+    let mut counters = StepCounters::default();
+    let (cpu0, t0) = (cpu_time(), Instant::now());
+    pool.install(|| {
+        for _ in 0..steps {
+            let r = step(params, &mut world, &mut scratch).expect("step");
+            counters.merge(&r.counters);
+        }
+    });
+    let (wall, cpu) = (t0.elapsed(), cpu_time() - cpu0);
+    (world, counters, wall, cpu)
+}
+
+fn main() {
+    let o = match parse() {
+        Ok(o) => o,
+        Err(e) => {
+            eprintln!("perf_threads: {e}");
+            std::process::exit(2);
+        }
+    };
+    for name in &o.scenes {
+        let mut b = match build(name) {
+            Ok(b) => b,
+            Err(e) => {
+                eprintln!("perf_threads: {e}");
+                std::process::exit(2);
+            }
+        };
+        if let Some(n) = o.min_candidates {
+            b.params.parallel.min_candidates = n;
+        }
+        if let Some(n) = o.min_bodies {
+            b.params.parallel.min_bodies = n;
+        }
+        let mut scratch = StepScratch::default();
+        for _ in 0..o.warm_up {
+            step(&b.params, &mut b.world, &mut scratch).expect("warm-up step");
+        }
+        let bodies = b.world.bodies.len();
+        println!(
+            "== {name}: {bodies} bodies, {} steps from the state after {} warm-up steps (dt {:.3e} s; \
+             parallel from {} candidates, {} integration units)",
+            o.steps, o.warm_up, b.params.dt, b.params.parallel.min_candidates, b.params.parallel.min_bodies
+        );
+        let mut reference: Option<(usize, Vec<u64>, f64)> = None;
+        for &threads in &o.threads {
+            let (w, c, wall, cpu) = run(&b.world, &b.params, o.steps, threads);
+            let ms = |d: Duration| d.as_secs_f64() * 1e3;
+            let ps = (bodies * o.steps) as f64 / wall.as_secs_f64();
+            let cs = c.contacts as f64 / wall.as_secs_f64();
+            println!(
+                "{name} {threads}t: wall {:.3} s, cpu {:.3} s, {:.3e} particle-steps/s, {:.3e} contacts/s, \
+                 {:.0} contacts/step, {:.0} candidates/step, load {}",
+                wall.as_secs_f64(),
+                cpu.as_secs_f64(),
+                ps,
+                cs,
+                c.contacts as f64 / o.steps as f64,
+                (c.body_pairs_tested + c.wall_pairs_tested) as f64 / o.steps as f64,
+                load_average()
+            );
+            println!(
+                "{name} {threads}t stages (ms): broad {:.0}, narrow+laws {:.0}, accumulate {:.0}, integrate {:.0}, checks {:.0}; broad rebuilds {}",
+                ms(c.broad),
+                ms(c.narrow + c.laws),
+                ms(c.accumulate),
+                ms(c.integrate),
+                ms(c.checks),
+                c.broad_rebuilds
+            );
+            let bits = state_bits(&w);
+            match &reference {
+                None => reference = Some((threads, bits, wall.as_secs_f64())),
+                Some((t_ref, bits_ref, wall_ref)) => println!(
+                    "{name} {threads}t vs {t_ref}t: speed-up {:.2}x (wall), final state bit-identical: {}",
+                    wall_ref / wall.as_secs_f64(),
+                    if *bits_ref == bits { "yes" } else { "NO" }
+                ),
+            }
+        }
+    }
+}
