@@ -11,13 +11,28 @@
 //! - Sleeping evaluates fewer contact candidates over the run.
 //! - The run with sleeping is bit-identical for 1 and 2 threads.
 //! - While the bed sleeps, the floor carries its weight (the frozen contacts keep their forces).
+//!
+//! Local waking, on a column of 40 spheres standing on the floor (every contact carries the weight above it,
+//! so the column is one connected group in which every body touches the next), struck on top by a steel
+//! sphere, from an exact equilibrium, with every sphere put to sleep after the first step:
+//! - the wake front: each sphere wakes within one pulse travel time per sphere of the step at which, in the
+//!   run without sleeping, its load first departs from equilibrium by the wake threshold; the woken spheres
+//!   are always a top segment of the column; the striker's velocity agrees with the run without sleeping
+//!   within 0.5 %;
+//! - the far part of the column, which the pulse has not reached, stays asleep and exactly in place (the
+//!   run without sleeping moves it by less than 1e-9 of a diameter), although it touches the woken part.
 
 #[path = "support/bed.rs"]
 mod bed;
 
-use polydem::dynamics::ViscousDamping;
-use polydem::math::Real;
-use polydem::world::{step, Parallelism, SleepParams, StepCounters, StepScratch};
+use polydem::dynamics::{PrincipalInertia, RigidBody, ViscousDamping};
+use polydem::law::{ContactModel, DampingLaw, NormalLaw, TangentialLaw};
+use polydem::math::{Point, Pose, Real, Vector};
+use polydem::shape::{Plane, Shape, Sphere};
+use polydem::world::{
+    sleeping, step, MaterialTable, Parallelism, SleepParams, StepCounters, StepParams, StepScratch,
+    Wall, World,
+};
 
 /// The bed after settling (damping removed), with the projectile added; returns it with the projectile's
 /// index.
@@ -100,12 +115,15 @@ fn projectile_residual_velocity_with_and_without_sleeping_agrees_and_sleeping_sa
     let evaluated = |c: &StepCounters| c.body_pairs_tested + c.wall_pairs_tested - c.frozen_pairs;
     let (e_awake, e_asleep) = (evaluated(&awake.counters), evaluated(&asleep.counters));
     let dv = (asleep.velocity - awake.velocity).norm() / awake.velocity.norm();
+    let bodies = 129.0;
     eprintln!(
         "projectile velocity without sleeping {:?}, with {:?}: relative difference {dv:e}; candidates evaluated \
-         {e_awake} vs {e_asleep} ({:.1} %), frozen {}, bodies asleep at most {}, fell asleep {}, woken {}",
+         {e_awake} vs {e_asleep} ({:.1} %), body-steps asleep {:.1} %, frozen {}, bodies asleep at most {}, \
+         fell asleep {}, woken {}",
         awake.velocity,
         asleep.velocity,
         100.0 * e_asleep as f64 / e_awake as f64,
+        100.0 * asleep.counters.sleeping_body_steps as f64 / (bodies * STEPS as f64),
         asleep.counters.frozen_pairs,
         asleep.max_sleeping,
         asleep.counters.fell_asleep,
@@ -168,4 +186,227 @@ fn sleeping_runs_are_bit_identical_for_one_and_two_threads() {
         ),
         "sleeping counters differ between 1 and 2 threads"
     );
+}
+
+/// Spheres of the column (the striker is one more body).
+const COLUMN: usize = 40;
+const RADIUS: Real = 0.05;
+const STIFFNESS: Real = 1.0e6;
+const DENSITY: Real = 2600.0;
+
+/// The column of [`COLUMN`] spheres on the floor in exact equilibrium (each linear contact compressed by the
+/// weight above it), a steel striker of the same radius 0.2 diameters above the top, falling at 1 m/s; the
+/// step parameters; the striker's index.
+fn column() -> (World, StepParams, usize) {
+    let mut materials = MaterialTable::default();
+    let rock = materials.add_material("rock");
+    let model = ContactModel {
+        normal: NormalLaw::linear(STIFFNESS).expect("stiffness"),
+        damping: DampingLaw::from_restitution(1.0, 0.5).expect("restitution"),
+        tangential: TangentialLaw::spring(0.5 * STIFFNESS, 0.5).expect("spring"),
+    };
+    materials.set_model(rock, rock, model);
+    let g = 9.81;
+    let mut world = World::new(Vector::new(0.0, 0.0, -g), materials, 0.05 * 2.0 * RADIUS);
+    let sphere = Sphere::new(RADIUS).expect("sphere");
+    let props = sphere.mass_properties();
+    let shape = world.add_shape(Shape::Sphere(sphere));
+    let mass = props.volume * DENSITY;
+    let inertia = PrincipalInertia::new(props.principal_moments * DENSITY).expect("inertia");
+    // Contact j (0 = the floor) carries the weight of the spheres j.. above it: overlap (N − j) m g / k.
+    let overlap = |j: usize| (COLUMN - j) as Real * mass * g / STIFFNESS;
+    let mut z = RADIUS - overlap(0);
+    for j in 0..COLUMN {
+        if j > 0 {
+            z += 2.0 * RADIUS - overlap(j);
+        }
+        let body = RigidBody::new_dynamic(Point::new(0.0, 0.0, z), mass, inertia).expect("body");
+        world
+            .add_body(&format!("s{j}"), shape, rock, body)
+            .expect("body added");
+    }
+    world
+        .add_wall(Wall {
+            name: "floor".to_owned(),
+            plane: Plane::new(Vector::z(), 0.0).expect("plane"),
+            pose: Pose::identity(),
+            velocity: Vector::zeros(),
+            material: rock,
+        })
+        .expect("floor");
+    let steel = 7800.0;
+    let mut striker = RigidBody::new_dynamic(
+        Point::new(0.0, 0.0, z + 2.0 * RADIUS + 0.2 * 2.0 * RADIUS),
+        props.volume * steel,
+        PrincipalInertia::new(props.principal_moments * steel).expect("inertia"),
+    )
+    .expect("striker");
+    striker.velocity = Vector::new(0.0, 0.0, -1.0);
+    let p = world
+        .add_body("striker", shape, rock, striker)
+        .expect("striker added") as usize;
+    let t_c = model.normal.elastic_contact_time(0.5 * mass, 1.0);
+    let mut params = StepParams::new(t_c / 40.0);
+    params.parallel = Parallelism {
+        min_candidates: 0,
+        min_bodies: 0,
+    };
+    (world, params, p)
+}
+
+struct ColumnRun {
+    /// Per sphere: the first step at which it was awake (sleeping) or its load departed from equilibrium by
+    /// the wake threshold (without sleeping); `None` if never.
+    first: Vec<Option<usize>>,
+    /// Per step: the woken spheres form a top segment of the column.
+    top_segment: bool,
+    positions: Vec<Point>,
+    striker_velocity: Vector,
+    sleeping_body_steps: u64,
+}
+
+/// Runs the struck column for one step and then `steps` steps, all spheres asleep after the first step when
+/// `sleeping`.
+fn strike_column(sleeping: bool, steps: usize) -> ColumnRun {
+    let (mut world, mut params, p) = column();
+    let sleep = SleepParams::on();
+    let mut scratch = StepScratch::default();
+    // One step awake in both runs, so that the contacts have been evaluated (their forces are what the
+    // sleeping spheres keep).
+    step(&params, &mut world, &mut scratch).expect("first step");
+    if sleeping {
+        params.sleeping = sleep;
+        let n = sleeping::put_to_sleep(&sleep, &mut world, 0..COLUMN);
+        assert_eq!(n, COLUMN, "every sphere of the column falls asleep");
+    }
+    let g = world.gravity.norm();
+    let mut first = vec![None; COLUMN];
+    let mut top_segment = true;
+    let mut counters = StepCounters::default();
+    for s in 0..steps {
+        let r = step(&params, &mut world, &mut scratch).expect("step");
+        counters.merge(&r.counters);
+        for (j, f) in first.iter_mut().enumerate() {
+            let body = &world.bodies[j];
+            let disturbed = if sleeping {
+                !world.sleep.is_asleep(j)
+            } else {
+                let net = world.loads.forces[j] + body.mass * world.gravity;
+                net.norm() > sleep.rest_force * body.mass * g
+                    || world.loads.torques[j].norm() > sleep.rest_force * body.mass * g * RADIUS
+            };
+            if disturbed && f.is_none() {
+                *f = Some(s);
+            }
+        }
+        if sleeping {
+            // Awake spheres (index from the floor up) must be a top segment: no sleeping sphere above one
+            // that woke.
+            let lowest_awake = (0..COLUMN).find(|&j| !world.sleep.is_asleep(j));
+            if let Some(low) = lowest_awake {
+                top_segment &= (low..COLUMN).all(|j| !world.sleep.is_asleep(j));
+            }
+        }
+    }
+    ColumnRun {
+        first,
+        top_segment,
+        positions: world.bodies.iter().map(|b| b.position).collect(),
+        striker_velocity: world.bodies[p].velocity,
+        sleeping_body_steps: counters.sleeping_body_steps,
+    }
+}
+
+/// Steps of the column runs: the pulse crosses about half of the column.
+const COLUMN_STEPS: usize = 500;
+
+/// Steps for a pulse to cross one sphere: 2 r / c with the chain's wave speed c = 2 r √(k/m).
+fn steps_per_sphere(params: &StepParams) -> Real {
+    let mass = DENSITY * 4.0 / 3.0 * std::f64::consts::PI * RADIUS.powi(3);
+    1.0 / (STIFFNESS / mass).sqrt() / params.dt
+}
+
+#[test]
+fn wake_front_follows_the_pulse_down_a_sleeping_column() {
+    let awake = strike_column(false, COLUMN_STEPS);
+    let asleep = strike_column(true, COLUMN_STEPS);
+    let (_, params, _) = column();
+    let tolerance = steps_per_sphere(&params);
+    eprintln!(
+        "arrival step per sphere (top first) without sleeping {:?}\nwake step with sleeping {:?}\n\
+         tolerance {tolerance:.1} steps (one sphere's pulse travel time); sphere-steps asleep {:.1} %",
+        awake.first.iter().rev().collect::<Vec<_>>(),
+        asleep.first.iter().rev().collect::<Vec<_>>(),
+        100.0 * asleep.sleeping_body_steps as f64 / ((COLUMN + 1) * COLUMN_STEPS) as f64
+    );
+    let reached = awake.first.iter().filter(|f| f.is_some()).count();
+    assert!(
+        (5..COLUMN - 5).contains(&reached),
+        "the pulse reached {reached} of {COLUMN} spheres in {COLUMN_STEPS} steps: the test needs a front \
+         inside the column"
+    );
+    assert!(
+        asleep.top_segment,
+        "the woken spheres were not always a top segment of the column"
+    );
+    for j in 0..COLUMN {
+        match (awake.first[j], asleep.first[j]) {
+            (Some(a), Some(b)) => assert!(
+                (a as Real - b as Real).abs() <= tolerance,
+                "sphere {j}: load departs from equilibrium at step {a} without sleeping, woken at step {b} \
+                 with sleeping; tolerance {tolerance:.1} steps"
+            ),
+            (None, None) => {}
+            (a, b) => {
+                // Only at the edge of the front may one run see the disturbance and the other not.
+                let last = a.or(b).expect("one of them");
+                assert!(
+                    (COLUMN_STEPS - 1 - last) as Real <= tolerance,
+                    "sphere {j}: disturbed at {a:?} without sleeping, woken at {b:?} with sleeping"
+                );
+            }
+        }
+    }
+    let dv = (asleep.striker_velocity - awake.striker_velocity).norm()
+        / awake.striker_velocity.norm().max(1.0);
+    assert!(
+        dv <= 5e-3,
+        "striker velocity with sleeping {:?}, without {:?}: relative difference {dv:e} (of max(|v|, 1 m/s)), \
+         tolerance 5e-3",
+        asleep.striker_velocity,
+        awake.striker_velocity
+    );
+}
+
+#[test]
+fn far_part_of_a_touching_column_stays_asleep_and_in_place() {
+    let awake = strike_column(false, COLUMN_STEPS);
+    let asleep = strike_column(true, COLUMN_STEPS);
+    let (world, _, _) = column();
+    let diameter = 2.0 * RADIUS;
+    // The far part: spheres the pulse did not reach without sleeping, less a margin of five spheres.
+    let reached_lowest = (0..COLUMN)
+        .find(|&j| awake.first[j].is_some())
+        .expect("the pulse reached some sphere");
+    let far = reached_lowest.saturating_sub(5);
+    assert!(
+        far >= 10,
+        "only {far} spheres far from the front: the test needs a far part"
+    );
+    for j in 0..far {
+        let moved_awake = (awake.positions[j] - world.bodies[j].position).norm();
+        assert!(
+            moved_awake <= 1e-9 * diameter,
+            "sphere {j} moved {moved_awake:e} m without sleeping: the far part is not at rest (tolerance 1e-9 \
+             of the diameter {diameter} m)"
+        );
+        assert_eq!(
+            asleep.first[j], None,
+            "sphere {j} (far from the struck top, below sphere {reached_lowest} where the pulse ended) woke"
+        );
+        assert_eq!(
+            asleep.positions[j], world.bodies[j].position,
+            "sleeping sphere {j} moved"
+        );
+    }
 }

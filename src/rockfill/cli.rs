@@ -59,10 +59,27 @@ pub struct ExperimentArgs {
     /// Use the full-scale experiment (scenes/rockfill/paper.toml).
     #[arg(long)]
     pub full: bool,
+    /// Override the file's `sleeping.penetration` (true: the bed starts asleep and wakes locally).
+    #[arg(long, value_name = "true|false")]
+    pub sleep_penetration: Option<bool>,
+    /// Override the file's `sleeping.packing`.
+    #[arg(long, value_name = "true|false")]
+    pub sleep_packing: Option<bool>,
 }
 
 impl ExperimentArgs {
     fn load(&self) -> Result<(ExperimentConfig, String)> {
+        let (mut config, name) = self.load_file()?;
+        if let Some(on) = self.sleep_penetration {
+            config.sleeping.penetration = on;
+        }
+        if let Some(on) = self.sleep_packing {
+            config.sleeping.packing = on;
+        }
+        Ok((config, name))
+    }
+
+    fn load_file(&self) -> Result<(ExperimentConfig, String)> {
         Ok(match (&self.config, self.full) {
             (Some(path), _) => (ExperimentConfig::load(path)?, path.display().to_string()),
             (None, true) => (ExperimentConfig::paper(), "paper.toml (full scale)".into()),
@@ -272,12 +289,14 @@ pub fn summary(config: &ExperimentConfig, r: &ExperimentResult) -> String {
     let p = &r.penetration;
     let _ = writeln!(
         s,
-        "penetration: {:?} after {} steps of {:.3e} s ({} rocks); {:.1} s wall time\n  residual speed {:.1} m/s (axial {:.1} m/s; paper: 1000–1025 m/s for 100–200 mm, ≈1100 m/s for 290 mm)\n  deflection at the end: velocity {:.2}°, axis {:.2}° (max {:.2}°, {:.2}°; paper: 10°–20°)\n  max axial resistance {:.3e} N; in the layer: mean {:.3e} N, CV per step {:.3}, CV over windows of one rock size {:.3} ({} windows)\n  disturbed rocks {}, zone width {:.3} m = {:.2} mean sizes (paper: 6–7)\n  energy: projectile lost {:.4e} J, damping {:.4e} J, friction {:.4e} J; ledger balance / initial projectile energy {:.3e}\n  max overlap/size {:.3}, steps with overlap warnings {}",
+        "penetration: {:?} after {} steps of {:.3e} s ({} rocks); {:.1} s wall time, {:.1} s in the step's stages; rock-steps asleep {:.1} %\n  residual speed {:.1} m/s (axial {:.1} m/s; paper: 1000–1025 m/s for 100–200 mm, ≈1100 m/s for 290 mm)\n  deflection at the end: velocity {:.2}°, axis {:.2}° (max {:.2}°, {:.2}°; paper: 10°–20°)\n  max axial resistance {:.3e} N; in the layer: mean {:.3e} N, CV per step {:.3}, CV over windows of one rock size {:.3} ({} windows)\n  disturbed rocks {}, zone width {:.3} m = {:.2} mean sizes (paper: 6–7)\n  energy: projectile lost {:.4e} J, damping {:.4e} J, friction {:.4e} J; ledger balance / initial projectile energy {:.3e}\n  max overlap/size {:.3}, steps with overlap warnings {}",
         p.outcome,
         p.steps,
         p.dt,
         p.rocks,
         p.wall_time.as_secs_f64(),
+        p.counters.total_time().as_secs_f64(),
+        100.0 * p.asleep_fraction,
         p.residual_speed,
         p.residual_axial_velocity,
         p.final_velocity_deflection,
@@ -309,6 +328,7 @@ pub fn summary(config: &ExperimentConfig, r: &ExperimentResult) -> String {
         "  disturbed zone by displacement threshold (mean sizes): {}",
         zones.join("; ")
     );
+    let _ = writeln!(s, "  {}", indent(&p.counters.to_string()).trim_start());
     s
 }
 

@@ -110,6 +110,59 @@ pub struct ImpactParams {
     pub disturbed_threshold: Real,
 }
 
+/// Sleeping in the experiment's runs ([`crate::world::sleeping`]): a numerical device, not a physical
+/// parameter, so the section and each of its keys may be left out; the defaults are the engine's thresholds
+/// and sleeping off, which reproduces the runs made before sleeping existed.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Deserialize, serde::Serialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct SleepingConfig {
+    /// Penetration run: the packed bed starts asleep, each rock with the load of the bed's last evaluation
+    /// as its rest load, and a rock wakes when the projectile (or a woken neighbour, or the removal of the
+    /// left and right walls) changes its load by more than `rest_force` of its weight.
+    pub penetration: bool,
+    /// Packing: rocks at rest fall asleep during deposition and hold (the moving top wall wakes the rocks
+    /// it touches, and their neighbours through their loads).
+    pub packing: bool,
+    /// [`crate::world::SleepParams::rest_speed`] (fraction of √(|g| d)).
+    pub rest_speed: Real,
+    /// [`crate::world::SleepParams::rest_force`] (fraction of the weight).
+    pub rest_force: Real,
+    /// [`crate::world::SleepParams::steps`].
+    pub steps: u32,
+    /// [`crate::world::SleepParams::wake_contact_fraction`]: in a compacted bed every contact carries many
+    /// rock weights, so a threshold of a fraction of the weight is a fraction of a per mille of the contact
+    /// forces, and the explicit step's one-contact-per-step precursor of any disturbance then wakes the whole
+    /// bed within tens of steps.
+    pub wake_contact_fraction: Real,
+}
+
+impl Default for SleepingConfig {
+    fn default() -> Self {
+        let engine = crate::world::SleepParams::default();
+        Self {
+            penetration: false,
+            packing: false,
+            rest_speed: engine.rest_speed,
+            rest_force: engine.rest_force,
+            steps: engine.steps,
+            wake_contact_fraction: engine.wake_contact_fraction,
+        }
+    }
+}
+
+impl SleepingConfig {
+    /// The engine's sleeping parameters, on when `enabled`.
+    pub fn params(&self, enabled: bool) -> crate::world::SleepParams {
+        crate::world::SleepParams {
+            enabled,
+            rest_speed: self.rest_speed,
+            rest_force: self.rest_force,
+            steps: self.steps,
+            wake_contact_fraction: self.wake_contact_fraction,
+        }
+    }
+}
+
 /// Everything the experiment needs.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields)]
@@ -120,6 +173,9 @@ pub struct ExperimentConfig {
     pub packing: PackingParams,
     pub impact: ImpactParams,
     pub projectile: ProjectileParams,
+    /// Optional (see [`SleepingConfig`]).
+    #[serde(default)]
+    pub sleeping: SleepingConfig,
 }
 
 /// The full-scale experiment (the file `scenes/rockfill/paper.toml`, compiled in).
@@ -201,7 +257,19 @@ impl ExperimentConfig {
             ("packing.viscous_rate", self.packing.viscous_rate),
             ("packing.hold_time", self.packing.hold_time),
             ("impact.arrival_time", self.impact.arrival_time),
+            ("sleeping.rest_speed", self.sleeping.rest_speed),
+            ("sleeping.rest_force", self.sleeping.rest_force),
         ];
+        if !(self.sleeping.wake_contact_fraction.is_finite()
+            && self.sleeping.wake_contact_fraction >= 0.0)
+        {
+            return Err(ConfigError::Invalid {
+                path: path.to_owned(),
+                field: "sleeping.wake_contact_fraction",
+                value: self.sleeping.wake_contact_fraction,
+                reason: "must be finite and non-negative",
+            });
+        }
         let invalid = |field, value, reason| ConfigError::Invalid {
             path: path.to_owned(),
             field,

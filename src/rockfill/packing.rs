@@ -284,6 +284,7 @@ pub fn pack(
     let p = &config.packing;
     let mut params = StepParams::new(dt);
     params.damping = ViscousDamping::MassProportional(p.viscous_rate);
+    params.sleeping = config.sleeping.params(config.sleeping.packing);
     let mut scratch = StepScratch::default();
     let mut report = PackingReport {
         rocks: world.bodies.len(),

@@ -28,7 +28,8 @@ use crate::dynamics::{Motion, RigidBody, ViscousDamping};
 use crate::math::{Point, Pose, Real, Vector};
 use crate::shape::Shape;
 use crate::world::{
-    step, ContactKey, EnergyLedger, StepError, StepParams, StepScratch, World, WorldError,
+    sleeping, step, ContactKey, EnergyLedger, StepCounters, StepError, StepParams, StepScratch,
+    World, WorldError,
 };
 
 /// Why a penetration run failed.
@@ -241,9 +242,13 @@ pub struct PenetrationReport {
     pub start_positions: Vec<Point>,
     pub snapshots: Vec<Snapshot>,
     pub wall_time: Duration,
+    /// The step's stage timers and counters summed over the run.
+    pub counters: StepCounters,
+    /// Rock-steps spent asleep over all rock-steps (0 without sleeping).
+    pub asleep_fraction: Real,
 }
 
-/// Removes the left and right walls and adds the projectile with its tip `speed × arrival_time` ahead of
+/// With `sleeping.penetration`, puts every rock to sleep ([`sleeping::put_to_sleep`]). Removes the left and right walls and adds the projectile with its tip `speed × arrival_time` ahead of
 /// the centre of the left face, moving along +x. Returns the projectile's body index.
 pub fn add_projectile(
     config: &ExperimentConfig,
@@ -255,6 +260,11 @@ pub fn add_projectile(
             walls: world.walls.len(),
             expected: KEPT_WALLS + 2,
         });
+    }
+    if config.sleeping.penetration {
+        // The packed bed is at rest: every rock falls asleep against the walls it was packed in, so that
+        // removing the left and right walls wakes the rocks they held (see `crate::world::sleeping`).
+        sleeping::put_to_sleep(&config.sleeping.params(true), world, 0..world.bodies.len());
     }
     world.walls.truncate(KEPT_WALLS);
     world.loads.current = false;
@@ -324,6 +334,7 @@ pub fn penetrate_with(
     let dt = penetration_time_step(config, world)? / options.dt_divisor;
     let mut params = StepParams::new(dt);
     params.damping = ViscousDamping::None;
+    params.sleeping = config.sleeping.params(config.sleeping.penetration);
     let mut scratch = StepScratch::default();
     let start_positions: Vec<Point> = world.bodies.iter().map(|b| b.position).collect();
     let e0 = Vector::x();
@@ -331,6 +342,7 @@ pub fn penetrate_with(
         + world.bodies[index].rotational_kinetic_energy();
     // The ledger restarts here: removing walls and adding the projectile changed the energy outside it.
     world.ledger = EnergyLedger::default();
+    let mut counters = StepCounters::default();
     let t0 = world.time;
     let length = projectile.params.length;
     let mut rows = Vec::new();
@@ -342,6 +354,7 @@ pub fn penetrate_with(
     pending.sort_by(|a, b| b.total_cmp(a));
     let outcome = loop {
         let report = step(&params, world, &mut scratch)?;
+        counters.merge(&report.counters);
         steps += 1;
         max_overlap = max_overlap.max(report.max_overlap_ratio);
         if !report.overlap_warnings.is_empty() {
@@ -467,6 +480,9 @@ pub fn penetrate_with(
         start_positions,
         snapshots,
         wall_time: start.elapsed(),
+        asleep_fraction: counters.sleeping_body_steps as Real
+            / (steps as Real * (world.bodies.len() - 1) as Real),
+        counters,
         rows,
     })
 }

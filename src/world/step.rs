@@ -11,11 +11,12 @@
 //!                        4 and 5 run fused, one pass over the candidates (the store entry is in cache)
 //!   6. accumulate        per-body sums of forces and torques in candidate order (fixed, deterministic:
 //!                        a scatter on one thread, a gather per body over its pairs on several)
-//!  6b. (sleeping on) wake the sleeping islands touched by moving bodies or walls
+//!  6b. (sleeping on) wake the sleeping bodies whose load departs from their rest load, or that touch a
+//!      moving wall or a prescribed body
 //!   7. second half kick  v, L ← v, L + ½Δt (F_{n+1}, p_{n+1})
 //!   8. checks            non-finite state → StepError naming body and step; deep overlaps → StepReport
 //!                        (7 and the body checks of 8 run fused, one pass over the bodies)
-//!  8b. (sleeping on) calm counters, islands, bodies falling asleep (see [`super::sleeping`])
+//!  8b. (sleeping on) calm counters, bodies falling asleep (see [`super::sleeping`])
 //!   9. ledger, counters
 //! ```
 //! Forces are evaluated once per step, at the new positions x_{n+1} (stages 3–6); the same loads close this
@@ -115,9 +116,8 @@ pub struct StepScratch {
     evaluated: Vec<Evaluated>,
     /// One per chunk of the parallel stages (see [`super::parallel`]).
     workers: Vec<Worker>,
-    /// Union–find and island flags of the sleeping update.
-    islands: Vec<u32>,
-    ready: Vec<bool>,
+    /// The summed contributions of the frozen contacts (see [`super::sleeping`]).
+    frozen: sleeping::FrozenLoads,
 }
 
 /// Stage timers and counters of one or more steps (merge them with [`StepCounters::merge`]).
@@ -283,9 +283,7 @@ pub fn step(
     world.sleep.resize(world.bodies.len());
     if !params.sleeping.enabled && world.sleep.sleeping > 0 {
         // Sleeping switched off: every body wakes.
-        report.counters.woken += world.sleep.sleeping as u64;
-        world.sleep = Default::default();
-        world.sleep.resize(world.bodies.len());
+        report.counters.woken += world.sleep.wake_all() as u64;
     }
     let integrator = Integrator {
         translation: TranslationParams {
@@ -358,10 +356,9 @@ pub fn step(
     // 3–6. Loads at the new positions.
     evaluate_loads(params, world, scratch, &mut report, dt)?;
 
-    // 6b. Sleeping islands touched by something that moves wake before the second half kick.
+    // 6b. Sleeping bodies disturbed by this evaluation wake before the second half kick.
     if params.sleeping.enabled {
-        report.counters.woken +=
-            sleeping::wake_touched(world, &mut scratch.islands, &mut scratch.ready);
+        report.counters.woken += sleeping::wake_disturbed(world);
     }
 
     // 7–8. Second half kick, then the checks of the same body, in one pass (the first non-finite body in
@@ -386,14 +383,9 @@ pub fn step(
         });
     }
 
-    // 8b. Sleeping: calm counters, islands, falling asleep and waking (serial, in body order).
+    // 8b. Sleeping: calm counters, falling asleep (serial, in body order).
     if params.sleeping.enabled {
-        let counts = sleeping::update(
-            &params.sleeping,
-            world,
-            &mut scratch.islands,
-            &mut scratch.ready,
-        );
+        let counts = sleeping::update(&params.sleeping, world);
         report.counters.fell_asleep += counts.fell_asleep;
         report.counters.woken += counts.woken;
     }
@@ -494,6 +486,7 @@ fn evaluate_loads(
     let sync = contacts.sync(&scratch.candidates, step_index);
     counters.contacts_created += sync.created as u64;
     counters.contacts_dropped += sync.dropped as u64;
+    let store_changed = sync.created + sync.dropped > 0;
     let n_candidates = scratch.candidates.len();
     let parallel = n_candidates >= params.parallel.min_candidates;
     // Every slot's flags are overwritten below (the rest only for overlapping pairs): no clearing.
@@ -515,8 +508,13 @@ fn evaluate_loads(
         &mut scratch.workers,
         |i, state, out, worker| {
             let key = candidates[i];
-            if sleeping::is_frozen(world_ref, key) {
-                return frozen_response(&pair, key, state, out);
+            if sleeping::is_frozen_entry(world_ref, key, state) {
+                // Kept from its last evaluation and summed in `scratch.frozen` (stage 6).
+                out.frozen = true;
+                out.overlapping = false;
+                // Frozen bodies do not move: no work.
+                out.work = ContactWork::default();
+                return Ok(());
             }
             // The last contact point, for the ledger of a pair that opens in this step.
             let previous_point = state.geometry.point;
@@ -544,6 +542,11 @@ fn evaluate_loads(
     report.max_overlap_ratio = 0.0;
     report.overlap_warnings.clear();
     let n = world.bodies.len();
+    if world.sleep.sleeping > 0 {
+        scratch
+            .frozen
+            .ensure(world, store_changed, params.overlap_warning_fraction);
+    }
     let loads = &mut world.loads;
     loads.forces.clear();
     loads.forces.resize(n, Vector::zeros());
@@ -606,6 +609,25 @@ fn evaluate_loads(
             }
         }
         loads.elastic_potential += r.normal_potential + r.tangential_potential;
+    }
+    // The frozen contacts, summed once while the sleeping set and the store's pairs stay the same, added
+    // after the candidates in both summation modes (the same bits on any number of threads).
+    if world.sleep.sleeping > 0 {
+        let f = &scratch.frozen;
+        f.add_to(&mut loads.forces, &mut loads.torques);
+        for (w, force) in loads.wall_forces.iter_mut().zip(&f.wall_forces) {
+            *w += force;
+        }
+        loads.elastic_potential += f.potential;
+        report.contacts += f.contacts;
+        report.max_overlap_ratio = report.max_overlap_ratio.max(f.max_overlap_ratio);
+        report
+            .overlap_warnings
+            .extend(f.deep.iter().map(|c| OverlapWarning {
+                key: c.key,
+                depth: c.depth,
+                ratio: c.overlap_ratio,
+            }));
     }
     counters.contacts += report.contacts as u64;
     // Power delivered to the system by everything that moves without responding to forces.
@@ -978,72 +1000,6 @@ fn is_at_rest_fixed(body: &crate::dynamics::RigidBody) -> bool {
     matches!(body.motion, Motion::Fixed)
         && body.velocity == Vector::zeros()
         && body.angular_momentum == Vector::zeros()
-}
-
-/// Stage 5 for a frozen candidate: the kept geometry and force of its last evaluation, the torques about
-/// the unmoved centres and the elastic energy at the kept overlap (see [`super::sleeping`]).
-fn frozen_response(
-    pair: &PairInputs,
-    key: ContactKey,
-    state: &ContactState,
-    out: &mut Evaluated,
-) -> Result<(), StepError> {
-    let world = pair.world;
-    out.frozen = true;
-    // Frozen bodies do not move: no work.
-    out.work = ContactWork::default();
-    let g = &state.geometry;
-    if g.kind != ContactKind::Overlap {
-        out.overlapping = false;
-        return Ok(());
-    }
-    let (center_a, mat_a, b) = match key {
-        ContactKey::Body { a, b } => (
-            world.bodies[a as usize].position,
-            world.material_of[a as usize],
-            b,
-        ),
-        ContactKey::Wall { body, wall } => (g.point_a, world.walls[wall as usize].material, body),
-    };
-    let b = b as usize;
-    let model =
-        world
-            .materials
-            .model(mat_a, world.material_of[b])
-            .ok_or(StepError::MissingLaw {
-                step: pair.step_index,
-                a: mat_a,
-                b: world.material_of[b],
-            })?;
-    let shape_a = match key {
-        ContactKey::Body { a, .. } => Some(world.shape(a as usize)),
-        ContactKey::Wall { .. } => None,
-    };
-    let model = model.for_shapes(shape_a, world.shape(b));
-    let force = state.force_on_b;
-    let (k_t, _) = model.tangential.stiffness_and_friction(g.depth);
-    let scale = match key {
-        ContactKey::Body { a, .. } => world.length_scale(a as usize).min(world.length_scale(b)),
-        ContactKey::Wall { .. } => world.length_scale(b),
-    };
-    out.response = ContactResponse {
-        force_on_b: force,
-        torque_on_a: (g.point - center_a).cross(&(-force)),
-        torque_on_b: (g.point - world.bodies[b].position).cross(&force),
-        normal_force: force.dot(&g.normal),
-        tangential_force: force - g.normal * force.dot(&g.normal),
-        normal_potential: model.normal.potential(g.depth),
-        tangential_potential: 0.5 * k_t * state.history.displacement.norm_squared(),
-        damping_power: 0.0,
-        damping_force: state.damping_force,
-        friction_dissipation: 0.0,
-        tangential_stiffness_work: 0.0,
-        sliding: false,
-    };
-    out.overlapping = true;
-    out.depth = g.depth;
-    out.overlap_ratio = g.depth / scale;
-    Ok(())
 }
 
 /// Stage 8 for one body: the first non-finite quantity of its loads and state, if any.
