@@ -103,6 +103,17 @@ fn polydem(args: &[&std::ffi::OsStr]) -> std::process::Output {
         .expect("polydem runs")
 }
 
+/// Runs polydem and asserts it succeeded (the failure shows the arguments and standard error).
+fn succeeds(args: &[&std::ffi::OsStr]) -> std::process::Output {
+    let o = polydem(args);
+    assert!(
+        o.status.success(),
+        "{args:?}: {}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    o
+}
+
 fn scene_path(name: &str) -> std::path::PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("scenes")
@@ -243,15 +254,7 @@ fn restart_through_the_cli_continues_to_the_same_final_rows() {
     let straight = dir.join("straight");
     let first = dir.join("first");
     let second = dir.join("second");
-    let run = |args: &[&std::ffi::OsStr]| {
-        let o = polydem(args);
-        assert!(
-            o.status.success(),
-            "{args:?}: {}",
-            String::from_utf8_lossy(&o.stderr)
-        );
-        o
-    };
+    let run = succeeds;
     run(&[
         &os("run"),
         scene.as_os_str(),
@@ -348,14 +351,7 @@ fn restart_into_the_same_directory_continues_the_csv_and_vtk_series() {
     let os = |s: &str| std::ffi::OsString::from(s);
     let straight = dir.join("straight");
     let resumed = dir.join("resumed");
-    let run = |args: &[&std::ffi::OsStr]| {
-        let o = polydem(args);
-        assert!(
-            o.status.success(),
-            "{args:?}: {}",
-            String::from_utf8_lossy(&o.stderr)
-        );
-    };
+    let run = succeeds;
     let vtk = ["--vtk-interval", "0.05"].map(os);
     run(&[
         &os("run"),

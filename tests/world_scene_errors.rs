@@ -533,3 +533,81 @@ fn wall_depth_rule_and_band_are_read_and_bad_values_refused() {
         "simulation.wall_depth_band",
     );
 }
+
+/// The valid scene with `keys` added to `[simulation]`.
+fn with_keys(keys: &str) -> String {
+    VALID.replace(
+        "steps_per_contact = 50",
+        &format!("steps_per_contact = 50\n{keys}"),
+    )
+}
+
+/// `keys` added to the valid scene are refused, naming the file, the line starting with `line_prefix` and
+/// `field`.
+fn refused(case: &str, keys: &str, line_prefix: &str, field: &str) {
+    let text = with_keys(keys);
+    let (path, result) = load(case, &text);
+    let message = result
+        .err()
+        .unwrap_or_else(|| panic!("{keys:?} accepted"))
+        .to_string();
+    let location = format!("{}:{}:", path.display(), line_of(&text, line_prefix));
+    assert!(
+        message.contains(&location) && message.contains(field),
+        "{keys:?}: message {message:?} does not name {location:?} and the field {field:?}"
+    );
+}
+
+/// The pair smoothing the valid scene with `keys` reads.
+fn read(case: &str, keys: &str) -> polydem::contact::PairSmoothing {
+    load(case, &with_keys(keys))
+        .1
+        .unwrap_or_else(|e| panic!("{keys:?} refused: {e}"))
+        .params
+        .tolerances
+        .pair_smoothing
+}
+
+#[test]
+fn pair_smoothing_rule_and_band_are_read_and_bad_values_refused() {
+    // The smoothed polyhedron-pair overlap (src/contact/pair_smoothing.rs); its physics gates are the
+    // module's unit tests and `PolyEdgeFlat` in tests/polyhedral_energy_gates.rs.
+    use polydem::contact::PairSmoothing;
+    assert_eq!(read("default", ""), PairSmoothing::default());
+    assert_eq!(
+        read("band", "pair_smoothing_band = 3.0e-4"),
+        PairSmoothing::Smoothed { band: 3.0e-4 }
+    );
+    assert_eq!(
+        read("smoothed", "pair_smoothing = \"smoothed\""),
+        PairSmoothing::default()
+    );
+    assert_eq!(
+        read("exact", "pair_smoothing = \"exact\""),
+        PairSmoothing::Exact
+    );
+    refused(
+        "unknown",
+        "pair_smoothing = \"blended\"",
+        "pair_smoothing",
+        "simulation.pair_smoothing",
+    );
+    refused(
+        "band_with_exact",
+        "pair_smoothing = \"exact\"\npair_smoothing_band = 1.0e-4",
+        "pair_smoothing_band",
+        "simulation.pair_smoothing_band",
+    );
+    refused(
+        "negative_band",
+        "pair_smoothing_band = -1.0",
+        "pair_smoothing_band",
+        "simulation.pair_smoothing_band",
+    );
+    refused(
+        "nan_band",
+        "pair_smoothing_band = nan",
+        "pair_smoothing_band",
+        "simulation.pair_smoothing_band",
+    );
+}
