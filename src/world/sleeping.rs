@@ -77,10 +77,11 @@
 //! Sleeping is off by default: it changes the dynamics within the thresholds above, so a run that must
 //! reproduce exact dynamics (the validation cases) does not use it.
 
-use crate::contact::ContactKind;
+use crate::contact::{ContactGeometry, ContactKind};
 use crate::dynamics::Motion;
 use crate::law::ContactKinematics;
-use crate::math::{Real, Vector};
+use crate::math::{Point, Real, Vector};
+use crate::shape::Shape;
 
 use super::contact_store::{ContactKey, ContactState};
 use super::world::World;
@@ -317,13 +318,14 @@ fn freeze(params: &SleepParams, world: &mut World, fell: &[bool]) {
     }
 }
 
-/// The force on B of the stored contact `k`, evaluated by its law on the kept geometry at zero relative
-/// velocity and with no tangential increment (the kept tangential spring, capped by friction).
-fn static_force(world: &World, k: usize) -> Vector {
-    let key = world.contacts.keys()[k];
-    let state = &world.contacts.states()[k];
-    let g = &state.geometry;
-    let (center_a, mat_a, shape_a, b) = match key {
+/// Side A of a stored contact, as its law needs it: (centre or, for a wall, the contact point on it,
+/// material, shape if a body, index of body B).
+fn side_a<'w>(
+    world: &'w World,
+    key: ContactKey,
+    g: &ContactGeometry,
+) -> (Point, u32, Option<&'w Shape>, usize) {
+    match key {
         ContactKey::Body { a, b } => {
             let a = a as usize;
             (
@@ -339,7 +341,16 @@ fn static_force(world: &World, k: usize) -> Vector {
             None,
             body as usize,
         ),
-    };
+    }
+}
+
+/// The force on B of the stored contact `k`, evaluated by its law on the kept geometry at zero relative
+/// velocity and with no tangential increment (the kept tangential spring, capped by friction).
+fn static_force(world: &World, k: usize) -> Vector {
+    let key = world.contacts.keys()[k];
+    let state = &world.contacts.states()[k];
+    let g = &state.geometry;
+    let (center_a, mat_a, shape_a, b) = side_a(world, key, g);
     let Some(model) = world.materials.model(mat_a, world.material_of[b]) else {
         return state.force_on_b;
     };
@@ -517,23 +528,7 @@ fn frozen_contact(world: &World, k: usize) -> Option<FrozenContact> {
     if g.kind != ContactKind::Overlap {
         return None;
     }
-    let (center_a, mat_a, shape_a, b) = match key {
-        ContactKey::Body { a, b } => {
-            let a = a as usize;
-            (
-                world.bodies[a].position,
-                world.material_of[a],
-                Some(world.shape(a)),
-                b as usize,
-            )
-        }
-        ContactKey::Wall { body, wall } => (
-            g.point_a,
-            world.walls[wall as usize].material,
-            None,
-            body as usize,
-        ),
-    };
+    let (center_a, mat_a, shape_a, b) = side_a(world, key, g);
     // A frozen pair was evaluated before, so its law exists; a missing one contributes no energy.
     let potential = world
         .materials
