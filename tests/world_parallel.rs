@@ -14,7 +14,8 @@ use polydem::world::{step, Parallelism, StepScratch, World};
 
 const STEPS: usize = 300;
 
-fn run(threads: Option<usize>) -> (World, u64) {
+/// The test bed with every stage on its parallel path (`threads` given) or serial (`None`).
+fn bed_for(threads: Option<usize>) -> bed::Bed {
     let spec = bed::BedSpec {
         gap: 0.0,
         speed: 2.0,
@@ -31,15 +32,11 @@ fn run(threads: Option<usize>) -> (World, u64) {
             min_bodies: 0,
         },
     };
-    let go = move || {
-        let mut scratch = StepScratch::default();
-        let mut contacts = 0;
-        for _ in 0..STEPS {
-            let report = step(&bed.params, &mut bed.world, &mut scratch).expect("step");
-            contacts += report.contacts as u64;
-        }
-        (bed.world, contacts)
-    };
+    bed
+}
+
+/// Runs `go` on the calling thread (`None`) or in a rayon pool of `n` threads.
+fn on_threads<T: Send>(threads: Option<usize>, go: impl FnOnce() -> T + Send) -> T {
     match threads {
         None => go(),
         Some(n) => rayon::ThreadPoolBuilder::new()
@@ -48,6 +45,19 @@ fn run(threads: Option<usize>) -> (World, u64) {
             .expect("thread pool")
             .install(go),
     }
+}
+
+fn run(threads: Option<usize>) -> (World, u64) {
+    let mut bed = bed_for(threads);
+    on_threads(threads, move || {
+        let mut scratch = StepScratch::default();
+        let mut contacts = 0;
+        for _ in 0..STEPS {
+            let report = step(&bed.params, &mut bed.world, &mut scratch).expect("step");
+            contacts += report.contacts as u64;
+        }
+        (bed.world, contacts)
+    })
 }
 
 fn bits(v: &[f64]) -> Vec<u64> {
@@ -137,39 +147,16 @@ fn one_two_and_four_threads_give_bit_identical_states() {
 /// name the first non-finite body in body order, whatever the thread count.
 #[test]
 fn the_first_non_finite_body_is_reported_for_any_thread_count() {
-    let spec = bed::BedSpec {
-        gap: 0.0,
-        speed: 2.0,
-        ..bed::BedSpec::rocks([6, 6, 8], 4, 20261121)
-    };
     let run = |threads: Option<usize>| {
-        let mut bed = bed::build(&spec);
-        bed.params.parallel = match threads {
-            None => Parallelism {
-                min_candidates: usize::MAX,
-                min_bodies: usize::MAX,
-            },
-            Some(_) => Parallelism {
-                min_candidates: 0,
-                min_bodies: 0,
-            },
-        };
+        let mut bed = bed_for(threads);
         // Two bodies far apart in body order go bad; the later one in a different chunk of the parallel pass.
         bed.world.bodies[250].velocity.x = f64::NAN;
         bed.world.bodies[37].angular_momentum.y = f64::INFINITY;
-        let go = move || {
+        on_threads(threads, move || {
             let mut world = bed.world;
             let mut scratch = StepScratch::default();
             step(&bed.params, &mut world, &mut scratch)
-        };
-        match threads {
-            None => go(),
-            Some(n) => rayon::ThreadPoolBuilder::new()
-                .num_threads(n)
-                .build()
-                .expect("thread pool")
-                .install(go),
-        }
+        })
     };
     let serial =
         run(None).expect_err("a NaN velocity and an infinite angular momentum must fail the step");

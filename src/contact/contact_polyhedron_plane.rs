@@ -130,6 +130,30 @@ mod tests {
     use crate::contact::ContactKind;
     use rand::{Rng, SeedableRng};
 
+    /// The derivative of `depth` under a small turn of body 2 about each axis (central differences, step
+    /// 1e-7 rad) equals the torque arm of the contact point `g.point_b`: −((c − x₂) × n)·e, to 1e-6.
+    fn assert_turn_derivative_is_the_torque_arm(
+        depth: &dyn Fn(&Pose) -> Real,
+        pos2: &Pose,
+        g: &ContactGeometry,
+        label: &str,
+    ) {
+        let arm = g.point_b - Point::from(pos2.translation.vector);
+        let h = 1e-7;
+        for e in [Vector::x(), Vector::y(), Vector::z()] {
+            let turn = |s: Real| {
+                let r = crate::math::Rotation::from_scaled_axis(e * s);
+                Pose::from_parts(pos2.translation, r * pos2.rotation)
+            };
+            let fd = (depth(&turn(h)) - depth(&turn(-h))) / (2.0 * h);
+            let want = -arm.cross(&g.normal).dot(&e);
+            assert!(
+                (fd - want).abs() < 1e-6,
+                "{label}, axis {e:?}: dδ/dθ = {fd}, torque arm gives {want} (tolerance 1e-6)"
+            );
+        }
+    }
+
     #[test]
     fn box_resting_on_a_wall_reports_its_face_centroid() {
         let tol = ContactTolerances::default();
@@ -200,20 +224,7 @@ mod tests {
             let pos2 = Pose::from_parts(Vector::new(0.3, -0.2, -low - 1e-3).into(), rot);
             let g = contact_plane_polytope(&Pose::identity(), &Vector::z(), 0.0, &pos2, &bx, &tol);
             assert_eq!(g.kind, ContactKind::Overlap);
-            let arm = g.point_b - Point::from(pos2.translation.vector);
-            for e in [Vector::x(), Vector::y(), Vector::z()] {
-                let h = 1e-7;
-                let turn = |s: Real| {
-                    let r = crate::math::Rotation::from_scaled_axis(e * s);
-                    Pose::from_parts(pos2.translation, r * pos2.rotation)
-                };
-                let fd = (depth_at(&turn(h)) - depth_at(&turn(-h))) / (2.0 * h);
-                let want = -arm.cross(&g.normal).dot(&e);
-                assert!(
-                    (fd - want).abs() < 1e-6,
-                    "axis {e:?}: dδ/dθ = {fd}, torque arm gives {want}"
-                );
-            }
+            assert_turn_derivative_is_the_torque_arm(&depth_at, &pos2, &g, "deepest vertex");
         }
     }
 
@@ -351,19 +362,9 @@ mod tests {
             let g = contact_plane_polytope(&Pose::identity(), &Vector::z(), 0.0, &pos2, &bx, &tol);
             assert_eq!(g.kind, ContactKind::Overlap);
             assert!(g.depth > 0.0);
-            let arm = g.point_b - Point::from(pos2.translation.vector);
+            assert_turn_derivative_is_the_torque_arm(&law_depth, &pos2, &g, &format!("pose {k}"));
             let e_fd = 1e-7;
             for e in [Vector::x(), Vector::y(), Vector::z()] {
-                let turn = |s: Real| {
-                    let r = crate::math::Rotation::from_scaled_axis(e * s);
-                    Pose::from_parts(pos2.translation, r * pos2.rotation)
-                };
-                let fd = (law_depth(&turn(e_fd)) - law_depth(&turn(-e_fd))) / (2.0 * e_fd);
-                let want = -arm.cross(&g.normal).dot(&e);
-                assert!(
-                    (fd - want).abs() < 1e-6,
-                    "pose {k}, axis {e:?}: dD/dθ = {fd}, torque arm gives {want}"
-                );
                 let shift = |s: Real| {
                     Pose::from_parts((pos2.translation.vector + e * s).into(), pos2.rotation)
                 };
