@@ -211,13 +211,15 @@ fn main() {
                 load_average()
             );
             println!(
-                "{name} {threads}t stages (ms): broad {:.0}, narrow+laws {:.0}, accumulate {:.0}, integrate {:.0}, checks {:.0}; broad rebuilds {}",
+                "{name} {threads}t stages (ms): broad {:.0}, narrow+laws {:.0}, accumulate {:.0}, integrate {:.0}, checks {:.0}; broad rebuilds {}; serial sections {:.0} ms = {:.1} % of the stages",
                 ms(c.broad),
                 ms(c.narrow + c.laws),
                 ms(c.accumulate),
                 ms(c.integrate),
                 ms(c.checks),
-                c.broad_rebuilds
+                c.broad_rebuilds,
+                ms(c.serial),
+                100.0 * c.serial.as_secs_f64() / c.total_time().as_secs_f64()
             );
             let bits = state_bits(&w);
             match &reference {

@@ -54,6 +54,12 @@ pub struct BroadPhase {
     cell_bodies: Vec<u32>,
     #[serde(skip)]
     body_cells: Vec<CellRange>,
+    /// Time spent in the parallel pair search since the last [`take_parallel_search_time`]
+    /// (the step's serial-fraction accounting; not part of the state).
+    ///
+    /// [`take_parallel_search_time`]: BroadPhase::take_parallel_search_time
+    #[serde(skip)]
+    parallel_search_time: std::time::Duration,
 }
 
 /// The inclusive range of grid cells a body's inflated box covers.
@@ -114,6 +120,13 @@ impl BroadPhase {
     /// How many times the grid has been rebuilt.
     pub fn rebuilds(&self) -> u64 {
         self.rebuilds
+    }
+
+    /// The time spent in the parallelisable part of the rebuilds since the last call (the pair search from
+    /// [`PARALLEL_SEARCH_MIN_BODIES`] on, on any pool), and resets it: what the step does not count as
+    /// serial.
+    pub fn take_parallel_search_time(&mut self) -> std::time::Duration {
+        std::mem::take(&mut self.parallel_search_time)
     }
 
     /// Whether the pair list may have become incomplete: the body count changed, or some body moved more than
@@ -280,6 +293,7 @@ impl BroadPhase {
         let n = centres.len();
         if n >= PARALLEL_SEARCH_MIN_BODIES && rayon::current_num_threads() > 1 {
             use rayon::prelude::*;
+            let t = std::time::Instant::now();
             let chunk = n.div_ceil(rayon::current_num_threads() * 8);
             let found: Vec<Vec<Pair>> = (0..n.div_ceil(chunk))
                 .into_par_iter()
@@ -291,17 +305,23 @@ impl BroadPhase {
                     out
                 })
                 .collect();
+            self.parallel_search_time += t.elapsed();
             let mut pairs = std::mem::take(&mut self.pairs);
             for part in found {
                 pairs.extend_from_slice(&part);
             }
             self.pairs = pairs;
         } else {
+            let t = std::time::Instant::now();
             let mut pairs = std::mem::take(&mut self.pairs);
             for i in 0..n {
                 search(i, &mut pairs);
             }
             self.pairs = pairs;
+            if n >= PARALLEL_SEARCH_MIN_BODIES {
+                // Parallel on a pool of several threads.
+                self.parallel_search_time += t.elapsed();
+            }
         }
         debug_assert!(self.pairs.windows(2).all(|w| w[0] < w[1]));
     }

@@ -136,6 +136,13 @@ pub struct StepCounters {
     /// Zero since the checks run fused with the second half kick (their time is in `integrate`); kept so
     /// that the summaries keep their columns.
     pub checks: Duration,
+    /// The part of the stage times spent in sections that run on one thread whatever the pool: the
+    /// bookkeeping around the parallel regions (per-body inputs, candidate list, store sync, grid build,
+    /// sums in candidate order) and every region that stays below its [`Parallelism`] threshold. On one
+    /// thread, `serial / total_time()` is the serial fraction of Amdahl's law for that scene (the
+    /// single-thread scatter of the forces counts here, the gather that replaces it on several threads
+    /// does not: a slight overestimate).
+    pub serial: Duration,
     /// Broad-phase grid rebuilds.
     pub broad_rebuilds: u64,
     /// Body pairs passed to the narrow phase (broad-phase candidates with at least one dynamic body).
@@ -167,6 +174,7 @@ impl StepCounters {
         self.accumulate += other.accumulate;
         self.integrate += other.integrate;
         self.checks += other.checks;
+        self.serial += other.serial;
         self.broad_rebuilds += other.broad_rebuilds;
         self.body_pairs_tested += other.body_pairs_tested;
         self.wall_pairs_tested += other.wall_pairs_tested;
@@ -351,7 +359,11 @@ pub fn step(
     for wall in &mut world.walls {
         wall.pose.translation.vector += dt * wall.velocity;
     }
-    report.counters.integrate += t.elapsed();
+    let elapsed = t.elapsed();
+    report.counters.integrate += elapsed;
+    if !parallel_bodies {
+        report.counters.serial += elapsed;
+    }
 
     // 3–6. Loads at the new positions.
     evaluate_loads(params, world, scratch, &mut report, dt)?;
@@ -373,7 +385,11 @@ pub fn step(
         }
         non_finite_quantity(body, &loads.forces[i], &loads.torques[i])
     });
-    report.counters.integrate += t.elapsed();
+    let elapsed = t.elapsed();
+    report.counters.integrate += elapsed;
+    if !parallel_bodies {
+        report.counters.serial += elapsed;
+    }
     if let Some((body, quantity)) = non_finite {
         return Err(StepError::NonFinite {
             step: world.step_index + 1,
@@ -474,7 +490,9 @@ fn evaluate_loads(
                 .push(model.map(|m| effective_model(m, &params.skips)));
         }
     }
-    counters.broad += t.elapsed();
+    let elapsed = t.elapsed();
+    counters.broad += elapsed;
+    counters.serial += elapsed.saturating_sub(world.broad_phase.take_parallel_search_time());
 
     // 4–5. Narrow phase and laws, fused: per candidate, the contact query then (if the shapes overlap) the
     // law, in one pass over the store (in parallel, each candidate writing its own store entry and result
@@ -483,7 +501,9 @@ fn evaluate_loads(
     // The store is taken out of the world for stages 4–5 so that the queries can read the bodies while
     // writing the per-pair state; it is put back before any return.
     let mut contacts = std::mem::take(&mut world.contacts);
+    let t_sync = Instant::now();
     let sync = contacts.sync(&scratch.candidates, step_index);
+    counters.serial += t_sync.elapsed();
     counters.contacts_created += sync.created as u64;
     counters.contacts_dropped += sync.dropped as u64;
     let store_changed = sync.created + sync.dropped > 0;
@@ -501,6 +521,7 @@ fn evaluate_loads(
         dt,
         step_index,
     };
+    let t_parallel = Instant::now();
     let evaluated = for_each_chunked(
         parallel,
         contacts.states_mut(),
@@ -527,6 +548,9 @@ fn evaluate_loads(
             contact_law(&pair, key, state, &previous_point, out)
         },
     );
+    if !parallel {
+        counters.serial += t_parallel.elapsed();
+    }
     for worker in &mut scratch.workers {
         counters.query.merge(&worker.query);
         worker.query = QueryCounters::default();
@@ -562,8 +586,11 @@ fn evaluate_loads(
     // candidates (in the loop below: one sequential pass); on several per body over its pairs (the same
     // additions in the same order: the same bits; it reads each result twice, so it pays only in parallel).
     let gather = parallel && rayon::current_num_threads() > 1;
+    let mut gather_time = Duration::ZERO;
     if gather {
+        // The rows are rebuilt (serially) after a sync that changed the keys.
         let adjacency = world.contacts.body_adjacency(n);
+        let t_gather = Instant::now();
         let evaluated = &scratch.evaluated;
         for_each_item_pair(
             true,
@@ -571,6 +598,7 @@ fn evaluate_loads(
             &mut loads.torques,
             |i, force, torque| sum_body_loads(adjacency, evaluated, i, force, torque),
         );
+        gather_time = t_gather.elapsed();
     }
     for (key, e) in scratch.candidates.iter().zip(&scratch.evaluated) {
         counters.frozen_pairs += e.frozen as u64;
@@ -648,7 +676,9 @@ fn evaluate_loads(
     }
     loads.external_power = external_power;
     loads.current = true;
-    counters.accumulate += t.elapsed();
+    let elapsed = t.elapsed();
+    counters.accumulate += elapsed;
+    counters.serial += elapsed.saturating_sub(gather_time);
     Ok(())
 }
 
