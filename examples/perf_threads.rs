@@ -35,6 +35,8 @@ struct Options {
     scenes: Vec<String>,
     min_candidates: Option<usize>,
     min_bodies: Option<usize>,
+    /// Measure the fork/join cost of a parallel region instead of running the scenes.
+    overhead: bool,
 }
 
 fn parse() -> Result<Options, String> {
@@ -45,6 +47,7 @@ fn parse() -> Result<Options, String> {
         scenes: vec!["poly".into(), "poly_projectile".into(), "spheres".into()],
         min_candidates: None,
         min_bodies: None,
+        overhead: false,
     };
     let mut args = std::env::args().skip(1);
     while let Some(a) = args.next() {
@@ -69,6 +72,7 @@ fn parse() -> Result<Options, String> {
             "--min-bodies" => {
                 o.min_bodies = Some(value()?.parse().map_err(|e| format!("--min-bodies: {e}"))?)
             }
+            "--overhead" => o.overhead = true,
             _ => return Err(format!("unknown argument {a}")),
         }
     }
@@ -169,6 +173,10 @@ fn main() {
             std::process::exit(2);
         }
     };
+    if o.overhead {
+        region_overhead(&o.threads);
+        return;
+    }
     for name in &o.scenes {
         let mut b = match build(name) {
             Ok(b) => b,
@@ -230,6 +238,66 @@ fn main() {
                     if *bits_ref == bits { "yes" } else { "NO" }
                 ),
             }
+        }
+    }
+}
+
+/// The fork/join cost of one parallel region of the step on each thread count, measured through the
+/// step's own helper ([`for_each_item`]) over `items` items of about `work` ns each (a chain of dependent
+/// square roots), with a serial gap between regions as between the stages of a step (during it the pool's
+/// threads go idle and, after a while, to sleep: waking them is part of the cost). The minimum over the
+/// repeats is the cost on an idle machine, the median what this run saw. Region time on two threads minus
+/// half the one-thread time is the overhead; compared with the per-item costs of the stages it gives the
+/// item counts from which a region pays (see `src/world/parallel.rs`).
+///
+/// [`for_each_item`]: polydem::world::parallel::for_each_item
+fn region_overhead(threads: &[usize]) {
+    use polydem::world::parallel::for_each_item;
+    const REPEATS: usize = 5000;
+    println!("load {}", load_average());
+    // ~4 ns per square root on this machine class: `depth` dependent roots per item.
+    let item = |depth: usize, x: &mut f64| {
+        let mut y = *x + 2.0;
+        for _ in 0..depth {
+            y = y.sqrt() + 1.0;
+        }
+        *x = y;
+    };
+    let spin = |d: Duration| {
+        let t0 = Instant::now();
+        while t0.elapsed() < d {
+            std::hint::spin_loop();
+        }
+    };
+    for (items, depth) in [(1_000usize, 5usize), (4_000, 5), (10_000, 5)] {
+        for gap_us in [100u64, 1000] {
+            let gap = Duration::from_micros(gap_us);
+            let mut line = format!("{items} items x {depth} roots, gap {gap_us} us:");
+            for &t in threads {
+                let pool = rayon::ThreadPoolBuilder::new()
+                    .num_threads(t)
+                    .build()
+                    .expect("thread pool");
+                let mut data = vec![0.0f64; items];
+                let mut times = Vec::with_capacity(REPEATS);
+                pool.install(|| {
+                    for _ in 0..REPEATS {
+                        spin(gap);
+                        let t0 = Instant::now();
+                        for_each_item(true, &mut data, |_, x| item(depth, x));
+                        times.push(t0.elapsed());
+                    }
+                });
+                std::hint::black_box(&data);
+                times.sort();
+                let us = |d: Duration| d.as_secs_f64() * 1e6;
+                line += &format!(
+                    "  {t}t min {:.1} us, median {:.1} us;",
+                    us(times[0]),
+                    us(times[times.len() / 2])
+                );
+            }
+            println!("{line}");
         }
     }
 }
