@@ -112,11 +112,19 @@ impl Default for Parallelism {
     }
 }
 
-/// Per-chunk scratch of the narrow phase: nothing in it matters after a query.
+/// Per-chunk scratch of the narrow phase: nothing in it matters after the step's accumulation.
 #[derive(Clone, Debug, Default)]
 pub struct Worker {
     pub epa: EpaScratch,
     pub query: QueryCounters,
+    /// Items of this chunk that the caller marked for a serial pass after the region, in item order
+    /// (cleared by [`for_each_chunked`]). Chunks are contiguous ranges of items in chunk order, so the
+    /// lists of the workers taken in order are the marked items in item order, for any number of chunks:
+    /// a serial pass over them sees the same items in the same order as one over all items that skips the
+    /// unmarked ones.
+    pub picked: Vec<u32>,
+    /// Items of this chunk counted by the caller (cleared by [`for_each_chunked`]).
+    pub tally: u64,
 }
 
 /// Calls `f(i, &mut states[i], &mut out[i], worker)` for every item `i`, on the current rayon pool when
@@ -137,6 +145,10 @@ where
     F: Fn(usize, &mut S, &mut O, &mut Worker) -> Result<(), E> + Sync,
 {
     debug_assert_eq!(states.len(), out.len());
+    for worker in workers.iter_mut() {
+        worker.picked.clear();
+        worker.tally = 0;
+    }
     let n = states.len();
     let threads = rayon::current_num_threads();
     if !parallel || threads < 2 || n < 2 {

@@ -535,6 +535,7 @@ fn evaluate_loads(
                 out.overlapping = false;
                 // Frozen bodies do not move: no work.
                 out.work = ContactWork::default();
+                worker.tally += 1;
                 return Ok(());
             }
             // The last contact point, for the ledger of a pair that opens in this step.
@@ -545,7 +546,12 @@ fn evaluate_loads(
                     source,
                 }
             })?;
-            contact_law(&pair, key, state, &previous_point, out)
+            contact_law(&pair, key, state, &previous_point, out)?;
+            if out.contributes() {
+                // Summed by stage 6 (serially, in candidate order).
+                worker.picked.push(i as u32);
+            }
+            Ok(())
         },
     );
     if !parallel {
@@ -554,6 +560,7 @@ fn evaluate_loads(
     for worker in &mut scratch.workers {
         counters.query.merge(&worker.query);
         worker.query = QueryCounters::default();
+        counters.frozen_pairs += worker.tally;
     }
     world.contacts = contacts;
     evaluated?;
@@ -600,9 +607,16 @@ fn evaluate_loads(
         );
         gather_time = t_gather.elapsed();
     }
-    for (key, e) in scratch.candidates.iter().zip(&scratch.evaluated) {
-        counters.frozen_pairs += e.frozen as u64;
-        // Ledger terms: written for every candidate (a pair that opens in this step books its release).
+    // The serial sums visit only the candidates stages 4–5 picked (overlapping, or with ledger terms: a
+    // pair that opens in this step books its release), in candidate order: the others would add nothing
+    // (their ledger terms are ±0, and a sum that starts at +0 is unchanged by adding ±0), so the sums have
+    // the same bits as over all candidates, for any number of threads (see [`Worker::picked`]).
+    let picked = scratch.workers.iter().flat_map(|w| &w.picked);
+    for &i in picked {
+        let (key, e) = (
+            &scratch.candidates[i as usize],
+            &scratch.evaluated[i as usize],
+        );
         loads.damping_work += e.work.damping;
         loads.friction_dissipation += e.work.friction;
         loads.tangential_stiffness_work += e.work.stiffness;
@@ -708,6 +722,17 @@ fn sum_body_loads(
     }
     *force = f;
     *torque = t;
+}
+
+impl Evaluated {
+    /// Whether stage 6 has something to sum for this candidate: a force, or a nonzero ledger term.
+    #[inline]
+    fn contributes(&self) -> bool {
+        self.overlapping
+            || self.work.damping != 0.0
+            || self.work.friction != 0.0
+            || self.work.stiffness != 0.0
+    }
 }
 
 /// The result of stage 5 for one candidate. The flags and `work` are written for every candidate; the
