@@ -16,7 +16,14 @@
 //! ```text
 //! cargo run --release --example perf_threads -- [--steps N] [--warm-up N] [--threads 1,2] [--scenes poly,poly_projectile,spheres]
 //!     [--min-candidates N] [--min-bodies N]
+//! cargo run --release --example perf_threads -- --overhead [--threads 1,2]
+//! cargo run --release --example perf_threads -- --write-scenes DIR [--steps N] [--warm-up N] [--scenes ...]
 //! ```
+//! `--overhead` measures the fork/join cost of a parallel region (behind the thresholds of
+//! `src/world/parallel.rs`). `--write-scenes` writes each scene as a scene file `DIR/NAME.toml` for
+//! `polydem run` (the initial state, before the warm-up; `end_time` = warm-up + steps): a file of 10^4
+//! polyhedra with their own hulls is ~6 MB, too large to keep in the repository, so the scenes are
+//! generated on demand from this builder.
 //! The last two replace the parallel thresholds of the step ([`polydem::world::Parallelism`]; the results
 //! are the same bits either way), to re-measure them.
 //! (`scenes/perf/run_threads.sh` runs it with the defaults.)
@@ -37,6 +44,8 @@ struct Options {
     min_bodies: Option<usize>,
     /// Measure the fork/join cost of a parallel region instead of running the scenes.
     overhead: bool,
+    /// Write the scenes as scene files (TOML) into this folder instead of running them.
+    write_scenes: Option<std::path::PathBuf>,
 }
 
 fn parse() -> Result<Options, String> {
@@ -48,6 +57,7 @@ fn parse() -> Result<Options, String> {
         min_candidates: None,
         min_bodies: None,
         overhead: false,
+        write_scenes: None,
     };
     let mut args = std::env::args().skip(1);
     while let Some(a) = args.next() {
@@ -73,6 +83,7 @@ fn parse() -> Result<Options, String> {
                 o.min_bodies = Some(value()?.parse().map_err(|e| format!("--min-bodies: {e}"))?)
             }
             "--overhead" => o.overhead = true,
+            "--write-scenes" => o.write_scenes = Some(value()?.into()),
             _ => return Err(format!("unknown argument {a}")),
         }
     }
@@ -175,6 +186,13 @@ fn main() {
     };
     if o.overhead {
         region_overhead(&o.threads);
+        return;
+    }
+    if let Some(dir) = &o.write_scenes {
+        if let Err(e) = write_scenes(dir, &o) {
+            eprintln!("perf_threads: {e}");
+            std::process::exit(1);
+        }
         return;
     }
     for name in &o.scenes {
@@ -300,4 +318,114 @@ fn region_overhead(threads: &[usize]) {
             println!("{line}");
         }
     }
+}
+
+/// Writes every scene of `o.scenes` as `DIR/NAME.toml` (see the module docs): the bodies with their own
+/// hull (vertices in the body frame), position, orientation, velocities; the box walls; the bed's linear
+/// law with restitution and Coulomb spring; Δt and the skin of the built world.
+fn write_scenes(dir: &std::path::Path, o: &Options) -> Result<(), String> {
+    use polydem::shape::Shape;
+    use std::fmt::Write as _;
+    std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+    for name in &o.scenes {
+        let b = build(name)?;
+        let w = &b.world;
+        let spec = bed::BedSpec::rocks([25, 25, 16], 0, 0);
+        let v = |x: &polydem::math::Vector| format!("[{:?}, {:?}, {:?}]", x.x, x.y, x.z);
+        let mut t = String::new();
+        let steps = o.warm_up + o.steps;
+        let _ = writeln!(
+            t,
+            "# Perf scene '{name}' of issue 4, written by `cargo run --release --example perf_threads -- \
+             --write-scenes DIR` from the seeded builder of tests/support/bed.rs (do not edit; regenerate).\n\
+             # {} bodies; {steps} steps of the given time step. Run: RAYON_NUM_THREADS=1 polydem run THIS.toml --out OUT\n\
+             [simulation]\ngravity = {}\nend_time = {:?}\noutput_interval = {:?}\ntime_step = {:?}\nskin = {:?}\n",
+            w.bodies.len(),
+            v(&w.gravity),
+            b.params.dt * steps as f64,
+            b.params.dt * steps as f64,
+            b.params.dt,
+            w.broad_phase.skin()
+        );
+        // The projectile (a 7800 kg/m³ sphere) is its own material with the same law.
+        let projectile = w.names.iter().position(|n| n == "projectile");
+        let mut materials = vec![("rock", spec.density)];
+        if projectile.is_some() {
+            materials.push(("steel", 7800.0));
+        }
+        for (m, density) in &materials {
+            let _ = writeln!(t, "[[material]]\nname = \"{m}\"\ndensity = {density:?}\n");
+        }
+        for (i, (a, _)) in materials.iter().enumerate() {
+            for (b_name, _) in &materials[i..] {
+                let _ = writeln!(
+                    t,
+                    "[[interaction]]\nmaterials = [\"{a}\", \"{b_name}\"]\nlaw = \"linear\"\nnormal_stiffness = {:?}\n\
+                     restitution = {:?}\ntangential_stiffness = {:?}\nfriction = {:?}\n",
+                    spec.stiffness,
+                    spec.restitution,
+                    0.5 * spec.stiffness,
+                    spec.friction
+                );
+            }
+        }
+        for (k, shape) in w.shapes.iter().enumerate() {
+            match shape {
+                Shape::Polyhedron(p) => {
+                    let points: Vec<String> = p.vertices().iter().map(|x| v(&x.coords)).collect();
+                    let _ = writeln!(
+                        t,
+                        "[[shape]]\nname = \"s{k}\"\nkind = \"polyhedron\"\npoints = [{}]\n",
+                        points.join(", ")
+                    );
+                }
+                Shape::Sphere(sph) => {
+                    let _ = writeln!(
+                        t,
+                        "[[shape]]\nname = \"s{k}\"\nkind = \"sphere\"\nradius = {:?}\n",
+                        sph.radius()
+                    );
+                }
+                Shape::Plane(_) => return Err(format!("{name}: a plane body cannot be written")),
+            }
+        }
+        for (i, body) in w.bodies.iter().enumerate() {
+            let q = body.orientation.quaternion();
+            let _ = writeln!(
+                t,
+                "[[body]]\nname = \"{}\"\nshape = \"s{}\"\nmaterial = \"{}\"\nposition = {}\n\
+                 orientation = [{:?}, {:?}, {:?}, {:?}]\nvelocity = {}\nangular_velocity = {}\n",
+                w.names[i],
+                w.shape_of[i],
+                if Some(i) == projectile {
+                    "steel"
+                } else {
+                    "rock"
+                },
+                v(&body.position.coords),
+                q.w,
+                q.i,
+                q.j,
+                q.k,
+                v(&body.velocity),
+                v(&body.angular_velocity())
+            );
+        }
+        for wall in &w.walls {
+            let normal = wall.pose.rotation * wall.plane.normal();
+            let point =
+                wall.pose * polydem::math::Point::from(wall.plane.normal() * wall.plane.offset());
+            let _ = writeln!(
+                t,
+                "[[wall]]\nname = \"{}\"\nmaterial = \"rock\"\npoint = {}\nnormal = {}\n",
+                wall.name,
+                v(&point.coords),
+                v(&normal)
+            );
+        }
+        let path = dir.join(format!("{name}.toml"));
+        std::fs::write(&path, t).map_err(|e| format!("{}: {e}", path.display()))?;
+        println!("wrote {} ({} bodies)", path.display(), w.bodies.len());
+    }
+    Ok(())
 }
