@@ -91,7 +91,15 @@ pub fn query_with(
             );
             match tol.pair_smoothing {
                 PairSmoothing::Smoothed { band } if g.kind == ContactKind::Overlap => {
-                    smooth_pair_overlap(pos1, a.as_ref(), pos2, b.as_ref(), &g, band)
+                    smooth_pair_overlap(
+                        pos1,
+                        a.as_ref(),
+                        pos2,
+                        b.as_ref(),
+                        &g,
+                        band,
+                        [cache.hint_a, cache.hint_b],
+                    )
                 }
                 _ => g,
             }

@@ -44,6 +44,8 @@ pub trait Polytope: SupportMap {
     fn face_vertices(&self, i: usize) -> &[u32];
     /// Each edge once, as a pair of vertex indices.
     fn edges(&self) -> &[[u32; 2]];
+    /// The vertices sharing an edge with vertex `v` (the edge graph of [`Self::edges`] as adjacency lists).
+    fn neighbors(&self, v: u32) -> &[u32];
     /// Radius of a sphere about the local origin that contains the shape.
     fn bounding_radius(&self) -> Real;
     /// The length all contact tolerances are scaled by (the particle size).
@@ -68,6 +70,9 @@ impl Polytope for crate::shape::ConvexPolyhedron {
     }
     fn edges(&self) -> &[[u32; 2]] {
         crate::shape::ConvexPolyhedron::edges(self)
+    }
+    fn neighbors(&self, v: u32) -> &[u32] {
+        crate::shape::ConvexPolyhedron::neighbors(self, v)
     }
     fn bounding_radius(&self) -> Real {
         crate::shape::ConvexPolyhedron::bounding_radius(self)

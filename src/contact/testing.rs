@@ -13,6 +13,8 @@ pub struct TestPolytope {
     pub faces: Vec<Vec<u32>>,
     pub normals: Vec<Vector>,
     pub edges: Vec<[u32; 2]>,
+    /// Neighbours of each vertex, from `edges`.
+    pub adjacency: Vec<Vec<u32>>,
     pub radius: Real,
 }
 
@@ -45,12 +47,18 @@ impl TestPolytope {
                 }
             }
         }
+        let mut adjacency = vec![Vec::new(); verts.len()];
+        for &[i, j] in &edges {
+            adjacency[i as usize].push(j);
+            adjacency[j as usize].push(i);
+        }
         let radius = verts.iter().map(|p| p.coords.norm()).fold(0.0, Real::max);
         Self {
             verts,
             faces: faces_out,
             normals,
             edges,
+            adjacency,
             radius,
         }
     }
@@ -117,6 +125,9 @@ impl Polytope for TestPolytope {
     }
     fn edges(&self) -> &[[u32; 2]] {
         &self.edges
+    }
+    fn neighbors(&self, v: u32) -> &[u32] {
+        &self.adjacency[v as usize]
     }
     fn bounding_radius(&self) -> Real {
         self.radius
