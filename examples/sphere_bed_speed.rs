@@ -9,19 +9,23 @@
 //! trajectory).
 //!
 //! ```text
-//! cargo run --release --example sphere_bed_speed -- [--steps N] [--ledger on|off|scene] [SCENE.toml ...]
+//! cargo run --release --example sphere_bed_speed -- [--steps N] [--ledger on|off|scene] [--skin M]
+//!     [SCENE.toml ...]
 //! ```
 //! Default: 5000 steps (0.01 s of the bed) of the three variants a, b, c. `--ledger` overrides the
-//! scene's `energy_ledger` key (`scene`: keep it).
+//! scene's `energy_ledger` key (`scene`: keep it); `--skin` the Verlet skin of the broad phase (m; the
+//! candidate list changes, the trajectory does not).
 
 use std::path::PathBuf;
 use std::time::Instant;
 
 use polydem::scene::load_scene;
+use polydem::world::broad_phase::BroadPhase;
 
 struct Options {
     steps: u64,
     ledger: Option<bool>,
+    skin: Option<f64>,
     scenes: Vec<PathBuf>,
 }
 
@@ -29,6 +33,7 @@ fn parse() -> Result<Options, String> {
     let mut o = Options {
         steps: 5000,
         ledger: None,
+        skin: None,
         scenes: Vec::new(),
     };
     let mut args = std::env::args().skip(1);
@@ -44,6 +49,7 @@ fn parse() -> Result<Options, String> {
                     v => return Err(format!("--ledger: '{v}' is not on, off or scene")),
                 }
             }
+            "--skin" => o.skin = Some(value()?.parse().map_err(|e| format!("--skin: {e}"))?),
             s if s.starts_with("--") => return Err(format!("unknown option {s}")),
             s => o.scenes.push(PathBuf::from(s)),
         }
@@ -79,6 +85,9 @@ fn main() -> anyhow::Result<()> {
         if let Some(on) = o.ledger {
             sim.params.energy_ledger = on;
         }
+        if let Some(skin) = o.skin {
+            sim.world.broad_phase = BroadPhase::new(skin);
+        }
         sim.steps = sim.steps.min(o.steps);
         let particles = sim.world.bodies.len();
         let load_before = load_average();
@@ -100,10 +109,11 @@ fn main() -> anyhow::Result<()> {
         let steps = summary.steps as f64;
         println!("scene {}", path.display());
         println!(
-            "  {} particles, {} steps, ledger {}: CPU {} s, wall {:.3} s; particle-steps/s {} (CPU), {:.3e} (wall)",
+            "  {} particles, {} steps, ledger {}, skin {:.3e} m: CPU {} s, wall {:.3} s; particle-steps/s {} (CPU), {:.3e} (wall)",
             particles,
             summary.steps,
             if sim.params.energy_ledger { "on" } else { "off" },
+            sim.world.broad_phase.skin(),
             cpu.map_or("n/a".into(), |c| format!("{c:.3}")),
             wall,
             cpu.map_or("n/a".into(), |c| format!("{:.3e}", particles as f64 * steps / c)),

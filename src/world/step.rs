@@ -40,7 +40,7 @@ use crate::contact::{
 use crate::dynamics::rotation::{drift_isotropic, is_isotropic};
 use crate::dynamics::translation::drift_position;
 use crate::dynamics::{Integrator, Motion, RotationScheme, TranslationParams, ViscousDamping};
-use crate::law::{ContactKinematics, ContactModel, ContactResponse, DampingLaw, TangentialLaw};
+use crate::law::{ContactKinematics, ContactModel, DampingLaw, TangentialLaw};
 use crate::math::{Point, Real, Vector};
 use crate::shape::Shape;
 
@@ -625,7 +625,7 @@ fn evaluate_loads(
                 ratio: e.overlap_ratio,
             });
         }
-        let r = &e.response;
+        let r = e;
         match *key {
             ContactKey::Body { a, b } if !gather => {
                 loads.forces[a as usize] -= r.force_on_b;
@@ -642,7 +642,7 @@ fn evaluate_loads(
                 }
             }
         }
-        loads.elastic_potential += r.normal_potential + r.tangential_potential;
+        loads.elastic_potential += r.potential;
     }
     // The frozen contacts, summed once while the sleeping set and the store's pairs stay the same, added
     // after the candidates in both summation modes (the same bits on any number of threads).
@@ -703,11 +703,11 @@ fn sum_body_loads(
             continue;
         }
         if entry & BodyAdjacency::SIDE_A != 0 {
-            f -= e.response.force_on_b;
-            t += e.response.torque_on_a;
+            f -= e.force_on_b;
+            t += e.torque_on_a;
         } else {
-            f += e.response.force_on_b;
-            t += e.response.torque_on_b;
+            f += e.force_on_b;
+            t += e.torque_on_b;
         }
     }
     *force = f;
@@ -718,7 +718,12 @@ fn sum_body_loads(
 /// other fields only when `overlapping` (a separated pair contributes no force, and no stage reads them).
 #[derive(Clone, Copy, Debug, Default)]
 pub(super) struct Evaluated {
-    response: ContactResponse,
+    /// What stage 6 reads of the law's [`crate::law::ContactResponse`]: the force on B, the torques on A and B, and
+    /// the elastic potential (normal + tangential, J).
+    force_on_b: Vector,
+    torque_on_a: Vector,
+    torque_on_b: Vector,
+    potential: Real,
     /// The ledger terms of this step (nonzero for a separated pair only in the step it opens).
     work: ContactWork,
     /// Whether the shapes overlap (the law produced a force).
@@ -1024,11 +1029,11 @@ pub(super) fn overlap_law(
         damping_force: *damping_force,
         history: *history,
     };
-    out.response = model.evaluate(g, kinematics, history);
+    let response = model.evaluate(g, kinematics, history);
     out.work = if !pair.ledger {
         ContactWork::default()
     } else if previous.is_zero() {
-        ContactWork::of_new_contact(&out.response, &kinematics.relative_velocity, pair.dt)
+        ContactWork::of_new_contact(&response, &kinematics.relative_velocity, pair.dt)
     } else {
         // The last forces were applied with the lever arms of the last contact point.
         let previous_velocity = pair.relative_velocity(key, previous_point, pair.dt);
@@ -1036,13 +1041,17 @@ pub(super) fn overlap_law(
             &previous,
             &previous_velocity,
             &g.normal,
-            &out.response,
+            &response,
             &kinematics.relative_velocity,
             pair.dt,
         )
     };
-    *force_on_b = out.response.force_on_b;
-    *damping_force = out.response.damping_force;
+    *force_on_b = response.force_on_b;
+    *damping_force = response.damping_force;
+    out.force_on_b = response.force_on_b;
+    out.torque_on_a = response.torque_on_a;
+    out.torque_on_b = response.torque_on_b;
+    out.potential = response.normal_potential + response.tangential_potential;
     out.overlapping = true;
     out.depth = g.depth;
     out.overlap_ratio = g.depth / scale;
