@@ -718,8 +718,8 @@ fn sum_body_loads(
 /// other fields only when `overlapping` (a separated pair contributes no force, and no stage reads them).
 #[derive(Clone, Copy, Debug, Default)]
 pub(super) struct Evaluated {
-    /// What stage 6 reads of the law's [`crate::law::ContactResponse`]: the force on B, the torques on A and B, and
-    /// the elastic potential (normal + tangential, J).
+    /// What stage 6 reads of the law's [`crate::law::ContactResponse`]: the force on B, the torques on A
+    /// and B, and the elastic potential (normal + tangential, J).
     force_on_b: Vector,
     torque_on_a: Vector,
     torque_on_b: Vector,
