@@ -541,6 +541,12 @@ fn evaluate_loads(
         step_index,
         ledger: params.energy_ledger,
     };
+    // Every evaluated candidate that stage 6 has to sum is listed (serially, in candidate order, there).
+    let pick = |i: usize, out: &Evaluated, worker: &mut Worker| {
+        if out.contributes() {
+            worker.picked.push(i as u32);
+        }
+    };
     let t_parallel = Instant::now();
     let evaluated = for_each_chunked(
         parallel,
@@ -571,7 +577,9 @@ fn evaluate_loads(
                     out,
                     worker,
                 ) {
-                    return done;
+                    done?;
+                    pick(i, out, worker);
+                    return Ok(());
                 }
             }
             narrow_phase(params, world_ref, key, state, worker).map_err(|source| {
@@ -581,10 +589,7 @@ fn evaluate_loads(
                 }
             })?;
             contact_law(&pair, key, state, &previous_point, out)?;
-            if out.contributes() {
-                // Summed by stage 6 (serially, in candidate order).
-                worker.picked.push(i as u32);
-            }
+            pick(i, out, worker);
             Ok(())
         },
     );
