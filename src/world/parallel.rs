@@ -12,8 +12,10 @@
 //! — `tests/world_parallel.rs` proves it. Errors found per item (a failed query, a non-finite body) are
 //! reported for the first failing item in item order.
 //!
-//! Per step there are four parallel regions when everything is above the thresholds: first half kick and
-//! drift; narrow phase and laws (fused); force sums; second half kick and checks (fused). The broad phase's
+//! Per step there are three parallel regions when everything is above the thresholds: first half kick and
+//! drift; narrow phase and laws (fused); force sums, second half kick and checks (fused per body when no
+//! stage reads the loads in between: no sleeping, no prescribed body; else two regions). Each region
+//! costs a fork/join and, on an idle machine, the wake-up of the pool's threads (see below). The broad phase's
 //! search adds one on the steps that rebuild the grid.
 //!
 //! Work is split into contiguous chunks of items, a few per thread ([`CHUNKS_PER_THREAD`]), each with its
@@ -228,6 +230,46 @@ where
         let mut first = None;
         for (i, t) in items.iter_mut().enumerate() {
             if let Some(e) = f(i, t) {
+                first.get_or_insert((i, e));
+            }
+        }
+        first
+    }
+}
+
+/// Calls `f(i, &mut a[i], &mut b[i], &mut c[i])` for every item, in parallel when `parallel`, and returns
+/// the first item (in item order) for which `f` returned an error, with that error. Every item is visited
+/// whatever fails, so the items end in the same state for any number of threads.
+pub fn for_each_item3_checked<A, B, C, E, F>(
+    parallel: bool,
+    a: &mut [A],
+    b: &mut [B],
+    c: &mut [C],
+    f: F,
+) -> Option<(usize, E)>
+where
+    A: Send,
+    B: Send,
+    C: Send,
+    E: Send,
+    F: Fn(usize, &mut A, &mut B, &mut C) -> Option<E> + Sync + Send,
+{
+    debug_assert!(a.len() == b.len() && a.len() == c.len());
+    if parallel && rayon::current_num_threads() > 1 {
+        let min_len = a
+            .len()
+            .div_ceil(rayon::current_num_threads() * CHUNKS_PER_THREAD);
+        a.par_iter_mut()
+            .zip(b.par_iter_mut())
+            .zip(c.par_iter_mut())
+            .with_min_len(min_len.max(1))
+            .enumerate()
+            .filter_map(|(i, ((x, y), z))| f(i, x, y, z).map(|e| (i, e)))
+            .min_by_key(|(i, _)| *i)
+    } else {
+        let mut first = None;
+        for (i, ((x, y), z)) in a.iter_mut().zip(b.iter_mut()).zip(c.iter_mut()).enumerate() {
+            if let Some(e) = f(i, x, y, z) {
                 first.get_or_insert((i, e));
             }
         }

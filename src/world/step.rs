@@ -13,7 +13,9 @@
 //!                        a scatter on one thread, a gather per body over its pairs on several)
 //!  6b. (sleeping on) wake the sleeping bodies whose load departs from their rest load, or that touch a
 //!      moving wall or a prescribed body
-//!   7. second half kick  v, L ← v, L + ½Δt (F_{n+1}, p_{n+1})
+//!   7. second half kick  v, L ← v, L + ½Δt (F_{n+1}, p_{n+1}); on several threads without sleeping or
+//!                        prescribed bodies, each body's sums of stage 6 are taken in this pass, just before
+//!                        its kick (one parallel region fewer; the same additions)
 //!   8. checks            non-finite state → StepError naming body and step; deep overlaps → StepReport
 //!                        (7 and the body checks of 8 run fused, one pass over the bodies)
 //!  8b. (sleeping on) calm counters, bodies falling asleep (see [`super::sleeping`])
@@ -48,8 +50,8 @@ use super::contact_store::BodyAdjacency;
 use super::contact_store::{ContactKey, ContactState};
 use super::energy::{viscous_power, ContactWork, LastForces};
 use super::parallel::{
-    for_each_chunked, for_each_item, for_each_item_checked, for_each_item_pair, integration_work,
-    Parallelism, Worker,
+    for_each_chunked, for_each_item, for_each_item3_checked, for_each_item_checked,
+    for_each_item_pair, integration_work, Parallelism, Worker,
 };
 use super::skips::{self, Skips};
 use super::sleeping::{self, SleepParams};
@@ -129,6 +131,9 @@ pub struct StepScratch {
     frozen: sleeping::FrozenLoads,
     /// Per body, what the sphere path of stages 4–5 reads (see [`super::sphere_kernel`]).
     spheres: Vec<sphere_kernel::SphereBody>,
+    /// Set by stage 6 when it left the per-body force sums to the pass of stages 7–8 (the gather fused
+    /// with the second half kick); consumed in the same step.
+    deferred_gather: bool,
 }
 
 /// Stage timers and counters of one or more steps (merge them with [`StepCounters::merge`]).
@@ -313,7 +318,7 @@ pub fn step(
     };
     // 0. The loads of the initial state (no tangential increment: no time has passed).
     if !world.loads.current {
-        evaluate_loads(params, world, scratch, &mut report, 0.0)?;
+        evaluate_loads(params, world, scratch, &mut report, 0.0, false)?;
         if world.ledger.initial_total.is_none() {
             world.ledger.initial_total = Some(world.energy().mechanical());
         }
@@ -376,8 +381,16 @@ pub fn step(
         report.counters.serial += elapsed;
     }
 
-    // 3–6. Loads at the new positions.
-    evaluate_loads(params, world, scratch, &mut report, dt)?;
+    // 3–6. Loads at the new positions (without sleeping, the per-body sums of a parallel evaluation are
+    // left to the pass of 7–8: one parallel region fewer).
+    evaluate_loads(
+        params,
+        world,
+        scratch,
+        &mut report,
+        dt,
+        !params.sleeping.enabled,
+    )?;
 
     // 6b. Sleeping bodies disturbed by this evaluation wake before the second half kick.
     if params.sleeping.enabled {
@@ -389,18 +402,40 @@ pub fn step(
     let t = Instant::now();
     let parallel_bodies =
         integration_work(world.bodies.len(), scratch.anisotropic) >= params.parallel.min_bodies;
-    let (loads, asleep) = (&world.loads, &world.sleep);
-    let non_finite = for_each_item_checked(parallel_bodies, &mut world.bodies, |i, body| {
-        if !(asleep.is_asleep(i) || (skip.non_dynamic_pairs && is_at_rest_fixed(body))) {
-            integrator.second_half_kick(body, &loads.forces[i], &loads.torques[i], dt);
+    let non_finite = if std::mem::take(&mut scratch.deferred_gather) {
+        // Stage 6's per-body sums, fused with 7–8: body i's force and torque over its pairs in candidate
+        // order (the same additions as the gather of stage 6), then its kick and checks.
+        let adjacency = world.contacts.body_adjacency(world.bodies.len());
+        report.counters.serial += t.elapsed();
+        let (evaluated, asleep) = (&scratch.evaluated, &world.sleep);
+        let loads = &mut world.loads;
+        for_each_item3_checked(
+            true,
+            &mut world.bodies,
+            &mut loads.forces,
+            &mut loads.torques,
+            |i, body, force, torque| {
+                sum_body_loads(adjacency, evaluated, i, force, torque);
+                if !(asleep.is_asleep(i) || (skip.non_dynamic_pairs && is_at_rest_fixed(body))) {
+                    integrator.second_half_kick(body, force, torque, dt);
+                }
+                non_finite_quantity(body, force, torque)
+            },
+        )
+    } else {
+        let (loads, asleep) = (&world.loads, &world.sleep);
+        let non_finite = for_each_item_checked(parallel_bodies, &mut world.bodies, |i, body| {
+            if !(asleep.is_asleep(i) || (skip.non_dynamic_pairs && is_at_rest_fixed(body))) {
+                integrator.second_half_kick(body, &loads.forces[i], &loads.torques[i], dt);
+            }
+            non_finite_quantity(body, &loads.forces[i], &loads.torques[i])
+        });
+        if !parallel_bodies {
+            report.counters.serial += t.elapsed();
         }
-        non_finite_quantity(body, &loads.forces[i], &loads.torques[i])
-    });
-    let elapsed = t.elapsed();
-    report.counters.integrate += elapsed;
-    if !parallel_bodies {
-        report.counters.serial += elapsed;
-    }
+        non_finite
+    };
+    report.counters.integrate += t.elapsed();
     if let Some((body, quantity)) = non_finite {
         return Err(StepError::NonFinite {
             step: world.step_index + 1,
@@ -439,6 +474,7 @@ fn evaluate_loads(
     scratch: &mut StepScratch,
     report: &mut StepReport,
     dt: Real,
+    defer_gather: bool,
 ) -> Result<(), StepError> {
     let step_index = world.step_index;
     let counters = &mut report.counters;
@@ -632,8 +668,12 @@ fn evaluate_loads(
     // candidates (in the loop below: one sequential pass); on several per body over its pairs (the same
     // additions in the same order: the same bits; it reads each result twice, so it pays only in parallel).
     let gather = parallel && rayon::current_num_threads() > 1;
+    // The sums can wait for the pass of stages 7–8 when nothing reads the loads before it: no frozen
+    // contributions to add, no prescribed body's power (below), no sleeping check (the caller's choice).
+    scratch.deferred_gather =
+        gather && defer_gather && !scratch.any_prescribed && world.sleep.sleeping == 0;
     let mut gather_time = Duration::ZERO;
-    if gather {
+    if gather && !scratch.deferred_gather {
         // The rows are rebuilt (serially) after a sync that changed the keys.
         let adjacency = world.contacts.body_adjacency(n);
         let t_gather = Instant::now();
