@@ -72,6 +72,7 @@ impl DampingLaw {
 
     /// The damping force (N, along n on B) at overlap δ, overlap rate δ̇, for the normal law (k_n, n) and
     /// effective mass m*.
+    #[inline]
     pub fn force(
         &self,
         stiffness: Real,

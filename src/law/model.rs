@@ -71,6 +71,7 @@ pub struct ContactResponse {
 impl ContactModel {
     /// Evaluates the model on one contact. `history` is the pair's tangential state (stored by the caller);
     /// it is reset when the shapes do not overlap.
+    #[inline]
     pub fn evaluate(
         &self,
         geometry: &ContactGeometry,

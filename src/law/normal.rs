@@ -21,6 +21,7 @@ fn power(overlap: Real, exponent: Real) -> Real {
 }
 
 /// f_n = k_n δ^n (N) for an overlap δ ≥ 0 (m); zero for δ ≤ 0.
+#[inline]
 pub fn power_law_force(stiffness: Real, exponent: Real, overlap: Real) -> Real {
     if overlap <= 0.0 {
         0.0
@@ -30,6 +31,7 @@ pub fn power_law_force(stiffness: Real, exponent: Real, overlap: Real) -> Real {
 }
 
 /// U = k_n δ^(n+1)/(n+1) (J), the elastic potential of [`power_law_force`]; zero for δ ≤ 0.
+#[inline]
 pub fn power_law_potential(stiffness: Real, exponent: Real, overlap: Real) -> Real {
     if overlap <= 0.0 {
         0.0

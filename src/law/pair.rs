@@ -35,8 +35,12 @@ pub fn contact_radius(shape: &Shape) -> Option<Real> {
 
 /// R* of a pair: R_A R_B/(R_A + R_B), or the body's own radius against a wall (`a` is `None` or a plane).
 pub fn effective_radius(a: Option<&Shape>, b: &Shape) -> Real {
-    let rb = contact_radius(b);
-    let ra = a.and_then(contact_radius);
+    effective_contact_radius(a.and_then(contact_radius), contact_radius(b))
+}
+
+/// R* from the contact radii of the two sides (`None` for a wall): R_A R_B/(R_A + R_B), or the one radius.
+#[inline]
+pub fn effective_contact_radius(ra: Option<Real>, rb: Option<Real>) -> Real {
     match (ra, rb) {
         (Some(ra), Some(rb)) => ra * rb / (ra + rb),
         (None, Some(r)) | (Some(r), None) => r,
@@ -57,8 +61,21 @@ impl ContactModel {
         }
     }
 
+    /// [`ContactModel::for_shapes`] from the contact radii of the two sides ([`contact_radius`]; `None` for
+    /// a wall): the same model, without looking at the shapes.
+    #[inline]
+    pub fn for_contact_radii(&self, ra: Option<Real>, rb: Option<Real>) -> ContactModel {
+        match self.normal.radius_scaling {
+            RadiusScaling::Constant => *self,
+            RadiusScaling::SqrtEffectiveRadius => {
+                self.with_root_radius(effective_contact_radius(ra, rb).sqrt())
+            }
+        }
+    }
+
     /// k_n and the tangential stiffness multiplied by `root_radius` = √R*; the result has constant
     /// stiffnesses.
+    #[inline]
     pub fn with_root_radius(&self, root_radius: Real) -> ContactModel {
         let mut model = *self;
         model.normal.stiffness *= root_radius;

@@ -154,6 +154,7 @@ pub struct TangentialResponse {
 /// Rotates the displacement `u` expressed against `old_normal` into the plane perpendicular to `new_normal`
 /// (smallest rotation taking one normal to the other), keeping its length. A zero `old_normal` (new contact)
 /// only projects.
+#[inline]
 pub fn rotate_into_tangent_plane(u: &Vector, old_normal: &Vector, new_normal: &Vector) -> Vector {
     let length = u.norm();
     if length == 0.0 {
@@ -207,6 +208,7 @@ pub fn incremental_spring(
 /// (the LIGGGHTS `tangential history` order). The dashpot's power c_t |v_t|² is reported in
 /// [`TangentialResponse::damping_power`].
 #[allow(clippy::too_many_arguments)]
+#[inline]
 pub fn incremental_spring_damped(
     stiffness: Real,
     friction: Real,

@@ -1009,6 +1009,7 @@ fn build(ctx: &Ctx, file: &SceneFile) -> Result<Simulation, SceneError> {
     params.damping = damping;
     params.tolerances.wall_depth = wall_depth(ctx, sim)?;
     params.tolerances.pair_smoothing = pair_smoothing(ctx, sim)?;
+    params.energy_ledger = sim.energy_ledger.as_ref().is_none_or(|l| *l.get_ref());
     let steps = super::run::steps_to(end_time, dt);
     let output_every = ((output_interval / dt).round() as u64).max(1);
     Ok(Simulation {

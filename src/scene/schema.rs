@@ -63,6 +63,9 @@ pub struct SimulationSection {
     pub pair_smoothing: Option<Spanned<String>>,
     /// Band h of the smoothed pair overlap as a fraction of the smaller bounding diameter; absent = 1e-4.
     pub pair_smoothing_band: Option<Spanned<f64>>,
+    /// Whether the step books the per-contact terms of the energy ledger; absent = true (see
+    /// `crate::world::StepParams::energy_ledger`).
+    pub energy_ledger: Option<Spanned<bool>>,
 }
 
 /// `[[material]]`.

@@ -8,6 +8,7 @@
 //! - [`skips`]: the work a scene does not need, each skip switchable.
 //! - [`sleeping`]: freezing bodies at rest, islands, waking.
 //! - [`parallel`]: deterministic per-item parallelism of the step's stages (rayon).
+//! - `sphere_kernel`: the sphere path of the narrow phase and laws (sphere–sphere, wall–sphere).
 
 pub mod broad_phase;
 pub mod contact_store;
@@ -15,6 +16,7 @@ pub mod energy;
 pub mod parallel;
 pub mod skips;
 pub mod sleeping;
+mod sphere_kernel;
 pub mod step;
 pub mod tunnelling;
 #[allow(clippy::module_inception)]

@@ -10,6 +10,7 @@
 //! | `undamped_contacts` | the damping term of a viscous law whose coefficient is 0 (e = 1); e = 1 already maps to `DampingLaw::None`, which costs nothing | bit-identical (up to the sign of zero) |
 //! | `still_rotation` | the rotation drift of a dynamic body whose angular momentum is exactly zero | to the round-off of one quaternion renormalisation (≤ 2⁻⁵² relative) per step |
 //! | `isotropic_rotation` | the five sub-rotations of the splitting for a body whose principal moments are exactly equal (a sphere): its free rotation is one turn about the constant L by the angle Δt|L|/J, done as one quaternion product, and ω = L/J without the two frame changes | not bit-identical: the splitting is only second order for such a body (its sub-flows do not commute), the single turn is its exact flow (in the Cayley form, the same modified angle 4 atan(θ/4) as the paper's sub-steps); ω differs at round-off. Bounded in `tests/world_isotropic.rs` |
+//! | `sphere_kernel` | the general pair dispatch for candidates whose sides are spheres or a wall and a sphere: per-body inputs gathered once per step, the closed forms and the law called directly (`src/world/sphere_kernel.rs`) | exact: the same operations in the same order, bit-identical bodies, loads, ledger and contact store |
 //! | `non_dynamic_pairs` | queries between two non-dynamic bodies (fixed or prescribed) and the integration of fixed bodies | forces between two non-dynamic bodies are not computed: they act on nothing that moves, but the force reported on such a body omits them |
 //!
 //! Rejected pairs are stored as `Separated` with `distance` a lower bound of the true gap (the gap of the
@@ -37,6 +38,7 @@ pub struct Skips {
     pub still_rotation: bool,
     pub isotropic_rotation: bool,
     pub non_dynamic_pairs: bool,
+    pub sphere_kernel: bool,
 }
 
 impl Default for Skips {
@@ -57,6 +59,7 @@ impl Skips {
             still_rotation: on,
             isotropic_rotation: on,
             non_dynamic_pairs: on,
+            sphere_kernel: on,
         }
     }
 }

@@ -40,7 +40,7 @@ use crate::contact::{
 use crate::dynamics::rotation::{drift_isotropic, is_isotropic};
 use crate::dynamics::translation::drift_position;
 use crate::dynamics::{Integrator, Motion, RotationScheme, TranslationParams, ViscousDamping};
-use crate::law::{ContactKinematics, ContactModel, ContactResponse, DampingLaw, TangentialLaw};
+use crate::law::{ContactKinematics, ContactModel, DampingLaw, TangentialLaw};
 use crate::math::{Point, Real, Vector};
 use crate::shape::Shape;
 
@@ -53,6 +53,7 @@ use super::parallel::{
 };
 use super::skips::{self, Skips};
 use super::sleeping::{self, SleepParams};
+use super::sphere_kernel;
 use super::world::World;
 
 /// Default of [`StepParams::overlap_warning_fraction`]: 0.05. A DEM run with a stiffness that represents
@@ -80,6 +81,13 @@ pub struct StepParams {
     pub skips: Skips,
     /// Freezing of bodies at rest (off by default; see [`super::sleeping`]).
     pub sleeping: SleepParams,
+    /// Whether the step books the per-contact terms of the energy ledger (damping, friction and
+    /// tangential stiffness work; see [`super::energy`]). On by default. Off, the step skips that booking
+    /// (a run that only needs trajectories and forces: the speed comparisons with codes that keep no
+    /// ledger); bodies, forces and the contact store are the same bits either way, but the ledger's
+    /// `dissipated_damping`, `dissipated_friction` and `tangential_stiffness_work` stay where they were, so
+    /// [`World::energy`]'s balance no longer closes.
+    pub energy_ledger: bool,
 }
 
 impl StepParams {
@@ -95,6 +103,7 @@ impl StepParams {
             parallel: Parallelism::default(),
             skips: Skips::default(),
             sleeping: SleepParams::default(),
+            energy_ledger: true,
         }
     }
 }
@@ -118,6 +127,8 @@ pub struct StepScratch {
     workers: Vec<Worker>,
     /// The summed contributions of the frozen contacts (see [`super::sleeping`]).
     frozen: sleeping::FrozenLoads,
+    /// Per body, what the sphere path of stages 4–5 reads (see [`super::sphere_kernel`]).
+    spheres: Vec<sphere_kernel::SphereBody>,
 }
 
 /// Stage timers and counters of one or more steps (merge them with [`StepCounters::merge`]).
@@ -493,6 +504,14 @@ fn evaluate_loads(
     scratch.evaluated.resize(n_candidates, Evaluated::default());
     let world_ref: &World = world;
     let candidates = &scratch.candidates;
+    // The sphere path: its per-body inputs, gathered once (see [`super::sphere_kernel`]).
+    let spheres = (params.skips.sphere_kernel
+        && sphere_kernel::gather(
+            world_ref,
+            params.skips.isotropic_rotation,
+            &mut scratch.spheres,
+        ))
+    .then_some(scratch.spheres.as_slice());
     let pair = PairInputs {
         world: world_ref,
         isotropic: params.skips.isotropic_rotation,
@@ -500,6 +519,7 @@ fn evaluate_loads(
         n_materials,
         dt,
         step_index,
+        ledger: params.energy_ledger,
     };
     let evaluated = for_each_chunked(
         parallel,
@@ -518,6 +538,20 @@ fn evaluate_loads(
             }
             // The last contact point, for the ledger of a pair that opens in this step.
             let previous_point = state.geometry.point;
+            if let Some(spheres) = spheres {
+                if let Some(done) = sphere_kernel::evaluate(
+                    params,
+                    &pair,
+                    spheres,
+                    key,
+                    state,
+                    &previous_point,
+                    out,
+                    worker,
+                ) {
+                    return done;
+                }
+            }
             narrow_phase(params, world_ref, key, state, worker).map_err(|source| {
                 StepError::Contact {
                     step: step_index,
@@ -591,7 +625,7 @@ fn evaluate_loads(
                 ratio: e.overlap_ratio,
             });
         }
-        let r = &e.response;
+        let r = e;
         match *key {
             ContactKey::Body { a, b } if !gather => {
                 loads.forces[a as usize] -= r.force_on_b;
@@ -608,7 +642,7 @@ fn evaluate_loads(
                 }
             }
         }
-        loads.elastic_potential += r.normal_potential + r.tangential_potential;
+        loads.elastic_potential += r.potential;
     }
     // The frozen contacts, summed once while the sleeping set and the store's pairs stay the same, added
     // after the candidates in both summation modes (the same bits on any number of threads).
@@ -669,11 +703,11 @@ fn sum_body_loads(
             continue;
         }
         if entry & BodyAdjacency::SIDE_A != 0 {
-            f -= e.response.force_on_b;
-            t += e.response.torque_on_a;
+            f -= e.force_on_b;
+            t += e.torque_on_a;
         } else {
-            f += e.response.force_on_b;
-            t += e.response.torque_on_b;
+            f += e.force_on_b;
+            t += e.torque_on_b;
         }
     }
     *force = f;
@@ -683,8 +717,13 @@ fn sum_body_loads(
 /// The result of stage 5 for one candidate. The flags and `work` are written for every candidate; the
 /// other fields only when `overlapping` (a separated pair contributes no force, and no stage reads them).
 #[derive(Clone, Copy, Debug, Default)]
-struct Evaluated {
-    response: ContactResponse,
+pub(super) struct Evaluated {
+    /// What stage 6 reads of the law's [`crate::law::ContactResponse`]: the force on B, the torques on A
+    /// and B, and the elastic potential (normal + tangential, J).
+    force_on_b: Vector,
+    torque_on_a: Vector,
+    torque_on_b: Vector,
+    potential: Real,
     /// The ledger terms of this step (nonzero for a separated pair only in the step it opens).
     work: ContactWork,
     /// Whether the shapes overlap (the law produced a force).
@@ -697,19 +736,21 @@ struct Evaluated {
 }
 
 /// What stages 4–5 read for every candidate, gathered once per step.
-struct PairInputs<'a> {
-    world: &'a World,
+pub(super) struct PairInputs<'a> {
+    pub(super) world: &'a World,
     /// Whether ω of a body with equal principal moments is taken as L/J (the `isotropic_rotation` skip).
     isotropic: bool,
     /// The contact model of each material pair (row-major `n_materials²`), with the skips applied.
     models: &'a [Option<ContactModel>],
     n_materials: usize,
-    dt: Real,
+    pub(super) dt: Real,
     step_index: u64,
+    /// Whether the ledger terms are booked ([`StepParams::energy_ledger`]).
+    ledger: bool,
 }
 
 impl PairInputs<'_> {
-    fn model(&self, mat_a: u32, mat_b: u32) -> Result<&ContactModel, StepError> {
+    pub(super) fn model(&self, mat_a: u32, mat_b: u32) -> Result<&ContactModel, StepError> {
         self.models[mat_a as usize * self.n_materials + mat_b as usize]
             .as_ref()
             .ok_or(StepError::MissingLaw {
@@ -865,7 +906,7 @@ fn narrow_phase(
 /// updating the tangential history and the stored forces; the result goes to `out`. `previous_point` is
 /// the contact point of the pair's last evaluation (the ledger of a pair that opens needs it).
 #[inline]
-fn contact_law(
+pub(super) fn contact_law(
     pair: &PairInputs,
     key: ContactKey,
     state: &mut ContactState,
@@ -886,7 +927,7 @@ fn contact_law(
             damping_force: *damping_force,
             history: *history,
         };
-        if !previous.is_zero() {
+        if pair.ledger && !previous.is_zero() {
             // The pair opened in this step: its last forces acted for the first half kick.
             let world = pair.world;
             let (shape_a, mat_a, b) = match key {
@@ -950,13 +991,49 @@ fn contact_law(
         dt: pair.dt,
     };
     let model = model.for_shapes(a_body.map(|a| world.shape(a)), world.shape(b));
+    overlap_law(
+        pair,
+        key,
+        state,
+        previous_point,
+        &model,
+        &kinematics,
+        scale,
+        out,
+    );
+    Ok(())
+}
+
+/// The end of stage 5 for an overlapping candidate whose model (with the pair's stiffnesses), kinematics
+/// and length scale (the smaller particle's) are known: the law, the ledger terms, the stored forces.
+#[allow(clippy::too_many_arguments)]
+#[inline]
+pub(super) fn overlap_law(
+    pair: &PairInputs,
+    key: ContactKey,
+    state: &mut ContactState,
+    previous_point: &Point,
+    model: &ContactModel,
+    kinematics: &ContactKinematics,
+    scale: Real,
+    out: &mut Evaluated,
+) {
+    let ContactState {
+        geometry: g,
+        history,
+        force_on_b,
+        damping_force,
+        ..
+    } = state;
     let previous = LastForces {
         damping_force: *damping_force,
         history: *history,
     };
-    out.response = model.evaluate(g, &kinematics, history);
-    out.work = if previous.is_zero() {
-        ContactWork::of_new_contact(&out.response, &kinematics.relative_velocity, pair.dt)
+    let response = model.evaluate(g, kinematics, history);
+    out.work = if !pair.ledger {
+        ContactWork::default()
+    } else if previous.is_zero() {
+        ContactWork::of_new_contact(&response, &kinematics.relative_velocity, pair.dt)
     } else {
         // The last forces were applied with the lever arms of the last contact point.
         let previous_velocity = pair.relative_velocity(key, previous_point, pair.dt);
@@ -964,17 +1041,20 @@ fn contact_law(
             &previous,
             &previous_velocity,
             &g.normal,
-            &out.response,
+            &response,
             &kinematics.relative_velocity,
             pair.dt,
         )
     };
-    *force_on_b = out.response.force_on_b;
-    *damping_force = out.response.damping_force;
+    *force_on_b = response.force_on_b;
+    *damping_force = response.damping_force;
+    out.force_on_b = response.force_on_b;
+    out.torque_on_a = response.torque_on_a;
+    out.torque_on_b = response.torque_on_b;
+    out.potential = response.normal_potential + response.tangential_potential;
     out.overlapping = true;
     out.depth = g.depth;
     out.overlap_ratio = g.depth / scale;
-    Ok(())
 }
 
 /// The model with the slots the skips make free: no tangential spring when μ = 0, no damping term when its

@@ -2,6 +2,7 @@
 //! by a random convex polyhedron of the same volume (polydem only), run beside the sphere bed of the same
 //! scene, to show what the shape of the grains does to the penetration.
 
+pub mod bounds;
 pub mod crossings;
 pub mod generate;
 
@@ -27,7 +28,8 @@ pub fn template_scene(variant: &str) -> Result<&'static str, String> {
     match variant {
         "a" | "a_hertz_5ms" => Ok("scenes/sphere_bed_a_hertz_5ms.toml"),
         "b" | "b_hertz_200ms" => Ok("scenes/sphere_bed_b_hertz_200ms.toml"),
-        _ => Err(format!("unknown variant '{variant}' (a or b)")),
+        "c" | "c_linear_5ms" => Ok("scenes/sphere_bed_c_linear_5ms.toml"),
+        _ => Err(format!("unknown variant '{variant}' (a, b or c)")),
     }
 }
 
@@ -56,7 +58,6 @@ use std::time::Instant;
 
 use polydem::contact::contact_polyhedron_polyhedron::sat_polyhedra;
 use polydem::contact::ContactKind;
-use polydem::law::hertz_mindlin::{effective_young_modulus, ElasticMaterial};
 use polydem::scene::{load_scene, parse_scene, Simulation};
 use polydem::shape::Shape;
 use polydem::world::{step, StepScratch};
@@ -75,7 +76,7 @@ const NAME: &str = "polyhedra_bed";
 #[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 struct Variant {
-    /// Variant of the sphere bed: `a_hertz_5ms` or `b_hertz_200ms`.
+    /// Variant of the sphere bed: `a_hertz_5ms`, `b_hertz_200ms` or `c_linear_5ms`.
     name: String,
     /// Steps to run (at most the scene's); fewer steps compare the first part of the run.
     steps: Option<u64>,
@@ -340,34 +341,20 @@ fn initial_overlap(bodies: &[BedBody], side: Real) -> Result<Real, SuiteError> {
     Ok(worst)
 }
 
-/// Overlap at which one Hertz contact stores the energy `w` (J): w = (8/15) E* √R* δ^(5/2). With `w` the
-/// projectile's initial kinetic energy and the softest pair (smallest E* and R*), no contact of the run can
-/// be deeper without energy coming from nowhere (the bed's own potential energy drop during a run is
-/// orders of magnitude smaller: it is settled).
-fn hertz_energy_overlap(w: Real, e_star: Real, r_star: Real) -> Real {
-    (15.0 * w / (8.0 * e_star * r_star.sqrt())).powf(0.4)
-}
-
-/// Density, Young's modulus and Poisson's ratio of material `name` of a scene file.
-fn scene_material(template: &str, name: &str) -> Result<(Real, ElasticMaterial), SuiteError> {
+/// Density of material `name` of a scene file.
+fn scene_density(template: &str, name: &str) -> Result<Real, SuiteError> {
     let table: toml::Table =
         toml::from_str(template).map_err(|e| fail(format!("scene template: {e}")))?;
-    let m = table
+    table
         .get("material")
         .and_then(toml::Value::as_array)
         .and_then(|a| {
             a.iter()
                 .find(|m| m.get("name").and_then(toml::Value::as_str) == Some(name))
         })
-        .ok_or_else(|| fail(format!("scene template: no material '{name}'")))?;
-    let f = |key: &str| {
-        m.get(key)
-            .and_then(toml::Value::as_float)
-            .ok_or_else(|| fail(format!("scene template: material '{name}' lacks {key}")))
-    };
-    let elastic = ElasticMaterial::new(f("young_modulus")?, f("poisson_ratio")?)
-        .map_err(|e| fail(format!("material '{name}': {e}")))?;
-    Ok((f("density")?, elastic))
+        .and_then(|m| m.get("density"))
+        .and_then(toml::Value::as_float)
+        .ok_or_else(|| fail(format!("scene template: no density of material '{name}'")))
 }
 
 impl Case for PolyhedraBed {
@@ -420,7 +407,9 @@ impl Case for PolyhedraBed {
              radius of the sphere each polyhedron replaced — so a contact of two polyhedra has the \
              stiffness of the two spheres they replaced at the same overlap, whatever the features in \
              contact (vertex, edge or face): the shape changes where and along which normal the contacts \
-             act, not the law.",
+             act, not the law. The linear spring–dashpot law of variant c has one k_n and one dashpot per \
+             pair whatever the shape (f = k_n δ_M + c_n δ̇_M), as LIGGGHTS' `hooke/stiffness` has for \
+             spheres.",
             generate::MIN_POINTS,
             generate::MAX_POINTS,
             generate::MIN_SPACING,
@@ -450,8 +439,8 @@ impl Case for PolyhedraBed {
                     (pl.poly.mass_properties().volume / sphere - 1.0).abs()
                 })
                 .fold(0.0, Real::max);
-            let (bed_density, bed) = scene_material(&template, "bed")?;
-            let (_, steel) = scene_material(&template, "steel")?;
+            let bed_density = scene_density(&template, "bed")?;
+            let law = bounds::BedLaw::from_scene(&template).map_err(fail)?;
             let r_min = spheres
                 .iter()
                 .map(|s| s.radius)
@@ -460,10 +449,8 @@ impl Case for PolyhedraBed {
                 .iter()
                 .map(|s| bed_density * 4.0 / 3.0 * std::f64::consts::PI * s.radius.powi(3))
                 .sum();
-            let e_bed = effective_young_modulus(&bed, &bed);
             // The bed's whole weight on one contact of the two smallest grains: no static contact carries more.
-            let static_bound =
-                (bed_mass * 9.81 / (4.0 / 3.0 * e_bed * (0.5 * r_min).sqrt())).powf(2.0 / 3.0);
+            let static_bound = law.static_overlap(bed_mass * 9.81, 0.5 * r_min);
             let t_gen = Instant::now();
             let initial = initial_overlap(&bodies, box_side)?;
             let t_gen = t_gen.elapsed().as_secs_f64();
@@ -487,8 +474,7 @@ impl Case for PolyhedraBed {
                 &format!("{v} polyhedra"),
                 ctx,
             )?;
-            let e_star_min = e_bed.min(effective_young_modulus(&bed, &steel));
-            let overlap_bound = hertz_energy_overlap(poly_run.ke0, e_star_min, 0.5 * r_min);
+            let overlap_bound = law.energy_overlap(poly_run.ke0, 0.5 * r_min);
             let t_end = *poly_run.history.t.last().unwrap_or(&0.0);
 
             ctx.section(&format!("{v} (t ≤ {:.4} ms)", t_end * 1e3));
@@ -583,7 +569,7 @@ impl Case for PolyhedraBed {
                 &format!("{v}_initial_max_overlap"),
                 initial / mean_diameter,
                 Target::at_most(static_bound / mean_diameter),
-                "mean bed diameters (exact SAT oracle and walls, settled bed; bound: Hertz overlap of the bed's whole weight on one contact of the two smallest grains)",
+                &format!("mean bed diameters (exact SAT oracle and walls, settled bed; bound: {} overlap of the bed's whole weight on one contact of the two smallest grains)", law.describe()),
             );
             ctx.check(
                 &format!("{v}_non_finite_values"),
@@ -601,7 +587,7 @@ impl Case for PolyhedraBed {
                 &format!("{v}_max_overlap"),
                 poly_run.max_depth / mean_diameter,
                 Target::at_most(overlap_bound / mean_diameter),
-                "mean bed diameters (bound: one Hertz contact of the softest pair holding the projectile's whole kinetic energy)",
+                &format!("mean bed diameters (bound: one {} contact of the softest pair holding the projectile's whole kinetic energy)", law.describe()),
             );
             ctx.check(
                 &format!("{v}_tunnelling_crossings"),

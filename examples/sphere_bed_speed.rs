@@ -1,0 +1,132 @@
+//! Single-thread speed of the sphere-bed penetration scenes (issue 7): the quiet-machine re-measurement.
+//!
+//! Runs the scene files of `validation/src/cases/sphere_bed.rs` (`scenes/sphere_bed_*.toml`: 3000 settled
+//! spheres, Hertz–Mindlin or linear spring–dashpot with friction and damping, a steel projectile) for the
+//! given number of steps on a rayon pool of one thread, as the suite's speed rows do, and prints per
+//! scene: the thread's CPU time and the wall time of the stepping loop, particle-steps/s (CPU and wall),
+//! the stage timers and counters of the step, the load average before and after, and a checksum of the
+//! final positions and velocities (the bits: two builds that print the same checksum ran the same
+//! trajectory).
+//!
+//! ```text
+//! cargo run --release --example sphere_bed_speed -- [--steps N] [--ledger on|off|scene] [--skin M]
+//!     [SCENE.toml ...]
+//! ```
+//! Default: 5000 steps (0.01 s of the bed) of the three variants a, b, c. `--ledger` overrides the
+//! scene's `energy_ledger` key (`scene`: keep it); `--skin` the Verlet skin of the broad phase (m; the
+//! candidate list changes, the trajectory does not).
+
+use std::path::PathBuf;
+use std::time::Instant;
+
+use polydem::scene::load_scene;
+use polydem::world::broad_phase::BroadPhase;
+
+struct Options {
+    steps: u64,
+    ledger: Option<bool>,
+    skin: Option<f64>,
+    scenes: Vec<PathBuf>,
+}
+
+fn parse() -> Result<Options, String> {
+    let mut o = Options {
+        steps: 5000,
+        ledger: None,
+        skin: None,
+        scenes: Vec::new(),
+    };
+    let mut args = std::env::args().skip(1);
+    while let Some(a) = args.next() {
+        let mut value = || args.next().ok_or(format!("{a} needs a value"));
+        match a.as_str() {
+            "--steps" => o.steps = value()?.parse().map_err(|e| format!("--steps: {e}"))?,
+            "--ledger" => {
+                o.ledger = match value()?.as_str() {
+                    "on" => Some(true),
+                    "off" => Some(false),
+                    "scene" => None,
+                    v => return Err(format!("--ledger: '{v}' is not on, off or scene")),
+                }
+            }
+            "--skin" => o.skin = Some(value()?.parse().map_err(|e| format!("--skin: {e}"))?),
+            s if s.starts_with("--") => return Err(format!("unknown option {s}")),
+            s => o.scenes.push(PathBuf::from(s)),
+        }
+    }
+    if o.scenes.is_empty() {
+        let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
+        for v in ["a_hertz_5ms", "b_hertz_200ms", "c_linear_5ms"] {
+            o.scenes
+                .push(root.join(format!("scenes/sphere_bed_{v}.toml")));
+        }
+    }
+    Ok(o)
+}
+
+/// CPU time of the calling thread (s), from the scheduler's statistics.
+fn thread_cpu_time() -> Option<f64> {
+    let text = std::fs::read_to_string("/proc/thread-self/schedstat").ok()?;
+    let ns: f64 = text.split_whitespace().next()?.parse().ok()?;
+    Some(ns * 1e-9)
+}
+
+fn load_average() -> String {
+    std::fs::read_to_string("/proc/loadavg")
+        .map(|s| s.split_whitespace().take(3).collect::<Vec<_>>().join(" "))
+        .unwrap_or_else(|_| "n/a".into())
+}
+
+fn main() -> anyhow::Result<()> {
+    let o = parse().map_err(anyhow::Error::msg)?;
+    let pool = rayon::ThreadPoolBuilder::new().num_threads(1).build()?;
+    for path in &o.scenes {
+        let mut sim = load_scene(path)?;
+        if let Some(on) = o.ledger {
+            sim.params.energy_ledger = on;
+        }
+        if let Some(skin) = o.skin {
+            sim.world.broad_phase = BroadPhase::new(skin);
+        }
+        sim.steps = sim.steps.min(o.steps);
+        let particles = sim.world.bodies.len();
+        let load_before = load_average();
+        let (summary, wall, cpu) = pool.install(|| {
+            let cpu0 = thread_cpu_time();
+            let t = Instant::now();
+            let summary = sim.run(|_| Ok(()), |_, _| Ok(()));
+            let wall = t.elapsed().as_secs_f64();
+            let cpu = cpu0.zip(thread_cpu_time()).map(|(a, b)| b - a);
+            (summary, wall, cpu)
+        });
+        let summary = summary?;
+        let mut hash: u64 = 0xcbf2_9ce4_8422_2325;
+        for b in &sim.world.bodies {
+            for x in b.position.iter().chain(b.velocity.iter()) {
+                hash = (hash ^ x.to_bits()).wrapping_mul(0x0100_0000_01b3);
+            }
+        }
+        let steps = summary.steps as f64;
+        println!("scene {}", path.display());
+        println!(
+            "  {} particles, {} steps, ledger {}, skin {:.3e} m: CPU {} s, wall {:.3} s; particle-steps/s {} (CPU), {:.3e} (wall)",
+            particles,
+            summary.steps,
+            if sim.params.energy_ledger { "on" } else { "off" },
+            sim.world.broad_phase.skin(),
+            cpu.map_or("n/a".into(), |c| format!("{c:.3}")),
+            wall,
+            cpu.map_or("n/a".into(), |c| format!("{:.3e}", particles as f64 * steps / c)),
+            particles as f64 * steps / wall
+        );
+        println!(
+            "  load average before {load_before}, after {}",
+            load_average()
+        );
+        println!("  final state checksum {hash:016x}");
+        for line in summary.counters.to_string().lines() {
+            println!("  {line}");
+        }
+    }
+    Ok(())
+}

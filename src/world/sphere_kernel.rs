@@ -1,0 +1,240 @@
+//! The sphere path of stages 4–5: a candidate whose two sides are spheres, or a wall and a sphere, goes
+//! from the body positions to the law without the general pair dispatch.
+//!
+//! Per step the step gathers, once per body, what a sphere contact reads of it ([`SphereBody`]: centre,
+//! velocity, angular velocity, radii, length scale, mass, material, whether it is a dynamic sphere) into
+//! one compact array, so that a candidate reads two small records instead of two rigid bodies, their
+//! shapes and materials; the angular velocity (L/J for a body with equal principal moments when the
+//! `isotropic_rotation` skip is on, R J̄⁻¹ Rᵀ L otherwise, as [`super::step`] takes it) is formed once per
+//! body instead of once per contact side. A candidate then takes:
+//! - the bounding-sphere rejection (when the skip is on) and the closed forms
+//!   [`contact_sphere_sphere`] / [`contact_plane_sphere`], with the same arguments as the general
+//!   narrow phase;
+//! - for an overlapping pair, the kinematics (v_B − v_A at the contact point, m*, centres) and the model
+//!   scaled by √R* from the two radii ([`ContactModel::for_contact_radii`]), then the same end of stage 5
+//!   as every other pair ([`super::step::overlap_law`]);
+//! - for a pair that does not overlap, the general stage 5 ([`super::step::contact_law`]).
+//!
+//! Every value is computed by the same operations in the same order as the general path, so the path is
+//! exact: bodies, loads, ledger and contact store are the same bits with the `sphere_kernel` skip on or off
+//! (`tests/world_sphere_fast_paths.rs`, `tests/world_skips.rs`).
+
+use crate::contact::{contact_plane_sphere, contact_sphere_sphere, ContactKind};
+use crate::dynamics::rotation::is_isotropic;
+use crate::law::ContactKinematics;
+use crate::math::{Point, Real, Vector};
+use crate::shape::Shape;
+
+use super::contact_store::{ContactKey, ContactState};
+use super::parallel::Worker;
+use super::skips;
+use super::step::{contact_law, overlap_law, Evaluated, PairInputs, StepError, StepParams};
+use super::world::World;
+
+/// What a sphere contact reads of one body (gathered once per step by [`gather`]).
+#[derive(Clone, Copy, Debug, Default)]
+pub(super) struct SphereBody {
+    position: Point,
+    velocity: Vector,
+    /// World angular velocity, as the general path takes it (see the module docs); zero for a body that
+    /// is not a sphere (never read).
+    omega: Vector,
+    /// Radius of the sphere (m); zero for another shape.
+    radius: Real,
+    /// Bounding radius (`World::radii`, m).
+    bound: Real,
+    /// Length scale of the shape (the diameter, m).
+    length_scale: Real,
+    mass: Real,
+    material: u32,
+    /// Whether the body's shape is a sphere (only then is the record read).
+    sphere: bool,
+    dynamic: bool,
+}
+
+/// Fills `out` with one [`SphereBody`] per body of `world`; `isotropic` is the `isotropic_rotation` skip.
+/// Returns whether some body is a sphere (otherwise the kernel has nothing to do).
+pub(super) fn gather(world: &World, isotropic: bool, out: &mut Vec<SphereBody>) -> bool {
+    out.clear();
+    if !world.shapes.iter().any(|s| matches!(s, Shape::Sphere(_))) {
+        return false;
+    }
+    out.extend(world.bodies.iter().enumerate().map(|(i, body)| {
+        let Shape::Sphere(sphere) = world.shape(i) else {
+            return SphereBody::default();
+        };
+        let omega = if isotropic && is_isotropic(&body.inertia.0) {
+            body.angular_momentum / body.inertia.0.x
+        } else {
+            body.angular_velocity()
+        };
+        SphereBody {
+            position: body.position,
+            velocity: body.velocity,
+            omega,
+            radius: sphere.radius(),
+            bound: world.radii[i],
+            length_scale: sphere.length_scale(),
+            mass: body.mass,
+            material: world.material_of[i],
+            sphere: true,
+            dynamic: body.is_dynamic(),
+        }
+    }));
+    true
+}
+
+impl SphereBody {
+    /// Velocity (m/s) of the material point at `point` (world).
+    #[inline]
+    fn velocity_at(&self, point: &Point) -> Vector {
+        self.velocity + self.omega.cross(&(point - self.position))
+    }
+}
+
+/// Stages 4–5 for `key` if both its sides are spheres or a wall and a sphere: `Some` with the result of
+/// the stage (written to `state` and `out` as the general path writes them), `None` for any other pair.
+/// `previous_point` is the contact point of the pair's last evaluation.
+#[allow(clippy::too_many_arguments)]
+#[inline]
+pub(super) fn evaluate(
+    params: &StepParams,
+    pair: &PairInputs,
+    spheres: &[SphereBody],
+    key: ContactKey,
+    state: &mut ContactState,
+    previous_point: &Point,
+    out: &mut Evaluated,
+    worker: &mut Worker,
+) -> Option<Result<(), StepError>> {
+    let tol = &params.tolerances;
+    let counters = &mut worker.query;
+    match key {
+        ContactKey::Body { a, b } => {
+            let (sa, sb) = (&spheres[a as usize], &spheres[b as usize]);
+            if !(sa.sphere && sb.sphere) {
+                return None;
+            }
+            let rejected = if params.skips.bounding_spheres {
+                skips::reject_by_bounding_spheres(
+                    &sa.position,
+                    sa.bound,
+                    &sb.position,
+                    sb.bound,
+                    sa.length_scale.max(sb.length_scale),
+                    tol,
+                    counters,
+                )
+            } else {
+                None
+            };
+            state.geometry = match rejected {
+                Some(g) => g,
+                None => {
+                    counters.sphere_sphere += 1;
+                    let g = contact_sphere_sphere(
+                        &sa.position,
+                        sa.radius,
+                        &sb.position,
+                        sb.radius,
+                        tol,
+                    );
+                    counters.record(&g);
+                    g
+                }
+            };
+            if state.geometry.kind != ContactKind::Overlap {
+                return Some(contact_law(pair, key, state, previous_point, out));
+            }
+            let model = match pair.model(sa.material, sb.material) {
+                Ok(m) => m.for_contact_radii(Some(sa.radius), Some(sb.radius)),
+                Err(e) => return Some(Err(e)),
+            };
+            let effective_mass = match (sa.dynamic, sb.dynamic) {
+                (true, true) => sa.mass * sb.mass / (sa.mass + sb.mass),
+                (true, false) => sa.mass,
+                _ => sb.mass,
+            };
+            let point = &state.geometry.point;
+            let kinematics = ContactKinematics {
+                relative_velocity: sb.velocity_at(point) - sa.velocity_at(point),
+                effective_mass,
+                center_a: sa.position,
+                center_b: sb.position,
+                dt: pair.dt,
+            };
+            let scale = sa.length_scale.min(sb.length_scale);
+            overlap_law(
+                pair,
+                key,
+                state,
+                previous_point,
+                &model,
+                &kinematics,
+                scale,
+                out,
+            );
+            Some(Ok(()))
+        }
+        ContactKey::Wall { body, wall } => {
+            let s = &spheres[body as usize];
+            if !s.sphere {
+                return None;
+            }
+            let w = &pair.world.walls[wall as usize];
+            let rejected = if params.skips.bounding_spheres {
+                skips::reject_wall_by_bounding_sphere(
+                    w.signed_distance(&s.position),
+                    &w.normal_world(),
+                    &s.position,
+                    s.bound,
+                    counters,
+                )
+            } else {
+                None
+            };
+            state.geometry = match rejected {
+                Some(g) => g,
+                None => {
+                    counters.sphere_plane += 1;
+                    let g = contact_plane_sphere(
+                        &w.pose,
+                        w.plane.normal(),
+                        w.plane.offset(),
+                        &s.position,
+                        s.radius,
+                        tol,
+                    );
+                    counters.record(&g);
+                    g
+                }
+            };
+            if state.geometry.kind != ContactKind::Overlap {
+                return Some(contact_law(pair, key, state, previous_point, out));
+            }
+            let model = match pair.model(w.material, s.material) {
+                Ok(m) => m.for_contact_radii(None, Some(s.radius)),
+                Err(e) => return Some(Err(e)),
+            };
+            let g = &state.geometry;
+            let kinematics = ContactKinematics {
+                relative_velocity: s.velocity_at(&g.point) - w.velocity,
+                effective_mass: s.mass,
+                center_a: g.point_a,
+                center_b: s.position,
+                dt: pair.dt,
+            };
+            overlap_law(
+                pair,
+                key,
+                state,
+                previous_point,
+                &model,
+                &kinematics,
+                s.length_scale,
+                out,
+            );
+            Some(Ok(()))
+        }
+    }
+}
