@@ -22,7 +22,7 @@
 //! `--overhead` measures the fork/join cost of a parallel region (behind the thresholds of
 //! `src/world/parallel.rs`). `--write-scenes` writes each scene as a scene file `DIR/NAME.toml` for
 //! `polydem run` (the initial state, before the warm-up; `end_time` = warm-up + steps): a file of 10^4
-//! polyhedra with their own hulls is ~6 MB, too large to keep in the repository, so the scenes are
+//! polyhedra with their own hulls is ~14 MB, too large to keep in the repository, so the scenes are
 //! generated on demand from this builder.
 //! The last two replace the parallel thresholds of the step ([`polydem::world::Parallelism`]; the results
 //! are the same bits either way), to re-measure them.

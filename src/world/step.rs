@@ -654,9 +654,13 @@ fn evaluate_loads(
             .ensure(world, store_changed, params.overlap_warning_fraction);
     }
     let loads = &mut world.loads;
-    loads.forces.clear();
+    let gather = parallel && rayon::current_num_threads() > 1;
+    if !gather {
+        // The scatter below adds into zeros; the gather writes every body's slot (no clearing pass).
+        loads.forces.clear();
+        loads.torques.clear();
+    }
     loads.forces.resize(n, Vector::zeros());
-    loads.torques.clear();
     loads.torques.resize(n, Vector::zeros());
     loads.wall_forces.clear();
     loads.wall_forces.resize(world.walls.len(), Vector::zeros());
@@ -667,7 +671,6 @@ fn evaluate_loads(
     // Forces and torques on the bodies, summed in candidate order: on one thread by a scatter over the
     // candidates (in the loop below: one sequential pass); on several per body over its pairs (the same
     // additions in the same order: the same bits; it reads each result twice, so it pays only in parallel).
-    let gather = parallel && rayon::current_num_threads() > 1;
     // The sums can wait for the pass of stages 7–8 when nothing reads the loads before it: no frozen
     // contributions to add, no prescribed body's power (below), no sleeping check (the caller's choice).
     scratch.deferred_gather =
