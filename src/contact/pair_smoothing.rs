@@ -146,6 +146,22 @@ impl Band {
         self.len = 0;
         self.spill.clear();
     }
+    /// Keeps the entries with depth > `floor`, in order.
+    fn retain_above(&mut self, floor: Real) {
+        if self.spill.is_empty() {
+            let mut kept = 0;
+            for k in 0..self.len {
+                if self.depths[k] > floor {
+                    self.depths[kept] = self.depths[k];
+                    self.index[kept] = self.index[k];
+                    kept += 1;
+                }
+            }
+            self.len = kept;
+        } else {
+            self.spill.retain(|e| e.0 > floor);
+        }
+    }
     fn push(&mut self, d: Real, i: u32) {
         if self.spill.is_empty() && self.len < self.depths.len() {
             self.depths[self.len] = d;
@@ -179,34 +195,54 @@ const WALK_MARGIN: Real = 1e-8;
 
 /// The band by a full scan: every i with depth(i) > deepest − 2h (deepest = max_i depth(i)) pushed into
 /// `band` in increasing index order; returns (deepest, the smallest index reaching it).
+///
+/// One pass: a vertex is kept when it lies within 2h of the running maximum, and the kept ones are
+/// filtered against the final maximum at the end. The running maximum never exceeds the final one (and
+/// x ↦ x − 2h is monotone in floating point), so every vertex of the band is kept, and the filter leaves
+/// exactly the band, in index order.
+///
+/// Stops with [`Found::Rejected`] as soon as a depth exceeds `reject_above`.
 fn band_by_scan(
     n: usize,
     depth: &impl Fn(usize) -> Real,
     h: Real,
+    reject_above: Real,
     band: &mut Band,
-) -> (Real, usize) {
+) -> Found {
     let mut deepest = Real::NEG_INFINITY;
     let mut arg = 0;
-    for i in 0..n {
-        let d = depth(i);
-        if d > deepest {
-            deepest = d;
-            arg = i;
-        }
-    }
     band.clear();
     for i in 0..n {
         let d = depth(i);
+        if d > deepest {
+            if d > reject_above {
+                return Found::Rejected;
+            }
+            deepest = d;
+            arg = i;
+        }
         if d > deepest - 2.0 * h {
             band.push(d, i as u32);
         }
     }
-    (deepest, arg)
+    band.retain_above(deepest - 2.0 * h);
+    Found::Band(deepest, arg)
+}
+
+/// What a band search found.
+enum Found {
+    /// The deepest depth and the smallest index reaching it; the band is in the [`Band`] buffer.
+    Band(Real, usize),
+    /// A vertex lies deeper than the rejection level (see [`smoothed_support`]).
+    Rejected,
+    /// The walk outgrew its buffers (the scan answers instead).
+    Overflow,
 }
 
 /// The band of [`band_by_scan`], the same values in the same order, found by walking the edge graph of
 /// `p` from vertex `*start` (any value accepted; left at the deepest vertex found, a warm start for the
-/// next call). `None` when the polytope or the explored set exceeds the walk's buffers (then scan).
+/// next call). [`Found::Overflow`] when the polytope or the explored set exceeds the walk's buffers (then
+/// scan); [`Found::Rejected`] as soon as a depth exceeds `reject_above`.
 ///
 /// 1. Hill-climb: move to a strictly deeper neighbour while there is one.
 /// 2. Explore from that vertex t (breadth-first over neighbours) every vertex with
@@ -224,19 +260,20 @@ fn band_by_scan(
 /// the computed depths (exact value ≥ computed − ε ≥ depth(t) − ε ≥ L) and every vertex within 2h of it
 /// (exact value > max − 2h − ε ≥ L). So the collected maximum is the scan's `deepest` (and its smallest
 /// index the scan's `arg`), and the kept set is the scan's band, whatever vertex the climb stopped at:
-/// the climb only keeps the explored set small. Tested against the scan on random hulls, the ogive
-/// projectile and tied directions (`band_walk_equals_the_scan_*`).
+/// the climb only keeps the explored set small. Tested against the definition on random hulls, the
+/// ogive projectile and tied directions (`band_scan_and_walk_equal_the_definition_*`).
 fn band_by_walk<P: Polytope + ?Sized>(
     p: &P,
     depth: &impl Fn(usize) -> Real,
     h: Real,
     margin: Real,
+    reject_above: Real,
     start: &mut u32,
     band: &mut Band,
-) -> Option<(Real, usize)> {
+) -> Found {
     let n = p.vertices().len();
     if n > 64 * WALK_MARK_WORDS {
-        return None;
+        return Found::Overflow;
     }
     let mut top = if (*start as usize) < n { *start } else { 0 };
     let mut d_top = depth(top as usize);
@@ -249,11 +286,14 @@ fn band_by_walk<P: Polytope + ?Sized>(
                 d_top = d;
             }
         }
+        *start = top;
+        if d_top > reject_above {
+            return Found::Rejected;
+        }
         if top == current {
             break;
         }
     }
-    *start = top;
     let floor = d_top - 2.0 * h - margin;
     let mut marks = [0u64; WALK_MARK_WORDS];
     let mut found = [(0u32, 0.0); WALK_CAPACITY];
@@ -270,8 +310,11 @@ fn band_by_walk<P: Polytope + ?Sized>(
             }
             let d = depth(k as usize);
             if d > floor {
+                if d > reject_above {
+                    return Found::Rejected;
+                }
                 if len == WALK_CAPACITY {
-                    return None;
+                    return Found::Overflow;
                 }
                 marks[word] |= bit;
                 found[len] = (k, d);
@@ -295,39 +338,55 @@ fn band_by_walk<P: Polytope + ?Sized>(
             band.push(d, k);
         }
     }
-    Some((deepest, arg))
-}
-
-/// How [`smoothed_support`] finds the band: a scan of all vertices, or a walk of the edge graph from a
-/// start vertex (updated to the deepest vertex found) with the margin of [`band_by_walk`].
-enum Search<'s> {
-    Scan,
-    Walk { start: &'s mut u32, margin: Real },
+    Found::Band(deepest, arg)
 }
 
 /// The smoothed depth of the vertex depths `depth(i)` (i over the vertices of `p`) and the weighted point
 /// Σ w_i x_i: (D, point, smoothed?). `smoothed` is false when one vertex leads by 2h (then D is its depth).
+///
+/// The band is found by a walk of the edge graph from `*start` ([`band_by_walk`], with its `margin`) when
+/// `walk` is `Some(margin)`, by a scan otherwise; `*start` is left at a deep vertex, a warm start for the
+/// next call. `None` when some vertex lies deeper than `reject_above`, checked first at `*start`: the
+/// caller sets it to reach + 2h + m, and D ≥ deepest − 2h (S_h ≥ the deepest depth: Newton climbs to it
+/// from there; S_2h < deepest + 2h: ψ vanishes beyond) up to round-off far below m, so such a candidate
+/// has D > reach and would be dropped anyway. Most face candidates that pass the cheap lower bound
+/// (the faces around a vertex that pokes into the other body) end here after one or a few dot products.
+#[allow(clippy::too_many_arguments)]
 fn smoothed_support<P: Polytope + ?Sized>(
     p: &P,
     depth: impl Fn(usize) -> Real,
     point: impl Fn(usize) -> Vector,
     h: Real,
-    search: Search<'_>,
+    start: &mut u32,
+    walk: Option<Real>,
+    reject_above: Real,
     band: &mut Band,
-) -> (Real, Vector, bool) {
-    let walked = match search {
-        Search::Walk { start, margin } => band_by_walk(p, &depth, h, margin, start, band),
-        Search::Scan => None,
+) -> Option<(Real, Vector, bool)> {
+    let n = p.vertices().len();
+    if (*start as usize) < n && depth(*start as usize) > reject_above {
+        return None;
+    }
+    let mut found = match walk {
+        Some(margin) => band_by_walk(p, &depth, h, margin, reject_above, start, band),
+        None => Found::Overflow,
     };
-    let (deepest, arg) =
-        walked.unwrap_or_else(|| band_by_scan(p.vertices().len(), &depth, h, band));
+    if let Found::Overflow = found {
+        found = band_by_scan(n, &depth, h, reject_above, band);
+    }
+    let (deepest, arg) = match found {
+        Found::Band(deepest, arg) => (deepest, arg),
+        Found::Rejected | Found::Overflow => return None,
+    };
+    if walk.is_none() {
+        *start = arg as u32;
+    }
     let count = if band.spill.is_empty() {
         band.len
     } else {
         band.spill.len()
     };
     if count <= 1 {
-        return (deepest, point(arg), false);
+        return Some((deepest, point(arg), false));
     }
     let (ds, idx): (Vec<Real>, Vec<u32>);
     let (ds, idx): (&[Real], &[u32]) = if band.spill.is_empty() {
@@ -352,7 +411,7 @@ fn smoothed_support<P: Polytope + ?Sized>(
     for (wi, &i) in w.iter().zip(idx) {
         c += point(i as usize) * *wi;
     }
-    (d, c, true)
+    Some((d, c, true))
 }
 
 /// The smoothed overlap of the module docs for an overlapping polyhedron pair, from the exact geometry
@@ -374,8 +433,8 @@ pub fn smooth_pair_overlap<A: Polytope + ?Sized, B: Polytope + ?Sized>(
     smooth_pair_overlap_by(pos1, a, pos2, b, exact, band, Some(starts))
 }
 
-/// [`smooth_pair_overlap`], walking the edge graphs from `starts` when given (and the polytope is large
-/// enough), scanning every vertex when `None`.
+/// [`smooth_pair_overlap`], walking the edge graphs from `starts` and rejecting deep candidates early when
+/// `starts` is given; with `None`, the reference: every vertex of every face candidate scanned.
 fn smooth_pair_overlap_by<A: Polytope + ?Sized, B: Polytope + ?Sized>(
     pos1: &Pose,
     a: &A,
@@ -410,6 +469,8 @@ fn smooth_pair_overlap_by<A: Polytope + ?Sized, B: Polytope + ?Sized>(
     let walk_a = starts.is_some() && va.len() >= WALK_MIN_VERTICES;
     let walk_b = starts.is_some() && vb.len() >= WALK_MIN_VERTICES;
     let [mut start_a, mut start_b] = starts.unwrap_or_default();
+    // Without starts (the reference of the tests): every face candidate's band in full, no early rejection.
+    let rejecting = starts.is_some();
     // Faces of A: B's vertices below the face plane.
     for f in 0..a.num_faces() {
         let n = a.face_normal(f);
@@ -419,22 +480,23 @@ fn smooth_pair_overlap_by<A: Polytope + ?Sized, B: Polytope + ?Sized>(
         }
         let u = rot12.inverse_transform_vector(&n);
         let s = o - n.dot(&t12);
-        let search = if walk_b {
-            Search::Walk {
-                start: &mut start_b,
-                margin: WALK_MARGIN * (s.abs() + b.bounding_radius()),
-            }
-        } else {
-            Search::Scan
-        };
-        let (d, c2, smoothed) = smoothed_support(
+        let margin = WALK_MARGIN * (s.abs() + b.bounding_radius());
+        let Some((d, c2, smoothed)) = smoothed_support(
             b,
             |j| s - u.dot(&vb[j].coords),
             |j| rot12 * vb[j].coords + t12,
             h,
-            search,
+            &mut start_b,
+            walk_b.then_some(margin),
+            if rejecting {
+                reach + 2.0 * h + margin
+            } else {
+                Real::INFINITY
+            },
             &mut band_buf,
-        );
+        ) else {
+            continue;
+        };
         if d > reach {
             continue;
         }
@@ -459,22 +521,23 @@ fn smooth_pair_overlap_by<A: Polytope + ?Sized, B: Polytope + ?Sized>(
         }
         let m = rot12 * m_b;
         let s = o_b + m.dot(&t12);
-        let search = if walk_a {
-            Search::Walk {
-                start: &mut start_a,
-                margin: WALK_MARGIN * (s.abs() + a.bounding_radius()),
-            }
-        } else {
-            Search::Scan
-        };
-        let (d, c1, smoothed) = smoothed_support(
+        let margin = WALK_MARGIN * (s.abs() + a.bounding_radius());
+        let Some((d, c1, smoothed)) = smoothed_support(
             a,
             |i| s - m.dot(&va[i].coords),
             |i| va[i].coords,
             h,
-            search,
+            &mut start_a,
+            walk_a.then_some(margin),
+            if rejecting {
+                reach + 2.0 * h + margin
+            } else {
+                Real::INFINITY
+            },
             &mut band_buf,
-        );
+        ) else {
+            continue;
+        };
         if d > reach {
             continue;
         }
@@ -733,12 +796,44 @@ mod tests {
         shapes
     }
 
-    /// The band walk finds the scan's band — the same vertices, depths, order, deepest depth and deepest
-    /// index, bit for bit — on every shape of [`walk_shapes`], for random directions, directions along face
-    /// normals and edges (exact ties of two or more vertices), bands from 0 to 0.3 of the size, and random
-    /// start vertices (including out-of-range ones).
+    /// The band as defined (two passes: the deepest depth, then every vertex within 2h of it, in index
+    /// order), as (depth bits, vertex) pairs.
+    fn band_by_definition(
+        n: usize,
+        depth: &impl Fn(usize) -> Real,
+        h: Real,
+    ) -> (Real, usize, Vec<(u64, u32)>) {
+        let mut deepest = Real::NEG_INFINITY;
+        let mut arg = 0;
+        for i in 0..n {
+            if depth(i) > deepest {
+                deepest = depth(i);
+                arg = i;
+            }
+        }
+        let band = (0..n)
+            .filter(|&i| depth(i) > deepest - 2.0 * h)
+            .map(|i| (depth(i).to_bits(), i as u32))
+            .collect();
+        (deepest, arg, band)
+    }
+
+    fn entries(b: &Band) -> Vec<(u64, u32)> {
+        if b.spill.is_empty() {
+            (0..b.len)
+                .map(|i| (b.depths[i].to_bits(), b.index[i]))
+                .collect()
+        } else {
+            b.spill.iter().map(|e| (e.0.to_bits(), e.1)).collect()
+        }
+    }
+
+    /// The one-pass scan and the band walk find the band of its definition — the same vertices, depths,
+    /// order, deepest depth and deepest index, bit for bit — on every shape of [`walk_shapes`], for random
+    /// directions, directions along face normals and edges (exact ties of two or more vertices), bands from
+    /// 0 to 0.3 of the size, and random start vertices (including out-of-range ones).
     #[test]
-    fn band_walk_equals_the_scan_on_random_hulls_and_tied_directions() {
+    fn band_scan_and_walk_equal_the_definition_on_random_hulls_and_tied_directions() {
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(29);
         let shapes = walk_shapes(&mut rng);
         let (mut compared, mut multi, mut overflow) = (0usize, 0usize, 0usize);
@@ -762,26 +857,31 @@ mod tests {
                     let h = rel_h * l;
                     let s = rng.random_range(-1.0..1.0) * l;
                     let depth = |j: usize| s - u.dot(&p.vertices()[j].coords);
+                    let (d_ref, arg_ref, band_ref) = band_by_definition(n, &depth, h);
                     let mut scan = Band::new();
-                    let (d_scan, arg_scan) = band_by_scan(n, &depth, h, &mut scan);
+                    let Found::Band(d_scan, arg_scan) =
+                        band_by_scan(n, &depth, h, Real::INFINITY, &mut scan)
+                    else {
+                        panic!("the scan without a rejection level always finds the band");
+                    };
+                    assert!(
+                        d_scan.to_bits() == d_ref.to_bits()
+                            && arg_scan == arg_ref
+                            && entries(&scan) == band_ref,
+                        "shape {k} ({n} vertices), direction {u:?}, s = {s}, h = {h}: one-pass scan \
+                         (deepest {d_scan:e}, vertex {arg_scan}, band {:?}) against the definition \
+                         (deepest {d_ref:e}, vertex {arg_ref}, band {band_ref:?}); expected identical",
+                        entries(&scan)
+                    );
                     let mut start = rng.random_range(0..n as u32 + 3);
                     let start_in = start;
                     let margin = WALK_MARGIN * (s.abs() + p.bounding_radius());
                     let mut walk = Band::new();
-                    let Some((d_walk, arg_walk)) =
-                        band_by_walk(p, &depth, h, margin, &mut start, &mut walk)
+                    let Found::Band(d_walk, arg_walk) =
+                        band_by_walk(p, &depth, h, margin, Real::INFINITY, &mut start, &mut walk)
                     else {
                         overflow += 1;
                         continue;
-                    };
-                    let entries = |b: &Band| -> Vec<(u64, u32)> {
-                        if b.spill.is_empty() {
-                            (0..b.len)
-                                .map(|i| (b.depths[i].to_bits(), b.index[i]))
-                                .collect()
-                        } else {
-                            b.spill.iter().map(|e| (e.0.to_bits(), e.1)).collect()
-                        }
                     };
                     let (es, ew) = (entries(&scan), entries(&walk));
                     assert!(
@@ -806,11 +906,13 @@ mod tests {
         );
     }
 
-    /// The smoothed overlap by band walks equals the one by scans, bit for bit, on random overlapping pairs
-    /// of the shapes of [`walk_shapes`] (pairs with the projectile included), with bands of 1e-4 and 1e-2 of
-    /// the size (the larger one puts ties in the band often), from random start vertices.
+    /// The smoothed overlap as computed in production (band walks on hulls of more than 16 vertices, early
+    /// rejection of deep candidates, warm starts) equals the reference that scans every vertex of every face
+    /// candidate, bit for bit, on random overlapping pairs of the shapes of [`walk_shapes`] (pairs with the
+    /// projectile included), with bands of 1e-4 and 1e-2 of the size (the larger one puts ties in the band
+    /// often), from random start vertices.
     #[test]
-    fn smoothed_overlap_by_walk_equals_the_scan_on_random_pairs() {
+    fn smoothed_overlap_by_walks_and_early_rejection_equals_the_full_scan_on_random_pairs() {
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(31);
         let shapes = walk_shapes(&mut rng);
         let (mut overlapping, mut smoothed) = (0usize, 0usize);

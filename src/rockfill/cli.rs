@@ -272,6 +272,17 @@ pub fn summary(config: &ExperimentConfig, r: &ExperimentResult) -> String {
             p.ledger_balance_relative[2],
             p.wall_time.as_secs_f64()
         );
+        for (stage, c) in ["deposition", "compaction", "hold"].iter().zip(&p.counters) {
+            let time = c.total_time().as_secs_f64();
+            let _ = writeln!(
+                s,
+                "  {stage}: {:.3e} rock-steps/s in the step's stages ({:.1} s), {:.2} contacts per rock\n    {}",
+                (c.steps as f64 * p.rocks as f64) / time,
+                time,
+                c.contacts as f64 / (c.steps.max(1) as f64 * p.rocks as f64),
+                indent(&c.to_string()).trim_start().replace('\n', "\n  ")
+            );
+        }
     }
     let pr = &r.projectile;
     let _ = writeln!(

@@ -46,7 +46,7 @@ use crate::math::{Point, Pose, Real, Rotation, Vector};
 use crate::scene::time_step::{contact_time_and_limit, PairEstimate};
 use crate::shape::{ConvexPolyhedron, Plane, Shape, ShapeError};
 use crate::world::{
-    step, MaterialTable, StepError, StepParams, StepScratch, Wall, World, WorldError,
+    step, MaterialTable, StepCounters, StepError, StepParams, StepScratch, Wall, World, WorldError,
 };
 
 /// Material ids of the experiment's world.
@@ -251,6 +251,8 @@ pub struct PackingReport {
     /// energy of the rocks relative to the floor.
     pub ledger_balance_relative: [Real; 3],
     pub wall_time: Duration,
+    /// The step's stage timers and counters summed over deposition, compaction and hold.
+    pub counters: [StepCounters; 3],
 }
 
 /// Builds the loose world from `rocks` (container top at `top`).
@@ -298,16 +300,21 @@ pub fn pack(
         .iter()
         .map(|b| b.mass * 9.81 * b.position.z)
         .sum();
-    let mut run = |world: &mut World, report: &mut PackingReport| -> Result<(), PackingError> {
-        let r = step(&params, world, &mut scratch)?;
-        report.max_overlap_ratio = report.max_overlap_ratio.max(r.max_overlap_ratio);
-        Ok(())
-    };
+    const DEPOSITION: usize = 0;
+    const COMPACTION: usize = 1;
+    const HOLD: usize = 2;
+    let mut run =
+        |world: &mut World, report: &mut PackingReport, stage: usize| -> Result<(), PackingError> {
+            let r = step(&params, world, &mut scratch)?;
+            report.max_overlap_ratio = report.max_overlap_ratio.max(r.max_overlap_ratio);
+            report.counters[stage].merge(&r.counters);
+            Ok(())
+        };
     // 1. Deposition.
     let fall_time = (2.0 * initial_top / 9.81).sqrt();
     let check_every = 100;
     loop {
-        run(world, &mut report)?;
+        run(world, &mut report, DEPOSITION)?;
         report.deposition_steps += 1;
         let t = world.time;
         if report.deposition_steps.is_multiple_of(check_every) {
@@ -335,7 +342,7 @@ pub fn pack(
             let force = world.loads.wall_forces.get(TOP_WALL).map_or(0.0, |f| f.z);
             let fraction = (1.0 - force / force_cap).clamp(0.0, 1.0);
             world.walls[TOP_WALL].velocity = Vector::new(0.0, 0.0, -p.compaction_speed * fraction);
-            run(world, &mut report)?;
+            run(world, &mut report, COMPACTION)?;
             report.compaction_steps += 1;
             if report.compaction_steps.is_multiple_of(check_every) {
                 progress("compaction", world.time, top_wall_height(world));
@@ -357,7 +364,7 @@ pub fn pack(
     // 3. Hold.
     let hold_end = world.time + p.hold_time;
     while world.time < hold_end {
-        run(world, &mut report)?;
+        run(world, &mut report, HOLD)?;
         report.hold_steps += 1;
         if report.hold_steps.is_multiple_of(check_every) {
             progress("hold", world.time, bed_top(world));
