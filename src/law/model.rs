@@ -66,6 +66,10 @@ pub struct ContactResponse {
     pub tangential_stiffness_work: Real,
     /// True when the Coulomb cap was active.
     pub sliding: bool,
+    /// The spring of the last evaluation rotated into this evaluation's tangent plane (u_prev of
+    /// [`super::tangential`], m), as the tangential law formed it; `None` without a tangential law. The
+    /// energy ledger books the last spring force along it (see [`crate::world::energy`]).
+    pub previous_displacement: Option<Vector>,
 }
 
 impl ContactModel {
@@ -109,8 +113,18 @@ impl ContactModel {
             tangential_power,
             dashpot_force,
             tangential_stiffness_work,
+            previous_displacement,
         ) = match self.tangential {
-            TangentialLaw::None => (Vector::zeros(), 0.0, 0.0, false, 0.0, Vector::zeros(), 0.0),
+            TangentialLaw::None => (
+                Vector::zeros(),
+                0.0,
+                0.0,
+                false,
+                0.0,
+                Vector::zeros(),
+                0.0,
+                None,
+            ),
             law => {
                 let (stiffness, friction) = law.stiffness_and_friction(overlap);
                 let dashpot = match law {
@@ -138,6 +152,7 @@ impl ContactModel {
                     r.damping_power,
                     r.damping_force,
                     r.stiffness_work,
+                    Some(r.previous_displacement),
                 )
             }
         };
@@ -156,6 +171,7 @@ impl ContactModel {
             friction_dissipation,
             tangential_stiffness_work,
             sliding,
+            previous_displacement,
         }
     }
 }

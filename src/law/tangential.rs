@@ -149,6 +149,9 @@ pub struct TangentialResponse {
     /// Work of the stiffness change in this step, ½ (k_t − k_t,prev) u_prev·u_trial (J, either sign; zero
     /// for a constant k_t; see the module docs).
     pub stiffness_work: Real,
+    /// u_prev: the stored displacement rotated into the current tangent plane (m), before this step's
+    /// increment.
+    pub previous_displacement: Vector,
 }
 
 /// Rotates the displacement `u` expressed against `old_normal` into the plane perpendicular to `new_normal`
@@ -260,6 +263,7 @@ pub fn incremental_spring_damped(
         damping_power,
         damping_force,
         stiffness_work,
+        previous_displacement: u_previous,
     }
 }
 

@@ -214,7 +214,11 @@ impl ContactWork {
         let h = &previous.history;
         let mut friction = response.friction_dissipation;
         if h.stiffness != 0.0 && h.displacement != Vector::zeros() {
-            let u_previous = rotate_into_tangent_plane(&h.displacement, &h.normal, normal);
+            // The law rotated the same spring into the same plane (the same bits); a model without a
+            // tangential law did not.
+            let u_previous = response
+                .previous_displacement
+                .unwrap_or_else(|| rotate_into_tangent_plane(&h.displacement, &h.normal, normal));
             let v_t = relative_velocity - normal * relative_velocity.dot(normal);
             let assumed = -0.5 * dt * h.stiffness * u_previous.dot(&v_t);
             let applied = 0.5 * dt * previous.spring_force().dot(previous_velocity);

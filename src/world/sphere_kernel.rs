@@ -11,8 +11,9 @@
 //!   [`contact_sphere_sphere`] / [`contact_plane_sphere`], with the same arguments as the general
 //!   narrow phase;
 //! - for an overlapping pair, the kinematics (v_B − v_A at the contact point, m*, centres) and the model
-//!   scaled by √R* from the two radii ([`ContactModel::for_contact_radii`]), then the same end of stage 5
-//!   as every other pair ([`super::step::overlap_law`]);
+//!   scaled by √R* from the two radii ([`crate::law::ContactModel::for_contact_radii`]), then the same end of stage 5
+//!   as every other pair ([`super::step::overlap_law`]), the ledger's velocity at the last contact point
+//!   also from the gathered records;
 //! - for a pair that does not overlap, the general stage 5 ([`super::step::contact_law`]).
 //!
 //! Every value is computed by the same operations in the same order as the general path, so the path is
@@ -90,6 +91,13 @@ impl SphereBody {
     fn velocity_at(&self, point: &Point) -> Vector {
         self.velocity + self.omega.cross(&(point - self.position))
     }
+
+    /// Velocity (m/s) at `point` with the lever arm from the centre `back` seconds earlier (x − back·v):
+    /// [`super::step`]'s `PairInputs::relative_velocity` for one side.
+    #[inline]
+    fn velocity_back_at(&self, point: &Point, back: Real) -> Vector {
+        self.velocity_at(&(point + back * self.velocity))
+    }
 }
 
 /// Stages 4–5 for `key` if both its sides are spheres or a wall and a sphere: `Some` with the result of
@@ -164,11 +172,14 @@ pub(super) fn evaluate(
                 dt: pair.dt,
             };
             let scale = sa.length_scale.min(sb.length_scale);
+            let dt = pair.dt;
             overlap_law(
                 pair,
-                key,
                 state,
-                previous_point,
+                || {
+                    sb.velocity_back_at(previous_point, dt)
+                        - sa.velocity_back_at(previous_point, dt)
+                },
                 &model,
                 &kinematics,
                 scale,
@@ -224,11 +235,11 @@ pub(super) fn evaluate(
                 center_b: s.position,
                 dt: pair.dt,
             };
+            let dt = pair.dt;
             overlap_law(
                 pair,
-                key,
                 state,
-                previous_point,
+                || s.velocity_back_at(previous_point, dt) - w.velocity,
                 &model,
                 &kinematics,
                 s.length_scale,

@@ -1096,9 +1096,8 @@ pub(super) fn contact_law(
     let model = model.for_shapes(a_body.map(|a| world.shape(a)), world.shape(b));
     overlap_law(
         pair,
-        key,
         state,
-        previous_point,
+        || pair.relative_velocity(key, previous_point, pair.dt),
         &model,
         &kinematics,
         scale,
@@ -1109,13 +1108,13 @@ pub(super) fn contact_law(
 
 /// The end of stage 5 for an overlapping candidate whose model (with the pair's stiffnesses), kinematics
 /// and length scale (the smaller particle's) are known: the law, the ledger terms, the stored forces.
-#[allow(clippy::too_many_arguments)]
+/// `previous_velocity` gives v_B − v_A at the last contact point with the last lever arms (called only
+/// when the ledger books the last forces: [`PairInputs::relative_velocity`] with `back` = Δt).
 #[inline]
 pub(super) fn overlap_law(
     pair: &PairInputs,
-    key: ContactKey,
     state: &mut ContactState,
-    previous_point: &Point,
+    previous_velocity: impl FnOnce() -> Vector,
     model: &ContactModel,
     kinematics: &ContactKinematics,
     scale: Real,
@@ -1139,10 +1138,9 @@ pub(super) fn overlap_law(
         ContactWork::of_new_contact(&response, &kinematics.relative_velocity, pair.dt)
     } else {
         // The last forces were applied with the lever arms of the last contact point.
-        let previous_velocity = pair.relative_velocity(key, previous_point, pair.dt);
         ContactWork::of_evaluation(
             &previous,
-            &previous_velocity,
+            &previous_velocity(),
             &g.normal,
             &response,
             &kinematics.relative_velocity,
