@@ -21,10 +21,12 @@
 //! (`tests/world_sphere_fast_paths.rs`, `tests/world_skips.rs`).
 
 use crate::contact::{contact_plane_sphere, contact_sphere_sphere, ContactKind};
+use crate::dynamics::body::RigidBody;
 use crate::dynamics::rotation::is_isotropic;
 use crate::law::ContactKinematics;
 use crate::math::{Point, Real, Vector};
 use crate::shape::Shape;
+use rayon::prelude::*;
 
 use super::contact_store::{ContactKey, ContactState};
 use super::parallel::Worker;
@@ -55,12 +57,17 @@ pub(super) struct SphereBody {
 
 /// Fills `out` with one [`SphereBody`] per body of `world`; `isotropic` is the `isotropic_rotation` skip.
 /// Returns whether some body is a sphere (otherwise the kernel has nothing to do).
-pub(super) fn gather(world: &World, isotropic: bool, out: &mut Vec<SphereBody>) -> bool {
+pub(super) fn gather(
+    world: &World,
+    isotropic: bool,
+    parallel: bool,
+    out: &mut Vec<SphereBody>,
+) -> bool {
     out.clear();
     if !world.shapes.iter().any(|s| matches!(s, Shape::Sphere(_))) {
         return false;
     }
-    out.extend(world.bodies.iter().enumerate().map(|(i, body)| {
+    let one = |(i, body): (usize, &RigidBody)| {
         let Shape::Sphere(sphere) = world.shape(i) else {
             return SphereBody::default();
         };
@@ -81,7 +88,15 @@ pub(super) fn gather(world: &World, isotropic: bool, out: &mut Vec<SphereBody>) 
             sphere: true,
             dynamic: body.is_dynamic(),
         }
-    }));
+    };
+    // One slot per body, each a function of that body alone: the same slots on any number of threads
+    // (an indexed parallel extend keeps the order). On many threads this pass would otherwise be a serial
+    // part of every step of a large bed.
+    if parallel {
+        out.par_extend(world.bodies.par_iter().enumerate().map(one));
+    } else {
+        out.extend(world.bodies.iter().enumerate().map(one));
+    }
     true
 }
 

@@ -565,6 +565,8 @@ fn evaluate_loads(
         && sphere_kernel::gather(
             world_ref,
             params.skips.isotropic_rotation,
+            world_ref.bodies.len() >= params.parallel.min_bodies
+                && rayon::current_num_threads() > 1,
             &mut scratch.spheres,
         ))
     .then_some(scratch.spheres.as_slice());
