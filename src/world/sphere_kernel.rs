@@ -20,7 +20,9 @@
 //! exact: bodies, loads, ledger and contact store are the same bits with the `sphere_kernel` skip on or off
 //! (`tests/world_sphere_fast_paths.rs`, `tests/world_skips.rs`).
 
-use crate::contact::{contact_plane_sphere, contact_sphere_sphere, ContactKind};
+use crate::contact::{
+    contact_plane_sphere, contact_sphere_sphere, ContactGeometry, ContactKind, QueryCounters,
+};
 use crate::dynamics::body::RigidBody;
 use crate::dynamics::rotation::is_isotropic;
 use crate::law::ContactKinematics;
@@ -115,6 +117,21 @@ impl SphereBody {
     }
 }
 
+/// A candidate's geometry: the bounding-sphere rejection's when there is one, else the closed form's
+/// (`query` counts its kind), recorded in the counters.
+#[inline]
+fn rejected_or(
+    rejected: Option<ContactGeometry>,
+    counters: &mut QueryCounters,
+    query: impl FnOnce(&mut QueryCounters) -> ContactGeometry,
+) -> ContactGeometry {
+    rejected.unwrap_or_else(|| {
+        let g = query(counters);
+        counters.record(&g);
+        g
+    })
+}
+
 /// Stages 4–5 for `key` if both its sides are spheres or a wall and a sphere: `Some` with the result of
 /// the stage (written to `state` and `out` as the general path writes them), `None` for any other pair.
 /// `previous_point` is the contact point of the pair's last evaluation.
@@ -151,21 +168,10 @@ pub(super) fn evaluate(
             } else {
                 None
             };
-            state.geometry = match rejected {
-                Some(g) => g,
-                None => {
-                    counters.sphere_sphere += 1;
-                    let g = contact_sphere_sphere(
-                        &sa.position,
-                        sa.radius,
-                        &sb.position,
-                        sb.radius,
-                        tol,
-                    );
-                    counters.record(&g);
-                    g
-                }
-            };
+            state.geometry = rejected_or(rejected, counters, |c| {
+                c.sphere_sphere += 1;
+                contact_sphere_sphere(&sa.position, sa.radius, &sb.position, sb.radius, tol)
+            });
             if state.geometry.kind != ContactKind::Overlap {
                 return Some(contact_law(pair, key, state, previous_point, out));
             }
@@ -219,22 +225,17 @@ pub(super) fn evaluate(
             } else {
                 None
             };
-            state.geometry = match rejected {
-                Some(g) => g,
-                None => {
-                    counters.sphere_plane += 1;
-                    let g = contact_plane_sphere(
-                        &w.pose,
-                        w.plane.normal(),
-                        w.plane.offset(),
-                        &s.position,
-                        s.radius,
-                        tol,
-                    );
-                    counters.record(&g);
-                    g
-                }
-            };
+            state.geometry = rejected_or(rejected, counters, |c| {
+                c.sphere_plane += 1;
+                contact_plane_sphere(
+                    &w.pose,
+                    w.plane.normal(),
+                    w.plane.offset(),
+                    &s.position,
+                    s.radius,
+                    tol,
+                )
+            });
             if state.geometry.kind != ContactKind::Overlap {
                 return Some(contact_law(pair, key, state, previous_point, out));
             }
