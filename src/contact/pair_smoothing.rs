@@ -471,6 +471,14 @@ fn smooth_pair_overlap_by<A: Polytope + ?Sized, B: Polytope + ?Sized>(
     let [mut start_a, mut start_b] = starts.unwrap_or_default();
     // Without starts (the reference of the tests): every face candidate's band in full, no early rejection.
     let rejecting = starts.is_some();
+    // A candidate is dropped once a vertex lies deeper than this: its smoothed depth cannot win then.
+    let reject_beyond = |margin: Real| {
+        if rejecting {
+            reach + 2.0 * h + margin
+        } else {
+            Real::INFINITY
+        }
+    };
     // Faces of A: B's vertices below the face plane.
     for f in 0..a.num_faces() {
         let n = a.face_normal(f);
@@ -488,11 +496,7 @@ fn smooth_pair_overlap_by<A: Polytope + ?Sized, B: Polytope + ?Sized>(
             h,
             &mut start_b,
             walk_b.then_some(margin),
-            if rejecting {
-                reach + 2.0 * h + margin
-            } else {
-                Real::INFINITY
-            },
+            reject_beyond(margin),
             &mut band_buf,
         ) else {
             continue;
@@ -529,11 +533,7 @@ fn smooth_pair_overlap_by<A: Polytope + ?Sized, B: Polytope + ?Sized>(
             h,
             &mut start_a,
             walk_a.then_some(margin),
-            if rejecting {
-                reach + 2.0 * h + margin
-            } else {
-                Real::INFINITY
-            },
+            reject_beyond(margin),
             &mut band_buf,
         ) else {
             continue;
