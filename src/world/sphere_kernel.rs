@@ -321,9 +321,5 @@ fn lean_overlap_law(
     let response = model.evaluate_inlined(g, kinematics, history);
     *force_on_b = response.force_on_b;
     *damping_force = response.damping_force;
-    out.set_overlapping(
-        &response,
-        g.depth,
-        g.depth / scale,
-    );
+    out.set_overlapping(&response, g.depth, g.depth / scale);
 }
