@@ -214,8 +214,32 @@ impl BroadPhase {
         self.walls_at_build.clear();
         self.walls_at_build
             .extend(walls.iter().map(|w| w.pose.translation.vector));
+        let skin = self.skin;
         self.wall_pairs = region_profile::serial(Section::SerialGrid, || {
-            brute_force_wall_pairs(centres, radii, walls, self.skin)
+            if centres.len() >= PARALLEL_SEARCH_MIN_BODIES && rayon::current_num_threads() > 1 {
+                // The same test per body, bodies in parallel chunks concatenated in body order: the
+                // list of the serial definition.
+                use rayon::prelude::*;
+                let chunk = centres
+                    .len()
+                    .div_ceil(rayon::current_num_threads() * super::parallel::CHUNKS_PER_THREAD);
+                let found: Vec<Vec<Pair>> = centres
+                    .par_chunks(chunk)
+                    .zip(radii.par_chunks(chunk))
+                    .with_max_len(1)
+                    .enumerate()
+                    .map(|(k, (c, r))| {
+                        let mut out = brute_force_wall_pairs(c, r, walls, skin);
+                        for pair in &mut out {
+                            pair.0 += (k * chunk) as u32;
+                        }
+                        out
+                    })
+                    .collect();
+                found.concat()
+            } else {
+                brute_force_wall_pairs(centres, radii, walls, skin)
+            }
         });
         self.generation = fresh_generation();
     }
@@ -258,18 +282,26 @@ impl BroadPhase {
 
         // Cell ranges of every body's inflated box.
         self.body_cells.clear();
-        self.body_cells
-            .extend(centres.iter().zip(radii).map(|(c, &r)| {
-                // Widened by a relative 1e-9 so that rounding can never drop a pair the sphere test would keep:
-                // extra cells only cost a test, a missing cell would lose a contact.
-                let reach = (r + half_skin) * (1.0 + 1e-9);
-                let mut range = CellRange::default();
-                for axis in 0..3 {
-                    range.lo[axis] = grid.coord(c[axis] - reach, axis);
-                    range.hi[axis] = grid.coord(c[axis] + reach, axis);
-                }
-                range
-            }));
+        let cells_of = |(c, &r): (&Point, &Real)| {
+            // Widened by a relative 1e-9 so that rounding can never drop a pair the sphere test would keep:
+            // extra cells only cost a test, a missing cell would lose a contact.
+            let reach = (r + half_skin) * (1.0 + 1e-9);
+            let mut range = CellRange::default();
+            for axis in 0..3 {
+                range.lo[axis] = grid.coord(c[axis] - reach, axis);
+                range.hi[axis] = grid.coord(c[axis] + reach, axis);
+            }
+            range
+        };
+        if centres.len() >= PARALLEL_SEARCH_MIN_BODIES && rayon::current_num_threads() > 1 {
+            // One range per body, in body order (an indexed parallel extend).
+            use rayon::prelude::*;
+            self.body_cells
+                .par_extend(centres.par_iter().zip(radii.par_iter()).map(cells_of));
+        } else {
+            self.body_cells
+                .extend(centres.iter().zip(radii).map(cells_of));
+        }
 
         // Counting sort of (cell, body) entries into CSR form: cell_bodies[cell_start[k]..cell_start[k+1]].
         let num_cells = (grid.dims[0] * grid.dims[1] * grid.dims[2]) as usize;
@@ -555,7 +587,37 @@ mod tests {
                 .build()
                 .expect("pool")
                 .install(|| {
-                    assert_matches_oracle(&format!("{threads} threads"), &centres, &radii, 0.01)
+                    assert_matches_oracle(&format!("{threads} threads"), &centres, &radii, 0.01);
+                    // The body–wall list of a build with walls (bodies in parallel chunks above the
+                    // threshold) is the serial definition's.
+                    let walls: Vec<Wall> = [
+                        (Vector::z(), 0.3),
+                        (-Vector::x(), -3.7),
+                        (Vector::new(1.0, 1.0, 0.0).normalize(), 0.9),
+                    ]
+                    .iter()
+                    .map(|&(normal, offset)| Wall {
+                        name: "w".to_owned(),
+                        plane: crate::shape::Plane::new(normal, offset).expect("plane"),
+                        pose: crate::math::Pose::identity(),
+                        velocity: Vector::zeros(),
+                        material: 0,
+                    })
+                    .collect();
+                    let mut broad = BroadPhase::new(0.01);
+                    broad.rebuild_with_walls(&centres, &radii, &walls);
+                    let expected = brute_force_wall_pairs(&centres, &radii, &walls, 0.01);
+                    assert!(
+                        expected.len() > 100,
+                        "only {} body-wall pairs: the walls test nothing",
+                        expected.len()
+                    );
+                    assert!(
+                        broad.wall_pairs() == expected.as_slice(),
+                        "{threads} threads: {} body-wall pairs against {} of the serial definition",
+                        broad.wall_pairs().len(),
+                        expected.len()
+                    );
                 });
         }
     }
