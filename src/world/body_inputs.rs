@@ -3,9 +3,10 @@
 //!
 //! Per body the drift pass writes the centre (the broad phase's input) and a byte of flags: dynamic,
 //! anisotropic (unequal principal moments: the integration's cost), prescribed motion (the ledger's
-//! external power), and whether the centre moved half the skin since the last grid build (the Verlet
-//! rebuild test of [`super::broad_phase::BroadPhase::needs_rebuild`], the same comparison). Stage 3 then
-//! folds the bytes serially (a few µs for 10⁴ bodies) instead of reading every rigid body.
+//! external power), and whether the centre moved half the skin since the last grid build (the comparison
+//! of [`super::broad_phase::BroadPhase::needs_rebuild`]; only then can the two largest moves reach the
+//! skin, and stage 3 runs the exact test [`super::broad_phase::BroadPhase::pairs_may_be_stale`]). Stage 3
+//! then folds the bytes serially (a few µs for 10⁴ bodies) instead of reading every rigid body.
 //!
 //! The candidate list (the broad phase's pairs with a dynamic side, then the body–wall pairs of dynamic
 //! bodies) depends only on the broad phase's lists and the dynamic flags: it is rebuilt only when the grid

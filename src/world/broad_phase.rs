@@ -4,7 +4,9 @@
 //! invalidate the list). Two bodies are a candidate pair when their spheres, each inflated by half the skin,
 //! overlap: `|x_i − x_j| < r_i + r_j + skin`. The list stays valid — it contains every pair that can touch —
 //! until some body has moved more than `skin / 2` from where it was at the last rebuild, so the grid is rebuilt
-//! only then ([`BroadPhase::needs_rebuild`]).
+//! only then ([`BroadPhase::needs_rebuild`]). The step uses the sharper test of the two largest moves
+//! ([`BroadPhase::pairs_may_be_stale`]: valid while d₁ + d₂ < skin), which lets one fast body travel nearly
+//! the whole skin.
 //!
 //! The grid's cell size is the median inflated diameter, so a typical body covers one to eight cells; a body
 //! much larger than its neighbours (a 0.8 m projectile among 0.1 m rocks) is simply entered in every cell
@@ -177,6 +179,42 @@ impl BroadPhase {
             .iter()
             .zip(&self.centres_at_build)
             .any(|(now, then)| (now - then).norm_squared() >= limit_sq)
+    }
+
+    /// Whether the pair lists may miss a pair that touches now, by the sharper test of two movers: a pair
+    /// left out at the build had its spheres at least `skin` apart (a body and a wall: the body's sphere at
+    /// least `skin` from the plane), and that gap shrinks by at most the sum of the two displacements, so
+    /// the lists hold every touching pair while the two largest body displacements d₁ ≥ d₂ and the largest
+    /// wall translation w₁ since the build give d₁ + max(d₂, w₁) < skin (taken with a relative margin of
+    /// 1e-9 against rounding). [`needs_rebuild`](Self::needs_rebuild) asks every body to stay within half
+    /// the skin, which implies it; this test lets one fast body (a projectile among resting rocks) travel
+    /// nearly the whole skin between builds, so the grid is rebuilt about half as often. `centres` must hold
+    /// one centre per body of the last build.
+    pub fn pairs_may_be_stale(&self, centres: &[Point], walls: &[Wall]) -> bool {
+        if centres.len() != self.centres_at_build.len()
+            || walls.len() != self.walls_at_build.len()
+            || self.rebuilds == 0
+        {
+            return true;
+        }
+        let (mut d1, mut d2) = (0.0, 0.0);
+        for (now, then) in centres.iter().zip(&self.centres_at_build) {
+            let d_sq: Real = (now - then).norm_squared();
+            if d_sq > d2 {
+                if d_sq > d1 {
+                    d2 = d1;
+                    d1 = d_sq;
+                } else {
+                    d2 = d_sq;
+                }
+            }
+        }
+        let w1 = walls
+            .iter()
+            .zip(&self.walls_at_build)
+            .map(|(w, then)| (w.pose.translation.vector - then).norm_squared())
+            .fold(0.0, Real::max);
+        d1.sqrt() + d2.max(w1).sqrt() >= self.skin * (1.0 - 1e-9)
     }
 
     /// The body–wall candidates `(body, wall)` of the last [`update_with_walls`](Self::update_with_walls),
@@ -736,6 +774,47 @@ mod tests {
         assert_eq!(
             broad.wall_pairs(),
             brute_force_wall_pairs(&centres, &radii, &walls, skin).as_slice()
+        );
+    }
+
+    #[test]
+    fn one_fast_body_may_travel_nearly_the_skin_and_the_list_still_holds_every_touching_pair() {
+        let (mut centres, radii) = random_scene(4, 600, 1.0, 0.04, 0.06);
+        let skin = 0.02;
+        let mut broad = BroadPhase::new(skin);
+        broad.rebuild_with_walls(&centres, &radii, &[]);
+        let mut rng = SplitMix(17);
+        // Body 42 moves 0.9 skin, every other body 0.09 skin, each in a seeded direction: 0.99 skin in all.
+        for (i, c) in centres.iter_mut().enumerate() {
+            let d = Vector::new(
+                rng.uniform(-1.0, 1.0),
+                rng.uniform(-1.0, 1.0),
+                rng.uniform(-1.0, 1.0),
+            )
+            .normalize();
+            *c += d * if i == 42 { 0.9 } else { 0.09 } * skin;
+        }
+        assert!(
+            broad.needs_rebuild(&centres),
+            "0.9 skin exceeds the half-skin rule"
+        );
+        assert!(
+            !broad.pairs_may_be_stale(&centres, &[]),
+            "moves of 0.9 and 0.09 skin (sum 0.99) must keep the lists"
+        );
+        // Every pair that can touch now (no skin), also with the shifted spheres inflated by 0.01 skin,
+        // is in the kept list.
+        for (i, j) in brute_force_pairs(&centres, &radii, 0.01 * skin) {
+            assert!(
+                broad.pairs().binary_search(&(i, j)).is_ok(),
+                "kept list lost pair ({i}, {j}) within 0.01 skin after moves summing to 0.99 skin"
+            );
+        }
+        // A second body at 0.11 skin: the sum reaches the skin.
+        centres[7] = broad.centres_at_build()[7] + Vector::new(0.11 * skin, 0.0, 0.0);
+        assert!(
+            broad.pairs_may_be_stale(&centres, &[]),
+            "moves of 0.9 and 0.11 skin (sum 1.01) must rebuild"
         );
     }
 

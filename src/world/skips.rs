@@ -5,7 +5,7 @@
 //! |---|---|---|
 //! | `bounding_spheres` | the query of a body pair whose bounding spheres are apart by more than the touching band, and of a body–wall pair whose bounding sphere does not reach the plane | same forces; the pair's GJK warm start is not refreshed, so later EPA answers of that pair may differ at the solver tolerance |
 //! | `cached_axis` | GJK for a polyhedron pair still separated along its cached separating direction (one support call per shape) | as above |
-//! | `verlet_skin` | broad-phase rebuilds while no body moved half the skin since the last one | exact: the pair list only differs by pairs whose bounding spheres are farther apart than the skin |
+//! | `verlet_skin` | broad-phase rebuilds only when the two largest moves since the last one sum to the skin (one body alone may travel nearly the whole skin) | exact: the pair list only differs by pairs whose bounding spheres are farther apart than the skin |
 //! | `frictionless_history` | the tangential spring of pairs with μ = 0 (its force is zero: the Coulomb cap is 0) | bit-identical bodies and forces (up to the sign of zero); the stored history stays empty |
 //! | `undamped_contacts` | the damping term of a viscous law whose coefficient is 0 (e = 1); e = 1 already maps to `DampingLaw::None`, which costs nothing | bit-identical (up to the sign of zero) |
 //! | `still_rotation` | the rotation drift of a dynamic body whose angular momentum is exactly zero | to the round-off of one quaternion renormalisation (≤ 2⁻⁵² relative) per step |

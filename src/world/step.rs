@@ -521,11 +521,13 @@ fn evaluate_loads(
     inputs.summarise();
     let summary = inputs.summary;
     let broad = &mut world.broad_phase;
+    // A body beyond half the skin does not rebuild by itself: the lists stay valid while the two largest
+    // moves sum to less than the skin (`BroadPhase::pairs_may_be_stale`, scanned only then).
     let rebuild = !params.skips.verlet_skin
         || broad.rebuilds() == 0
         || broad.centres_at_build().len() != inputs.centres.len()
-        || summary.any_far
-        || broad.walls_moved(&world.walls);
+        || broad.walls_moved(&world.walls)
+        || (summary.any_far && broad.pairs_may_be_stale(&inputs.centres, &world.walls));
     region_profile::serial_end(Section::SerialInputs, profile_inputs);
     if rebuild {
         broad.rebuild_with_walls(&inputs.centres, &world.radii, &world.walls);
