@@ -41,13 +41,15 @@ use super::world::World;
 /// the module docs; exported as `world::sphere_step_applies` for the tests that compare the two paths).
 pub fn applies(params: &StepParams, world: &World) -> bool {
     let skips = &params.skips;
-    if !(skips.sphere_kernel && skips.isotropic_rotation && skips.still_rotation)
-        || !matches!(params.rotation, RotationScheme::Splitting { .. })
-        || params.sleeping.enabled
-        || world.sleep.sleeping > 0
-        || !world.loads.current
-        || world.loads.forces.len() != world.bodies.len()
-    {
+    let eligible = skips.sphere_kernel
+        && skips.isotropic_rotation
+        && skips.still_rotation
+        && matches!(params.rotation, RotationScheme::Splitting { .. })
+        && !params.sleeping.enabled
+        && world.sleep.sleeping == 0
+        && world.loads.current
+        && world.loads.forces.len() == world.bodies.len();
+    if !eligible {
         return false;
     }
     world.bodies.iter().zip(&world.shape_of).all(|(b, &s)| {
