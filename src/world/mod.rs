@@ -11,10 +11,12 @@
 //! - `sphere_kernel`: the sphere path of the narrow phase and laws (sphere–sphere, wall–sphere).
 //! - `sphere_step`: the integration stages of a world of free spheres, without the per-body tests other bodies need.
 
+mod body_inputs;
 pub mod broad_phase;
 pub mod contact_store;
 pub mod energy;
 pub mod parallel;
+pub mod region_profile;
 pub mod skips;
 pub mod sleeping;
 mod sphere_kernel;

@@ -27,10 +27,12 @@ use crate::dynamics::{Motion, RigidBody, RotationScheme, TranslationParams, Visc
 use crate::math::{Real, Vector};
 use crate::shape::Shape;
 
+use super::body_inputs;
 use super::energy::viscous_power;
 use super::parallel::{
-    for_each_item, for_each_item3_checked, for_each_item_checked, integration_work,
+    for_each_item3, for_each_item3_checked, for_each_item_checked, integration_work,
 };
+use super::region_profile::{self, Section};
 use super::step::{
     evaluate_loads, non_finite_quantity, sum_body_loads, StepError, StepParams, StepReport,
     StepScratch,
@@ -140,19 +142,37 @@ pub(super) fn step_spheres(
 
     // 1–2. First half kick with the kept loads, drift.
     let t = Instant::now();
-    let parallel_bodies =
-        integration_work(world.bodies.len(), scratch.anisotropic) >= params.parallel.min_bodies;
+    let parallel_bodies = integration_work(world.bodies.len(), scratch.inputs.summary.anisotropic)
+        >= params.parallel.min_bodies;
     let loads = &world.loads;
-    for_each_item(parallel_bodies, &mut world.bodies, |i, body| {
-        kick_and_drift(
-            body,
-            &loads.forces[i],
-            &loads.torques[i],
-            &translation,
-            form,
-            dt,
-        );
+    // The drift pass also writes what stage 3 reads of each body, as the general one does.
+    let inputs = &mut scratch.inputs;
+    inputs.resize(world.bodies.len());
+    let (at_build, limit_sq) = (
+        world.broad_phase.centres_at_build(),
+        world.broad_phase.rebuild_limit_sq(),
+    );
+    region_profile::region(Section::KickDrift, || {
+        for_each_item3(
+            parallel_bodies,
+            &mut world.bodies,
+            &mut inputs.centres,
+            &mut inputs.flags,
+            |i, body, centre, flags| {
+                kick_and_drift(
+                    body,
+                    &loads.forces[i],
+                    &loads.torques[i],
+                    &translation,
+                    form,
+                    dt,
+                );
+                *centre = body.position;
+                *flags = body_inputs::flags_of(i, body, at_build, limit_sq);
+            },
+        )
     });
+    inputs.fresh = true;
     for wall in &mut world.walls {
         wall.pose.translation.vector += dt * wall.velocity;
     }
@@ -167,27 +187,34 @@ pub(super) fn step_spheres(
 
     // 7–8. Second half kick and checks, in one pass.
     let t = Instant::now();
-    let parallel_bodies =
-        integration_work(world.bodies.len(), scratch.anisotropic) >= params.parallel.min_bodies;
+    let parallel_bodies = integration_work(world.bodies.len(), scratch.inputs.summary.anisotropic)
+        >= params.parallel.min_bodies;
     let non_finite = if std::mem::take(&mut scratch.deferred_gather) {
-        let adjacency = world.contacts.body_adjacency(world.bodies.len());
+        let n_bodies = world.bodies.len();
+        let adjacency = region_profile::serial(Section::SerialStore, || {
+            world.contacts.body_adjacency(n_bodies)
+        });
         report.counters.serial += t.elapsed();
         let evaluated = &scratch.evaluated;
         let loads = &mut world.loads;
-        for_each_item3_checked(
-            true,
-            &mut world.bodies,
-            &mut loads.forces,
-            &mut loads.torques,
-            |i, body, force, torque| {
-                sum_body_loads(adjacency, evaluated, i, force, torque);
-                kick_and_check(body, force, torque, &translation, dt)
-            },
-        )
+        region_profile::region(Section::KickChecks, || {
+            for_each_item3_checked(
+                true,
+                &mut world.bodies,
+                &mut loads.forces,
+                &mut loads.torques,
+                |i, body, force, torque| {
+                    sum_body_loads(adjacency, evaluated, i, force, torque);
+                    kick_and_check(body, force, torque, &translation, dt)
+                },
+            )
+        })
     } else {
         let loads = &world.loads;
-        let non_finite = for_each_item_checked(parallel_bodies, &mut world.bodies, |i, body| {
-            kick_and_check(body, &loads.forces[i], &loads.torques[i], &translation, dt)
+        let non_finite = region_profile::region(Section::KickChecks, || {
+            for_each_item_checked(parallel_bodies, &mut world.bodies, |i, body| {
+                kick_and_check(body, &loads.forces[i], &loads.torques[i], &translation, dt)
+            })
         });
         if !parallel_bodies {
             report.counters.serial += t.elapsed();
