@@ -82,6 +82,19 @@ impl ContactModel {
         kinematics: &ContactKinematics,
         history: &mut TangentialHistory,
     ) -> ContactResponse {
+        self.evaluate_inlined(geometry, kinematics, history)
+    }
+
+    /// [`ContactModel::evaluate`], always inlined into its caller: the same operations, so the same bits,
+    /// but a caller that reads only some fields of the response (the sphere kernel without the energy
+    /// ledger: forces, torques, potentials) lets the compiler drop the work of the others.
+    #[inline(always)]
+    pub fn evaluate_inlined(
+        &self,
+        geometry: &ContactGeometry,
+        kinematics: &ContactKinematics,
+        history: &mut TangentialHistory,
+    ) -> ContactResponse {
         if geometry.kind != ContactKind::Overlap || geometry.depth <= 0.0 {
             *history = TangentialHistory::default();
             return ContactResponse::default();

@@ -157,7 +157,7 @@ pub struct TangentialResponse {
 /// Rotates the displacement `u` expressed against `old_normal` into the plane perpendicular to `new_normal`
 /// (smallest rotation taking one normal to the other), keeping its length. A zero `old_normal` (new contact)
 /// only projects.
-#[inline]
+#[inline(always)]
 pub fn rotate_into_tangent_plane(u: &Vector, old_normal: &Vector, new_normal: &Vector) -> Vector {
     let length = u.norm();
     if length == 0.0 {
@@ -211,7 +211,7 @@ pub fn incremental_spring(
 /// (the LIGGGHTS `tangential history` order). The dashpot's power c_t |v_t|² is reported in
 /// [`TangentialResponse::damping_power`].
 #[allow(clippy::too_many_arguments)]
-#[inline]
+#[inline(always)]
 pub fn incremental_spring_damped(
     stiffness: Real,
     friction: Real,

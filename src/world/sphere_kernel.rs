@@ -25,7 +25,7 @@ use crate::contact::{
 };
 use crate::dynamics::body::RigidBody;
 use crate::dynamics::rotation::is_isotropic;
-use crate::law::ContactKinematics;
+use crate::law::{ContactKinematics, ContactModel};
 use crate::math::{Point, Real, Vector};
 use crate::shape::Shape;
 use rayon::prelude::*;
@@ -173,7 +173,7 @@ pub(super) fn evaluate(
                 contact_sphere_sphere(&sa.position, sa.radius, &sb.position, sb.radius, tol)
             });
             if state.geometry.kind != ContactKind::Overlap {
-                return Some(contact_law(pair, key, state, previous_point, out));
+                return Some(separated_law(pair, key, state, previous_point, out));
             }
             let model = match pair.model(sa.material, sb.material) {
                 Ok(m) => m.for_contact_radii(Some(sa.radius), Some(sb.radius)),
@@ -193,6 +193,10 @@ pub(super) fn evaluate(
                 dt: pair.dt,
             };
             let scale = sa.length_scale.min(sb.length_scale);
+            if !pair.ledger {
+                lean_overlap_law(state, &model, &kinematics, scale, out);
+                return Some(Ok(()));
+            }
             let dt = pair.dt;
             overlap_law(
                 pair,
@@ -237,7 +241,7 @@ pub(super) fn evaluate(
                 )
             });
             if state.geometry.kind != ContactKind::Overlap {
-                return Some(contact_law(pair, key, state, previous_point, out));
+                return Some(separated_law(pair, key, state, previous_point, out));
             }
             let model = match pair.model(w.material, s.material) {
                 Ok(m) => m.for_contact_radii(None, Some(s.radius)),
@@ -251,6 +255,10 @@ pub(super) fn evaluate(
                 center_b: s.position,
                 dt: pair.dt,
             };
+            if !pair.ledger {
+                lean_overlap_law(state, &model, &kinematics, s.length_scale, out);
+                return Some(Ok(()));
+            }
             let dt = pair.dt;
             overlap_law(
                 pair,
@@ -264,4 +272,54 @@ pub(super) fn evaluate(
             Some(Ok(()))
         }
     }
+}
+
+/// Stage 5 for a sphere candidate that does not overlap: [`contact_law`]'s answer. Without the ledger, or
+/// when the pair kept no force from its last evaluation (it was already apart: the usual case of a
+/// candidate in the skin), there is no release to book, and what the general stage writes is the cleared
+/// history and forces and a slot with no force and no work; those are written directly (the same values).
+#[inline(always)]
+fn separated_law(
+    pair: &PairInputs,
+    key: ContactKey,
+    state: &mut ContactState,
+    previous_point: &Point,
+    out: &mut Evaluated,
+) -> Result<(), StepError> {
+    let stale = state.damping_force != Vector::zeros()
+        || (state.history.stiffness != 0.0 && state.history.displacement != Vector::zeros());
+    if pair.ledger && stale {
+        return contact_law(pair, key, state, previous_point, out);
+    }
+    state.history = Default::default();
+    state.force_on_b = Vector::zeros();
+    state.damping_force = Vector::zeros();
+    out.clear_separated();
+    Ok(())
+}
+
+/// The end of stage 5 for an overlapping sphere candidate when the ledger is off: [`overlap_law`] without
+/// its ledger branch (the work slot is zero there too), with the law inlined
+/// ([`ContactModel::evaluate_inlined`]: the same operations, so the same bits) so that the terms only the
+/// ledger reads (friction and stiffness work, dissipated powers, the rotated previous spring) are not
+/// computed.
+#[inline(always)]
+fn lean_overlap_law(
+    state: &mut ContactState,
+    model: &ContactModel,
+    kinematics: &ContactKinematics,
+    scale: Real,
+    out: &mut Evaluated,
+) {
+    let ContactState {
+        geometry: g,
+        history,
+        force_on_b,
+        damping_force,
+        ..
+    } = state;
+    let response = model.evaluate_inlined(g, kinematics, history);
+    *force_on_b = response.force_on_b;
+    *damping_force = response.damping_force;
+    out.set_overlapping(&response, g.depth, g.depth / scale);
 }

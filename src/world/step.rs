@@ -809,6 +809,35 @@ fn sum_body_loads(
 }
 
 impl Evaluated {
+    /// The slot of a candidate that does not overlap and books no ledger term (what [`contact_law`] writes
+    /// for it).
+    #[inline(always)]
+    pub(super) fn clear_separated(&mut self) {
+        self.frozen = false;
+        self.work = ContactWork::default();
+        self.overlapping = false;
+    }
+
+    /// The slot of an overlapping candidate without ledger terms (what [`overlap_law`] writes for it with
+    /// the ledger off): the response's loads and potential, the overlap and its ratio to the size.
+    #[inline(always)]
+    pub(super) fn set_overlapping(
+        &mut self,
+        response: &crate::law::ContactResponse,
+        depth: Real,
+        overlap_ratio: Real,
+    ) {
+        self.frozen = false;
+        self.work = ContactWork::default();
+        self.force_on_b = response.force_on_b;
+        self.torque_on_a = response.torque_on_a;
+        self.torque_on_b = response.torque_on_b;
+        self.potential = response.normal_potential + response.tangential_potential;
+        self.overlapping = true;
+        self.depth = depth;
+        self.overlap_ratio = overlap_ratio;
+    }
+
     /// Whether stage 6 has something to sum for this candidate: a force, or a nonzero ledger term.
     #[inline]
     fn contributes(&self) -> bool {
@@ -851,7 +880,7 @@ pub(super) struct PairInputs<'a> {
     pub(super) dt: Real,
     step_index: u64,
     /// Whether the ledger terms are booked ([`StepParams::energy_ledger`]).
-    ledger: bool,
+    pub(super) ledger: bool,
 }
 
 impl PairInputs<'_> {

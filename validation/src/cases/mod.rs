@@ -10,6 +10,7 @@ pub mod perf;
 pub mod polyhedra_bed;
 pub mod polyhedra_box;
 pub mod precession;
+pub mod projectile_history;
 pub mod restitution;
 pub mod rockfill;
 pub mod single_contact_energy;

@@ -14,6 +14,8 @@ use polydem::math::Real;
 
 use generate::BedBody;
 
+use super::projectile_history::{self, History, Metrics, QUANTITIES};
+
 /// The sphere bed whose spheres are replaced (relative to the repository root).
 pub const SPHERE_FILE: &str = "reference/sphere_bed/bed_quick.csv";
 /// The settled state of the polyhedral bed (relative to the repository root).
@@ -92,17 +94,6 @@ struct Params {
 
 fn fail(msg: String) -> SuiteError {
     SuiteError::case(NAME, msg)
-}
-
-/// The projectile's history, sampled at the scene's output interval.
-#[derive(Clone, Debug, Default)]
-struct History {
-    t: Vec<Real>,
-    z: Vec<Real>,
-    vz: Vec<Real>,
-    fz: Vec<Real>,
-    /// Bodies in contact with the projectile.
-    contacts: Vec<Real>,
 }
 
 /// What one bed's run gave.
@@ -263,58 +254,10 @@ fn run_bed(
     })
 }
 
-/// Compared quantities of one history.
-#[derive(Clone, Copy, Debug)]
-struct Metrics {
-    final_depth: Real,
-    max_depth: Real,
-    final_vz: Real,
-    peak_force: Real,
-    peak_time: Real,
-    first_contact: Real,
-    slow_time: Real,
-    impulse: Real,
-    mean_contacts: Real,
-}
-
-fn metrics(run: &BedRun) -> Metrics {
-    let h = &run.history;
-    let n = h.t.len();
-    let (mut peak_force, mut peak_time) = (Real::NEG_INFINITY, Real::NAN);
-    let (mut first_contact, mut slow_time) = (Real::NAN, Real::NAN);
-    let (mut impulse, mut max_depth) = (0.0, Real::NEG_INFINITY);
-    let (mut contact_sum, mut contact_samples) = (0.0, 0usize);
-    for i in 0..n {
-        if h.fz[i] > peak_force {
-            peak_force = h.fz[i];
-            peak_time = h.t[i];
-        }
-        if first_contact.is_nan() && h.fz[i] > 1e-6 {
-            first_contact = h.t[i];
-        }
-        if !first_contact.is_nan() {
-            contact_sum += h.contacts[i];
-            contact_samples += 1;
-        }
-        if slow_time.is_nan() && h.vz[i].abs() < 0.1 * run.v0 {
-            slow_time = h.t[i];
-        }
-        if i > 0 {
-            impulse += 0.5 * (h.fz[i] + h.fz[i - 1]) * (h.t[i] - h.t[i - 1]);
-        }
-        max_depth = max_depth.max(run.z0 - h.z[i]);
-    }
-    Metrics {
-        final_depth: run.z0 - h.z[n - 1],
-        max_depth,
-        final_vz: h.vz[n - 1],
-        peak_force,
-        peak_time,
-        first_contact,
-        slow_time,
-        impulse,
-        mean_contacts: contact_sum / contact_samples.max(1) as Real,
-    }
+/// The metrics of a bed run over all its samples.
+fn metrics(label: &str, run: &BedRun) -> Result<Metrics, SuiteError> {
+    projectile_history::metrics(&run.history, run.z0, run.v0, Real::INFINITY)
+        .ok_or_else(|| fail(format!("{label}: the run has no samples")))
 }
 
 /// Largest Minkowski overlap of the initial polyhedral bed (m): every pair of bodies within reach, by the
@@ -478,7 +421,12 @@ impl Case for PolyhedraBed {
             let t_end = *poly_run.history.t.last().unwrap_or(&0.0);
 
             ctx.section(&format!("{v} (t ≤ {:.4} ms)", t_end * 1e3));
-            let (ms, mp) = (metrics(&spheres_run), metrics(&poly_run));
+            let (ms, mp) = (
+                metrics(&format!("{v} spheres"), &spheres_run)?,
+                metrics(&format!("{v} polyhedra"), &poly_run)?,
+            );
+            // Both runs count the projectile's contacts at every sample.
+            let contacts = |m: &Metrics| m.mean_contacts.unwrap_or(Real::NAN);
             let solid_fraction = |top: Real| {
                 spheres
                     .iter()
@@ -497,31 +445,23 @@ impl Case for PolyhedraBed {
                 poly_run.bed_top * 1e3,
                 solid_fraction(poly_run.bed_top),
             ));
-            let row = |q: &str, unit: &str, f: &dyn Fn(&Metrics) -> Real, scale: Real| {
-                let (a, b) = (f(&ms) * scale, f(&mp) * scale);
+            let row = |heading: String, a: Real, b: Real| {
                 vec![
-                    format!("{q} [{unit}]"),
+                    heading,
                     CaseContext::fmt(a),
                     CaseContext::fmt(b),
                     CaseContext::fmt(b / a),
                 ]
             };
-            let rows = vec![
-                row("final depth", "mm", &|m| m.final_depth, 1e3),
-                row("max depth", "mm", &|m| m.max_depth, 1e3),
-                row("final vertical velocity", "m/s", &|m| m.final_vz, 1.0),
-                row("peak contact force", "N", &|m| m.peak_force, 1.0),
-                row("time of peak force", "ms", &|m| m.peak_time, 1e3),
-                row("first contact", "ms", &|m| m.first_contact, 1e3),
-                row("speed below 10 % of v0 at", "ms", &|m| m.slow_time, 1e3),
-                row("vertical contact impulse", "N s", &|m| m.impulse, 1.0),
-                row(
-                    "mean projectile contacts after first contact",
-                    "-",
-                    &|m| m.mean_contacts,
-                    1.0,
-                ),
-            ];
+            let mut rows: Vec<Vec<String>> = QUANTITIES
+                .iter()
+                .map(|q| row(q.heading(), q.of(&ms), q.of(&mp)))
+                .collect();
+            rows.push(row(
+                "mean projectile contacts after first contact [-]".into(),
+                contacts(&ms),
+                contacts(&mp),
+            ));
             ctx.table(
                 Some(&format!("{v}_table")),
                 &["quantity", "spheres", "polyhedra", "polyhedra / spheres"],
@@ -675,8 +615,8 @@ impl Case for PolyhedraBed {
                 },
                 mp.final_vz,
                 ms.final_vz,
-                mp.mean_contacts,
-                ms.mean_contacts,
+                contacts(&mp),
+                contacts(&ms),
             ));
             summary_rows.push(vec![
                 v.clone(),

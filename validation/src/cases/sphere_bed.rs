@@ -29,6 +29,8 @@ use crate::context::CaseContext;
 use crate::error::SuiteError;
 use crate::plot::{Plot, Series, SeriesStyle};
 
+use super::projectile_history::{self, History, Metrics, Quantity, QUANTITIES};
+
 /// The case (registered in [`crate::cases::registry`]).
 pub struct SphereBed;
 
@@ -53,15 +55,6 @@ struct Params {
     check_speed: bool,
     /// Whether the reference codes are re-run when installed (full profile only).
     rerun_references: bool,
-}
-
-/// One code's projectile history: samples every 10 steps.
-#[derive(Clone, Debug, Default)]
-struct History {
-    t: Vec<Real>,
-    z: Vec<Real>,
-    vz: Vec<Real>,
-    fz: Vec<Real>,
 }
 
 /// The `# key: value` provenance lines of a recorded output.
@@ -272,56 +265,16 @@ fn run_polydem(variant: &Variant, ctx: &mut CaseContext) -> Result<Run, SuiteErr
     })
 }
 
-/// The compared quantities of one history over its samples with t ≤ `t_end`.
-#[derive(Clone, Copy, Debug)]
-struct Metrics {
-    final_depth: Real,
-    max_depth: Real,
-    final_vz: Real,
-    peak_force: Real,
-    peak_time: Real,
-    first_contact: Real,
-    slow_time: Real,
-    impulse: Real,
-}
-
-fn metrics(h: &History, z0: Real, v0: Real, t_end: Real) -> Metrics {
-    let n =
-        h.t.iter()
-            .take_while(|&&t| t <= t_end * (1.0 + 1e-9))
-            .count();
-    let depth = |i: usize| z0 - h.z[i];
-    let (mut peak_force, mut peak_time) = (Real::NEG_INFINITY, Real::NAN);
-    let (mut first_contact, mut slow_time) = (Real::NAN, Real::NAN);
-    let mut impulse = 0.0;
-    let mut max_depth = Real::NEG_INFINITY;
-    for i in 0..n {
-        if h.fz[i] > peak_force {
-            peak_force = h.fz[i];
-            peak_time = h.t[i];
-        }
-        // The reference outputs carry round-off of the gravity subtraction (~1e-16 N) before contact.
-        if first_contact.is_nan() && h.fz[i] > 1e-6 {
-            first_contact = h.t[i];
-        }
-        if slow_time.is_nan() && h.vz[i].abs() < 0.1 * v0 {
-            slow_time = h.t[i];
-        }
-        if i > 0 {
-            impulse += 0.5 * (h.fz[i] + h.fz[i - 1]) * (h.t[i] - h.t[i - 1]);
-        }
-        max_depth = max_depth.max(depth(i));
-    }
-    Metrics {
-        final_depth: depth(n - 1),
-        max_depth,
-        final_vz: h.vz[n - 1],
-        peak_force,
-        peak_time,
-        first_contact,
-        slow_time,
-        impulse,
-    }
+/// The metrics of `code`'s history up to `t_end` (an error names the code when it has no samples).
+fn metrics(
+    code: &str,
+    h: &History,
+    z0: Real,
+    v0: Real,
+    t_end: Real,
+) -> Result<Metrics, SuiteError> {
+    projectile_history::metrics(h, z0, v0, t_end)
+        .ok_or_else(|| fail(format!("{code}: no sample at or before t = {t_end} s")))
 }
 
 /// Largest |z_a − z_b| over the common samples with t ≤ t_end (same sampling steps in every code).
@@ -346,10 +299,10 @@ fn max_gap(a: &History, b: &History, t_end: Real) -> Result<Real, SuiteError> {
 /// `metrics`) with the three pairwise relative differences, then the depth-history gaps (`gaps`: polydem–YADE,
 /// polydem–LIGGGHTS, YADE–LIGGGHTS, in mean bed diameters).
 fn comparison_rows(metrics: [&Metrics; 3], gaps: [Real; 3]) -> Vec<Vec<String>> {
-    let row = |q: &str, unit: &str, f: &dyn Fn(&Metrics) -> Real, scale: Real| {
-        let [o, y, l] = metrics.map(|m| f(m) * scale);
+    let row = |q: &Quantity| {
+        let [o, y, l] = metrics.map(|m| q.of(m));
         vec![
-            format!("{q} [{unit}]"),
+            q.heading(),
             CaseContext::fmt(o),
             CaseContext::fmt(y),
             CaseContext::fmt(l),
@@ -365,17 +318,9 @@ fn comparison_rows(metrics: [&Metrics; 3], gaps: [Real; 3]) -> Vec<Vec<String>> 
         "-".into(),
     ];
     gap_row.extend(gaps.map(CaseContext::fmt));
-    vec![
-        row("final depth", "mm", &|m| m.final_depth, 1e3),
-        row("max depth", "mm", &|m| m.max_depth, 1e3),
-        row("final vertical velocity", "m/s", &|m| m.final_vz, 1.0),
-        row("peak contact force", "N", &|m| m.peak_force, 1.0),
-        row("time of peak force", "ms", &|m| m.peak_time, 1e3),
-        row("first contact", "ms", &|m| m.first_contact, 1e3),
-        row("speed below 10 % of v0 at", "ms", &|m| m.slow_time, 1e3),
-        row("vertical contact impulse", "N s", &|m| m.impulse, 1.0),
-        gap_row,
-    ]
+    let mut rows: Vec<Vec<String>> = QUANTITIES.iter().map(row).collect();
+    rows.push(gap_row);
+    rows
 }
 
 impl Case for SphereBed {
@@ -460,9 +405,15 @@ impl Case for SphereBed {
             let h = &ours.history;
             let t_end = *h.t.last().ok_or_else(|| fail("no samples".into()))?;
             let recorded_end = *liggghts.history.t.last().unwrap_or(&0.0);
-            let m_ours = metrics(h, ours.z0, ours.v0, t_end);
-            let m_yade = metrics(&yade.history, ours.z0, ours.v0, t_end);
-            let m_lig = metrics(&liggghts.history, ours.z0, ours.v0, t_end);
+            let m_ours = metrics("polydem", h, ours.z0, ours.v0, t_end)?;
+            let m_yade = metrics("YADE (recorded)", &yade.history, ours.z0, ours.v0, t_end)?;
+            let m_lig = metrics(
+                "LIGGGHTS (recorded)",
+                &liggghts.history,
+                ours.z0,
+                ours.v0,
+                t_end,
+            )?;
             let gap_yl = max_gap(&yade.history, &liggghts.history, t_end)?;
             let gap_py = max_gap(h, &yade.history, t_end)?;
             let gap_pl = max_gap(h, &liggghts.history, t_end)?;
@@ -560,8 +511,8 @@ impl Case for SphereBed {
                         format!("{code} (recorded: not installed)")
                     }
                 };
-                let m_fy = metrics(&fy.history, ours.z0, ours.v0, t_end);
-                let m_fl = metrics(&fl.history, ours.z0, ours.v0, t_end);
+                let m_fy = metrics("YADE", &fy.history, ours.z0, ours.v0, t_end)?;
+                let m_fl = metrics("LIGGGHTS", &fl.history, ours.z0, ours.v0, t_end)?;
                 let gap_fyl = max_gap(&fy.history, &fl.history, t_end)?;
                 let gap_pfy = max_gap(h, &fy.history, t_end)?;
                 let gap_pfl = max_gap(h, &fl.history, t_end)?;
