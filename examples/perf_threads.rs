@@ -15,7 +15,7 @@
 //!
 //! ```text
 //! cargo run --release --example perf_threads -- [--steps N] [--warm-up N] [--threads 1,2] [--scenes poly,poly_projectile,spheres]
-//!     [--min-candidates N] [--min-bodies N]
+//!     [--min-candidates N] [--min-bodies N] [--repeat N] [--profile]
 //! cargo run --release --example perf_threads -- --overhead [--threads 1,2]
 //! cargo run --release --example perf_threads -- --write-scenes DIR [--steps N] [--warm-up N] [--scenes ...]
 //! ```
@@ -24,8 +24,12 @@
 //! `polydem run` (the initial state, before the warm-up; `end_time` = warm-up + steps): a file of 10^4
 //! polyhedra with their own hulls is ~14 MB, too large to keep in the repository, so the scenes are
 //! generated on demand from this builder.
-//! The last two replace the parallel thresholds of the step ([`polydem::world::Parallelism`]; the results
-//! are the same bits either way), to re-measure them.
+//! `--min-candidates` and `--min-bodies` replace the parallel thresholds of the step
+//! ([`polydem::world::Parallelism`]; the results are the same bits either way), to re-measure them.
+//! `--repeat N` runs the thread counts alternately N times back to back per scene and prints the median,
+//! range and best-of-N ratio of the speed-ups (the quiet-machine re-measurement: `--repeat 7`).
+//! `--profile` prints per run the CPU time, load balance and costliest chunk of every parallel region and
+//! the CPU time of every serial section (`polydem::world::region_profile`).
 //! (`scenes/perf/run_threads.sh` runs it with the defaults.)
 
 #[path = "../tests/support/bed.rs"]
@@ -46,6 +50,10 @@ struct Options {
     overhead: bool,
     /// Write the scenes as scene files (TOML) into this folder instead of running them.
     write_scenes: Option<std::path::PathBuf>,
+    /// Runs of every thread count per scene, back to back (alternating thread counts).
+    repeat: usize,
+    /// Print the per-region profile (CPU time per thread, imbalance, serial sections).
+    profile: bool,
 }
 
 fn parse() -> Result<Options, String> {
@@ -58,6 +66,8 @@ fn parse() -> Result<Options, String> {
         min_bodies: None,
         overhead: false,
         write_scenes: None,
+        repeat: 1,
+        profile: false,
     };
     let mut args = std::env::args().skip(1);
     while let Some(a) = args.next() {
@@ -83,6 +93,13 @@ fn parse() -> Result<Options, String> {
                 o.min_bodies = Some(value()?.parse().map_err(|e| format!("--min-bodies: {e}"))?)
             }
             "--overhead" => o.overhead = true,
+            "--profile" => o.profile = true,
+            "--repeat" => {
+                o.repeat = value()?
+                    .parse::<usize>()
+                    .map_err(|e| format!("--repeat: {e}"))?
+                    .max(1)
+            }
             "--write-scenes" => o.write_scenes = Some(value()?.into()),
             _ => return Err(format!("unknown argument {a}")),
         }
@@ -219,45 +236,140 @@ fn main() {
              parallel from {} candidates, {} integration units)",
             o.steps, o.warm_up, b.params.dt, b.params.parallel.min_candidates, b.params.parallel.min_bodies
         );
-        let mut reference: Option<(usize, Vec<u64>, f64)> = None;
-        for &threads in &o.threads {
-            let (w, c, wall, cpu) = run(&b.world, &b.params, o.steps, threads);
-            let ms = |d: Duration| d.as_secs_f64() * 1e3;
-            let ps = (bodies * o.steps) as f64 / wall.as_secs_f64();
-            let cs = c.contacts as f64 / wall.as_secs_f64();
-            println!(
-                "{name} {threads}t: wall {:.3} s, cpu {:.3} s, {:.3e} particle-steps/s, {:.3e} contacts/s, \
-                 {:.0} contacts/step, {:.0} candidates/step, load {}",
-                wall.as_secs_f64(),
-                cpu.as_secs_f64(),
-                ps,
-                cs,
-                c.contacts as f64 / o.steps as f64,
-                (c.body_pairs_tested + c.wall_pairs_tested) as f64 / o.steps as f64,
-                load_average()
-            );
-            println!(
-                "{name} {threads}t stages (ms): broad {:.0}, narrow+laws {:.0}, accumulate {:.0}, integrate {:.0}, checks {:.0}; broad rebuilds {}; serial sections {:.0} ms = {:.1} % of the stages",
-                ms(c.broad),
-                ms(c.narrow + c.laws),
-                ms(c.accumulate),
-                ms(c.integrate),
-                ms(c.checks),
-                c.broad_rebuilds,
-                ms(c.serial),
-                100.0 * c.serial.as_secs_f64() / c.total_time().as_secs_f64()
-            );
-            let bits = state_bits(&w);
-            match &reference {
-                None => reference = Some((threads, bits, wall.as_secs_f64())),
-                Some((t_ref, bits_ref, wall_ref)) => println!(
-                    "{name} {threads}t vs {t_ref}t: speed-up {:.2}x (wall), final state bit-identical: {}",
-                    wall_ref / wall.as_secs_f64(),
-                    if *bits_ref == bits { "yes" } else { "NO" }
-                ),
+        polydem::world::region_profile::enable(o.profile);
+        // Wall times per thread count over the repeats, and the first run's final state.
+        let mut walls: Vec<Vec<f64>> = vec![Vec::new(); o.threads.len()];
+        let mut reference: Option<(usize, Vec<u64>)> = None;
+        let mut identical = true;
+        for rep in 0..o.repeat {
+            for (ti, &threads) in o.threads.iter().enumerate() {
+                let _ = polydem::world::region_profile::take();
+                let (w, c, wall, cpu) = run(&b.world, &b.params, o.steps, threads);
+                let profile = polydem::world::region_profile::take();
+                walls[ti].push(wall.as_secs_f64());
+                let ms = |d: Duration| d.as_secs_f64() * 1e3;
+                let ps = (bodies * o.steps) as f64 / wall.as_secs_f64();
+                let cs = c.contacts as f64 / wall.as_secs_f64();
+                let label = if o.repeat > 1 {
+                    format!("{name} {threads}t run {}", rep + 1)
+                } else {
+                    format!("{name} {threads}t")
+                };
+                println!(
+                    "{label}: wall {:.3} s, cpu {:.3} s, {:.3e} particle-steps/s, {:.3e} contacts/s, \
+                     {:.0} contacts/step, {:.0} candidates/step, load {}",
+                    wall.as_secs_f64(),
+                    cpu.as_secs_f64(),
+                    ps,
+                    cs,
+                    c.contacts as f64 / o.steps as f64,
+                    (c.body_pairs_tested + c.wall_pairs_tested) as f64 / o.steps as f64,
+                    load_average()
+                );
+                println!(
+                    "{label} stages (ms): broad {:.0}, narrow+laws {:.0}, accumulate {:.0}, integrate {:.0}, checks {:.0}; broad rebuilds {}; serial sections {:.0} ms = {:.1} % of the stages",
+                    ms(c.broad),
+                    ms(c.narrow + c.laws),
+                    ms(c.accumulate),
+                    ms(c.integrate),
+                    ms(c.checks),
+                    c.broad_rebuilds,
+                    ms(c.serial),
+                    100.0 * c.serial.as_secs_f64() / c.total_time().as_secs_f64()
+                );
+                if o.profile {
+                    print_profile(&label, &profile, cpu);
+                }
+                let bits = state_bits(&w);
+                match &reference {
+                    None => reference = Some((threads, bits)),
+                    Some((t_ref, bits_ref)) => {
+                        let same = *bits_ref == bits;
+                        identical &= same;
+                        println!(
+                            "{label} vs {t_ref}t: speed-up {:.2}x (wall, this repeat), final state bit-identical: {}",
+                            walls[0][rep] / wall.as_secs_f64(),
+                            if same { "yes" } else { "NO" }
+                        );
+                    }
+                }
+            }
+        }
+        if o.repeat > 1 {
+            for (ti, &threads) in o.threads.iter().enumerate().skip(1) {
+                let mut ratios: Vec<f64> = walls[0]
+                    .iter()
+                    .zip(&walls[ti])
+                    .map(|(a, b)| a / b)
+                    .collect();
+                ratios.sort_by(f64::total_cmp);
+                let median = if ratios.len() % 2 == 1 {
+                    ratios[ratios.len() / 2]
+                } else {
+                    0.5 * (ratios[ratios.len() / 2 - 1] + ratios[ratios.len() / 2])
+                };
+                let best = |v: &[f64]| v.iter().cloned().fold(f64::INFINITY, f64::min);
+                println!(
+                    "{name} {threads}t vs {}t over {} back-to-back repeats: speed-up median {median:.2}x, range {:.2}-{:.2}x, \
+                     best-of-{} times {:.2}x; runs at or above 1.8x: {}; final states bit-identical: {}; load {}",
+                    o.threads[0],
+                    o.repeat,
+                    ratios[0],
+                    ratios[ratios.len() - 1],
+                    o.repeat,
+                    best(&walls[0]) / best(&walls[ti]),
+                    ratios.iter().filter(|&&r| r >= 1.8).count(),
+                    if identical { "yes" } else { "NO" },
+                    load_average()
+                );
             }
         }
     }
+}
+
+/// The per-region profile of one run (see `polydem::world::region_profile`): per section, runs, CPU time
+/// and its share of the run's CPU time, and for a parallel region the imbalance (busiest thread / mean).
+fn print_profile(
+    label: &str,
+    profile: &[(
+        polydem::world::region_profile::Section,
+        polydem::world::region_profile::SectionStats,
+    )],
+    run_cpu: Duration,
+) {
+    let ms = |d: Duration| d.as_secs_f64() * 1e3;
+    let mut serial = Duration::ZERO;
+    for (section, s) in profile {
+        if s.runs == 0 {
+            continue;
+        }
+        let is_serial = section.name().starts_with("serial");
+        if is_serial {
+            serial += s.cpu;
+        }
+        println!(
+            "{label} profile {:<26} runs {:>5}, cpu {:>8.1} ms ({:>5.2} % of the run's cpu), wall {:>8.1} ms{}",
+            section.name(),
+            s.runs,
+            ms(s.cpu),
+            100.0 * s.cpu.as_secs_f64() / run_cpu.as_secs_f64(),
+            ms(s.wall),
+            if is_serial {
+                String::new()
+            } else {
+                format!(
+                    ", imbalance (busiest / mean thread cpu) {:.3}, costliest chunk / mean {:.3}",
+                    s.imbalance(),
+                    s.costliest_chunk.as_secs_f64() / s.mean.as_secs_f64()
+                )
+            }
+        );
+    }
+    println!(
+        "{label} profile serial sections: cpu {:.1} ms = {:.2} % of the run's cpu",
+        ms(serial),
+        100.0 * serial.as_secs_f64() / run_cpu.as_secs_f64()
+    );
 }
 
 /// The fork/join cost of one parallel region of the step on each thread count, measured through the

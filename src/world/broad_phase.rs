@@ -26,6 +26,7 @@
 
 use crate::math::{Point, Real, Vector};
 
+use super::region_profile::{self, Section};
 use super::world::Wall;
 
 /// A candidate pair of body indices, `i < j`.
@@ -60,6 +61,21 @@ pub struct BroadPhase {
     /// [`take_parallel_search_time`]: BroadPhase::take_parallel_search_time
     #[serde(skip)]
     parallel_search_time: std::time::Duration,
+    /// A number that identifies the content of `pairs` and `wall_pairs`: a fresh one at every build (unique
+    /// in the process), 0 until the first call of [`generation`](BroadPhase::generation) after a
+    /// deserialisation or a default construction. A clone keeps it, as it keeps the lists (not part of the
+    /// state).
+    #[serde(skip)]
+    generation: u64,
+}
+
+/// The last generation handed out (see [`BroadPhase::generation`]).
+static GENERATIONS: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
+
+/// A number never handed out before in this process (nonzero): the generations of the broad phase and the
+/// tags of the lists derived from its pairs.
+pub(crate) fn fresh_generation() -> u64 {
+    GENERATIONS.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1
 }
 
 /// The inclusive range of grid cells a body's inflated box covers.
@@ -122,6 +138,27 @@ impl BroadPhase {
         self.rebuilds
     }
 
+    /// An identifier of the current pair lists: equal generations (of this broad phase or a clone of it)
+    /// mean equal [`pairs`](Self::pairs) and [`wall_pairs`](Self::wall_pairs); every build takes a new one.
+    /// What is derived from the lists can be kept while the generation stays.
+    pub fn generation(&mut self) -> u64 {
+        if self.generation == 0 {
+            self.generation = fresh_generation();
+        }
+        self.generation
+    }
+
+    /// The body centres at the last build (empty before the first).
+    pub fn centres_at_build(&self) -> &[Point] {
+        &self.centres_at_build
+    }
+
+    /// (skin / 2)²: a body whose centre is this far (squared) from where it was at the last build makes
+    /// [`needs_rebuild`](Self::needs_rebuild) true.
+    pub fn rebuild_limit_sq(&self) -> Real {
+        0.25 * self.skin * self.skin
+    }
+
     /// The time spent in the parallelisable part of the rebuilds since the last call (the pair search from
     /// [`PARALLEL_SEARCH_MIN_BODIES`] on, on any pool), and resets it: what the step does not count as
     /// serial.
@@ -135,7 +172,7 @@ impl BroadPhase {
         if centres.len() != self.centres_at_build.len() || self.rebuilds == 0 {
             return true;
         }
-        let limit_sq = 0.25 * self.skin * self.skin;
+        let limit_sq = self.rebuild_limit_sq();
         centres
             .iter()
             .zip(&self.centres_at_build)
@@ -177,7 +214,34 @@ impl BroadPhase {
         self.walls_at_build.clear();
         self.walls_at_build
             .extend(walls.iter().map(|w| w.pose.translation.vector));
-        self.wall_pairs = brute_force_wall_pairs(centres, radii, walls, self.skin);
+        let skin = self.skin;
+        self.wall_pairs = region_profile::serial(Section::SerialGrid, || {
+            if centres.len() >= PARALLEL_SEARCH_MIN_BODIES && rayon::current_num_threads() > 1 {
+                // The same test per body, bodies in parallel chunks concatenated in body order: the
+                // list of the serial definition.
+                use rayon::prelude::*;
+                let chunk = centres
+                    .len()
+                    .div_ceil(rayon::current_num_threads() * super::parallel::CHUNKS_PER_THREAD);
+                let found: Vec<Vec<Pair>> = centres
+                    .par_chunks(chunk)
+                    .zip(radii.par_chunks(chunk))
+                    .with_max_len(1)
+                    .enumerate()
+                    .map(|(k, (c, r))| {
+                        let mut out = brute_force_wall_pairs(c, r, walls, skin);
+                        for pair in &mut out {
+                            pair.0 += (k * chunk) as u32;
+                        }
+                        out
+                    })
+                    .collect();
+                found.concat()
+            } else {
+                brute_force_wall_pairs(centres, radii, walls, skin)
+            }
+        });
+        self.generation = fresh_generation();
     }
 
     /// Rebuilds the pair list if [`needs_rebuild`](Self::needs_rebuild); returns whether it did.
@@ -201,6 +265,7 @@ impl BroadPhase {
             "broad phase: one radius per centre"
         );
         self.rebuilds += 1;
+        self.generation = fresh_generation();
         // The body–wall list belongs to a build with walls: a plain rebuild forgets it (the next
         // `update_with_walls` then rebuilds when there are walls).
         self.wall_pairs.clear();
@@ -212,22 +277,31 @@ impl BroadPhase {
             return;
         }
         let half_skin = 0.5 * self.skin;
+        let profile_grid = region_profile::serial_start();
         let grid = self.grid_for(centres, radii);
 
         // Cell ranges of every body's inflated box.
         self.body_cells.clear();
-        self.body_cells
-            .extend(centres.iter().zip(radii).map(|(c, &r)| {
-                // Widened by a relative 1e-9 so that rounding can never drop a pair the sphere test would keep:
-                // extra cells only cost a test, a missing cell would lose a contact.
-                let reach = (r + half_skin) * (1.0 + 1e-9);
-                let mut range = CellRange::default();
-                for axis in 0..3 {
-                    range.lo[axis] = grid.coord(c[axis] - reach, axis);
-                    range.hi[axis] = grid.coord(c[axis] + reach, axis);
-                }
-                range
-            }));
+        let cells_of = |(c, &r): (&Point, &Real)| {
+            // Widened by a relative 1e-9 so that rounding can never drop a pair the sphere test would keep:
+            // extra cells only cost a test, a missing cell would lose a contact.
+            let reach = (r + half_skin) * (1.0 + 1e-9);
+            let mut range = CellRange::default();
+            for axis in 0..3 {
+                range.lo[axis] = grid.coord(c[axis] - reach, axis);
+                range.hi[axis] = grid.coord(c[axis] + reach, axis);
+            }
+            range
+        };
+        if centres.len() >= PARALLEL_SEARCH_MIN_BODIES && rayon::current_num_threads() > 1 {
+            // One range per body, in body order (an indexed parallel extend).
+            use rayon::prelude::*;
+            self.body_cells
+                .par_extend(centres.par_iter().zip(radii.par_iter()).map(cells_of));
+        } else {
+            self.body_cells
+                .extend(centres.iter().zip(radii).map(cells_of));
+        }
 
         // Counting sort of (cell, body) entries into CSR form: cell_bodies[cell_start[k]..cell_start[k+1]].
         let num_cells = (grid.dims[0] * grid.dims[1] * grid.dims[2]) as usize;
@@ -250,6 +324,8 @@ impl BroadPhase {
                 fill[k] += 1;
             });
         }
+
+        region_profile::serial_end(Section::SerialGrid, profile_grid);
 
         // Each pair is examined in the first cell of the overlap of both ranges only. Bodies are independent
         // here: large scenes search in parallel chunks of bodies, concatenated in body order (the same list
@@ -294,17 +370,24 @@ impl BroadPhase {
         if n >= PARALLEL_SEARCH_MIN_BODIES && rayon::current_num_threads() > 1 {
             use rayon::prelude::*;
             let t = std::time::Instant::now();
-            let chunk = n.div_ceil(rayon::current_num_threads() * 8);
-            let found: Vec<Vec<Pair>> = (0..n.div_ceil(chunk))
-                .into_par_iter()
-                .map(|k| {
-                    let mut out = Vec::new();
-                    for i in k * chunk..((k + 1) * chunk).min(n) {
-                        search(i, &mut out);
-                    }
-                    out
-                })
-                .collect();
+            // Chunks of bodies handed out one at a time (see `parallel::for_each_chunked`): the bodies
+            // of a dense region have more pairs to test.
+            let chunk =
+                n.div_ceil(rayon::current_num_threads() * super::parallel::CHUNKS_PER_THREAD);
+            let found: Vec<Vec<Pair>> = region_profile::region(Section::BroadSearch, || {
+                (0..n.div_ceil(chunk))
+                    .into_par_iter()
+                    .with_max_len(1)
+                    .map(|k| {
+                        let _timer = region_profile::chunk();
+                        let mut out = Vec::new();
+                        for i in k * chunk..((k + 1) * chunk).min(n) {
+                            search(i, &mut out);
+                        }
+                        out
+                    })
+                    .collect()
+            });
             self.parallel_search_time += t.elapsed();
             let mut pairs = std::mem::take(&mut self.pairs);
             for part in found {
@@ -314,9 +397,12 @@ impl BroadPhase {
         } else {
             let t = std::time::Instant::now();
             let mut pairs = std::mem::take(&mut self.pairs);
-            for i in 0..n {
-                search(i, &mut pairs);
-            }
+            region_profile::region(Section::BroadSearch, || {
+                let _timer = region_profile::chunk();
+                for i in 0..n {
+                    search(i, &mut pairs);
+                }
+            });
             self.pairs = pairs;
             if n >= PARALLEL_SEARCH_MIN_BODIES {
                 // Parallel on a pool of several threads.
@@ -501,7 +587,37 @@ mod tests {
                 .build()
                 .expect("pool")
                 .install(|| {
-                    assert_matches_oracle(&format!("{threads} threads"), &centres, &radii, 0.01)
+                    assert_matches_oracle(&format!("{threads} threads"), &centres, &radii, 0.01);
+                    // The body–wall list of a build with walls (bodies in parallel chunks above the
+                    // threshold) is the serial definition's.
+                    let walls: Vec<Wall> = [
+                        (Vector::z(), 0.3),
+                        (-Vector::x(), -3.7),
+                        (Vector::new(1.0, 1.0, 0.0).normalize(), 0.9),
+                    ]
+                    .iter()
+                    .map(|&(normal, offset)| Wall {
+                        name: "w".to_owned(),
+                        plane: crate::shape::Plane::new(normal, offset).expect("plane"),
+                        pose: crate::math::Pose::identity(),
+                        velocity: Vector::zeros(),
+                        material: 0,
+                    })
+                    .collect();
+                    let mut broad = BroadPhase::new(0.01);
+                    broad.rebuild_with_walls(&centres, &radii, &walls);
+                    let expected = brute_force_wall_pairs(&centres, &radii, &walls, 0.01);
+                    assert!(
+                        expected.len() > 100,
+                        "only {} body-wall pairs: the walls test nothing",
+                        expected.len()
+                    );
+                    assert!(
+                        broad.wall_pairs() == expected.as_slice(),
+                        "{threads} threads: {} body-wall pairs against {} of the serial definition",
+                        broad.wall_pairs().len(),
+                        expected.len()
+                    );
                 });
         }
     }

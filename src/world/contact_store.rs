@@ -124,6 +124,10 @@ pub struct ContactStore {
     /// The rows of [`body_adjacency`](Self::body_adjacency), derived from `keys` (not part of the state).
     #[serde(skip)]
     adjacency: BodyAdjacency,
+    /// The tag of the candidate list of the last [`sync_tagged`](Self::sync_tagged) (0: none, or the keys
+    /// changed otherwise since; not part of the state).
+    #[serde(skip)]
+    synced_tag: u64,
 }
 
 /// For every body, the store entries (= candidates after a sync) it takes part in, in key order: entry `k`
@@ -211,8 +215,23 @@ impl ContactStore {
     /// order: kept entries stay as they are, new ones are created, the others dropped; the store is marked
     /// touched at `step`.
     pub fn sync(&mut self, candidates: &[ContactKey], step: u64) -> SyncCounts {
+        self.sync_tagged(candidates, 0, step)
+    }
+
+    /// [`sync`](Self::sync) with a tag that identifies the content of `candidates` (nonzero, and a list
+    /// with another content never gets the same tag; 0: unknown): when the last sync had the same tag, the
+    /// keys are the candidates already and the comparison of the two lists is skipped.
+    pub fn sync_tagged(&mut self, candidates: &[ContactKey], tag: u64, step: u64) -> SyncCounts {
         debug_assert!(candidates.windows(2).all(|w| w[0] < w[1]));
         self.last_touched = step;
+        if tag != 0 && tag == self.synced_tag {
+            debug_assert!(candidates == self.keys.as_slice());
+            return SyncCounts {
+                kept: candidates.len(),
+                ..SyncCounts::default()
+            };
+        }
+        self.synced_tag = tag;
         if candidates == self.keys.as_slice() {
             // The same pairs as at the last sync (the usual case between broad-phase rebuilds): every entry
             // is kept in place.

@@ -10,10 +10,12 @@
 //! - [`parallel`]: deterministic per-item parallelism of the step's stages (rayon).
 //! - `sphere_kernel`: the sphere path of the narrow phase and laws (sphere–sphere, wall–sphere).
 
+mod body_inputs;
 pub mod broad_phase;
 pub mod contact_store;
 pub mod energy;
 pub mod parallel;
+pub mod region_profile;
 pub mod skips;
 pub mod sleeping;
 mod sphere_kernel;

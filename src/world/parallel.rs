@@ -20,7 +20,14 @@
 //!
 //! Work is split into contiguous chunks of items, a few per thread ([`CHUNKS_PER_THREAD`]), each with its
 //! own [`Worker`] scratch (EPA buffers and narrow-phase counters) taken from a vector kept in the step's
-//! scratch: no locks, no allocation once warm. Errors are reported deterministically: each chunk stops at
+//! scratch: no locks, no allocation once warm. Every chunk is a rayon job of its own (`with_max_len(1)`),
+//! so a thread that runs dry steals single chunks and the threads of a region end within about one chunk
+//! of each other (rayon's default split stops at runs of a quarter of the chunks on two threads unless
+//! they are stolen, and a run one thread has started cannot be shared any more: the expensive candidates
+//! around a projectile are contiguous in candidate order). The load balance per region is measured by
+//! [`super::region_profile`] (`perf_threads --profile`): on the struck bed of 10⁴ polyhedra the costliest
+//! chunk of the narrow phase holds ~6 % of a thread's share (2026-11-22), so chunking alone leaves the
+//! threads ≤ ~3 % apart. Errors are reported deterministically: each chunk stops at
 //! its first failing item and the error of the lowest failing chunk wins, which is the first failing item
 //! in item order.
 //!
@@ -58,13 +65,16 @@ use rayon::prelude::*;
 
 use crate::contact::{EpaScratch, QueryCounters};
 
+use super::region_profile;
+
 /// Chunks per thread: more than one so that a thread finishing early takes work from a slow one (contact
 /// queries differ in cost by 10× between a cached rejection and an EPA run), few enough that the per-chunk
 /// overhead stays small. At the end of a region one thread waits on average for half a chunk of the
 /// other's: with `k` chunks per thread on two threads that is `1 / (8 k)` of the serial work, 1.6 % of the
-/// region at 8, 0.4 % at 32. A chunk costs a [`Worker`] (kept between steps) and a result slot, and rayon
-/// splits the chunk sequence adaptively (a steal, ~1 µs, only where a thread runs dry), so 32 chunks of the
-/// ~360 candidates of a 10⁴-polyhedra bed (~150 µs each) cost nothing measurable.
+/// region at 8, 0.4 % at 32 (for chunks of equal cost; the costliest chunk of the struck bed costs about
+/// twice the mean). A chunk costs a [`Worker`] (kept between steps), a result slot and a rayon job (a
+/// push and pop of the thread's own deque, or a steal of ~1 µs where a thread runs dry), so 32 chunks of
+/// the ~360 candidates of a 10⁴-polyhedra bed (~150 µs each) cost nothing measurable.
 pub const CHUNKS_PER_THREAD: usize = 32;
 
 /// Default [`Parallelism::min_candidates`]: 4096 candidate pairs (see the module docs: a region pays from
@@ -129,10 +139,29 @@ pub struct Worker {
     pub tally: u64,
 }
 
+/// Items per chunk of a region of `n` items on the current pool: [`CHUNKS_PER_THREAD`] chunks per thread.
+#[inline]
+fn chunk_len(n: usize) -> usize {
+    n.div_ceil(rayon::current_num_threads() * CHUNKS_PER_THREAD)
+        .max(1)
+}
+
+/// Whether a region of `n` items runs on the pool.
+#[inline]
+fn on_pool(parallel: bool, n: usize) -> bool {
+    parallel && n >= 2 && rayon::current_num_threads() > 1
+}
+
 /// Calls `f(i, &mut states[i], &mut out[i], worker)` for every item `i`, on the current rayon pool when
 /// `parallel` (in chunks, one [`Worker`] per chunk), else serially with `workers[0]`. Returns the error of
 /// the first failing item in item order. `workers` is resized to the number of chunks; its counters are
 /// left for the caller to merge.
+///
+/// Every chunk is a job of its own (`with_max_len(1)`): a thread that runs dry steals single chunks, so
+/// the threads end within about one chunk of each other however the cost is spread over the items (a
+/// struck region's expensive pairs are contiguous in candidate order). Rayon's default adaptive split
+/// stops at a few large runs of chunks unless they are stolen, and a run taken by one thread could not be
+/// shared any more.
 pub fn for_each_chunked<S, O, E, F>(
     parallel: bool,
     states: &mut [S],
@@ -152,8 +181,7 @@ where
         worker.tally = 0;
     }
     let n = states.len();
-    let threads = rayon::current_num_threads();
-    if !parallel || threads < 2 || n < 2 {
+    if !on_pool(parallel, n) {
         if workers.is_empty() {
             workers.push(Worker::default());
         }
@@ -163,8 +191,7 @@ where
         }
         return Ok(());
     }
-    let chunks = (threads * CHUNKS_PER_THREAD).min(n);
-    let size = n.div_ceil(chunks);
+    let size = chunk_len(n);
     let chunks = n.div_ceil(size);
     if workers.len() < chunks {
         workers.resize_with(chunks, Worker::default);
@@ -173,8 +200,10 @@ where
         .par_chunks_mut(size)
         .zip(out.par_chunks_mut(size))
         .zip(workers[..chunks].par_iter_mut())
+        .with_max_len(1)
         .enumerate()
         .map(|(k, ((s, o), worker))| {
+            let _timer = region_profile::chunk();
             for (j, (s, o)) in s.iter_mut().zip(o.iter_mut()).enumerate() {
                 f(k * size + j, s, o, worker)?;
             }
@@ -184,22 +213,25 @@ where
     results.into_iter().collect()
 }
 
-/// Calls `f(i, &mut items[i])` for every item, in parallel when `parallel` (work split by rayon; `f` must
-/// not depend on the order).
+/// Calls `f(i, &mut items[i])` for every item, in parallel when `parallel` (chunks of items, each a job:
+/// see [`for_each_chunked`]; `f` must not depend on the order).
 pub fn for_each_item<T, F>(parallel: bool, items: &mut [T], f: F)
 where
     T: Send,
     F: Fn(usize, &mut T) + Sync + Send,
 {
-    if parallel && rayon::current_num_threads() > 1 {
-        let min_len = items
-            .len()
-            .div_ceil(rayon::current_num_threads() * CHUNKS_PER_THREAD);
+    if on_pool(parallel, items.len()) {
+        let size = chunk_len(items.len());
         items
-            .par_iter_mut()
-            .with_min_len(min_len.max(1))
+            .par_chunks_mut(size)
+            .with_max_len(1)
             .enumerate()
-            .for_each(|(i, t)| f(i, t));
+            .for_each(|(k, chunk)| {
+                let _timer = region_profile::chunk();
+                for (j, t) in chunk.iter_mut().enumerate() {
+                    f(k * size + j, t);
+                }
+            });
     } else {
         for (i, t) in items.iter_mut().enumerate() {
             f(i, t);
@@ -216,15 +248,23 @@ where
     E: Send,
     F: Fn(usize, &mut T) -> Option<E> + Sync + Send,
 {
-    if parallel && rayon::current_num_threads() > 1 {
-        let min_len = items
-            .len()
-            .div_ceil(rayon::current_num_threads() * CHUNKS_PER_THREAD);
+    if on_pool(parallel, items.len()) {
+        let size = chunk_len(items.len());
         items
-            .par_iter_mut()
-            .with_min_len(min_len.max(1))
+            .par_chunks_mut(size)
+            .with_max_len(1)
             .enumerate()
-            .filter_map(|(i, t)| f(i, t).map(|e| (i, e)))
+            .filter_map(|(k, chunk)| {
+                let _timer = region_profile::chunk();
+                let mut first = None;
+                for (j, t) in chunk.iter_mut().enumerate() {
+                    let i = k * size + j;
+                    if let Some(e) = f(i, t) {
+                        first.get_or_insert((i, e));
+                    }
+                }
+                first
+            })
             .min_by_key(|(i, _)| *i)
     } else {
         let mut first = None;
@@ -255,16 +295,29 @@ where
     F: Fn(usize, &mut A, &mut B, &mut C) -> Option<E> + Sync + Send,
 {
     debug_assert!(a.len() == b.len() && a.len() == c.len());
-    if parallel && rayon::current_num_threads() > 1 {
-        let min_len = a
-            .len()
-            .div_ceil(rayon::current_num_threads() * CHUNKS_PER_THREAD);
-        a.par_iter_mut()
-            .zip(b.par_iter_mut())
-            .zip(c.par_iter_mut())
-            .with_min_len(min_len.max(1))
+    if on_pool(parallel, a.len()) {
+        let size = chunk_len(a.len());
+        a.par_chunks_mut(size)
+            .zip(b.par_chunks_mut(size))
+            .zip(c.par_chunks_mut(size))
+            .with_max_len(1)
             .enumerate()
-            .filter_map(|(i, ((x, y), z))| f(i, x, y, z).map(|e| (i, e)))
+            .filter_map(|(k, ((xs, ys), zs))| {
+                let _timer = region_profile::chunk();
+                let mut first = None;
+                for (j, ((x, y), z)) in xs
+                    .iter_mut()
+                    .zip(ys.iter_mut())
+                    .zip(zs.iter_mut())
+                    .enumerate()
+                {
+                    let i = k * size + j;
+                    if let Some(e) = f(i, x, y, z) {
+                        first.get_or_insert((i, e));
+                    }
+                }
+                first
+            })
             .min_by_key(|(i, _)| *i)
     } else {
         let mut first = None;
@@ -274,6 +327,41 @@ where
             }
         }
         first
+    }
+}
+
+/// Calls `f(i, &mut a[i], &mut b[i], &mut c[i])` for every item, in parallel when `parallel` (chunks of
+/// items, each a job; `f` must not depend on the order).
+pub fn for_each_item3<A, B, C, F>(parallel: bool, a: &mut [A], b: &mut [B], c: &mut [C], f: F)
+where
+    A: Send,
+    B: Send,
+    C: Send,
+    F: Fn(usize, &mut A, &mut B, &mut C) + Sync + Send,
+{
+    debug_assert!(a.len() == b.len() && a.len() == c.len());
+    if on_pool(parallel, a.len()) {
+        let size = chunk_len(a.len());
+        a.par_chunks_mut(size)
+            .zip(b.par_chunks_mut(size))
+            .zip(c.par_chunks_mut(size))
+            .with_max_len(1)
+            .enumerate()
+            .for_each(|(k, ((xs, ys), zs))| {
+                let _timer = region_profile::chunk();
+                for (j, ((x, y), z)) in xs
+                    .iter_mut()
+                    .zip(ys.iter_mut())
+                    .zip(zs.iter_mut())
+                    .enumerate()
+                {
+                    f(k * size + j, x, y, z);
+                }
+            });
+    } else {
+        for (i, ((x, y), z)) in a.iter_mut().zip(b.iter_mut()).zip(c.iter_mut()).enumerate() {
+            f(i, x, y, z);
+        }
     }
 }
 
@@ -287,8 +375,8 @@ where
     for_each_item(parallel, out, |i, slot| *slot = f(i));
 }
 
-/// Calls `f(i, &mut a[i], &mut b[i])` for every item, in parallel when `parallel` (work split by rayon; `f`
-/// must not depend on the order).
+/// Calls `f(i, &mut a[i], &mut b[i])` for every item, in parallel when `parallel` (chunks of items, each a
+/// job; `f` must not depend on the order).
 pub fn for_each_item_pair<A, B, F>(parallel: bool, a: &mut [A], b: &mut [B], f: F)
 where
     A: Send,
@@ -296,15 +384,18 @@ where
     F: Fn(usize, &mut A, &mut B) + Sync + Send,
 {
     debug_assert_eq!(a.len(), b.len());
-    if parallel && rayon::current_num_threads() > 1 {
-        let min_len = a
-            .len()
-            .div_ceil(rayon::current_num_threads() * CHUNKS_PER_THREAD);
-        a.par_iter_mut()
-            .zip(b.par_iter_mut())
-            .with_min_len(min_len.max(1))
+    if on_pool(parallel, a.len()) {
+        let size = chunk_len(a.len());
+        a.par_chunks_mut(size)
+            .zip(b.par_chunks_mut(size))
+            .with_max_len(1)
             .enumerate()
-            .for_each(|(i, (x, y))| f(i, x, y));
+            .for_each(|(k, (xs, ys))| {
+                let _timer = region_profile::chunk();
+                for (j, (x, y)) in xs.iter_mut().zip(ys.iter_mut()).enumerate() {
+                    f(k * size + j, x, y);
+                }
+            });
     } else {
         for (i, (x, y)) in a.iter_mut().zip(b.iter_mut()).enumerate() {
             f(i, x, y);

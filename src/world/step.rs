@@ -46,13 +46,15 @@ use crate::law::{ContactKinematics, ContactModel, DampingLaw, TangentialLaw};
 use crate::math::{Point, Real, Vector};
 use crate::shape::Shape;
 
+use super::body_inputs;
 use super::contact_store::BodyAdjacency;
 use super::contact_store::{ContactKey, ContactState};
 use super::energy::{viscous_power, ContactWork, LastForces};
 use super::parallel::{
-    for_each_chunked, for_each_item, for_each_item3_checked, for_each_item_checked,
+    for_each_chunked, for_each_item3, for_each_item3_checked, for_each_item_checked,
     for_each_item_pair, integration_work, Parallelism, Worker,
 };
+use super::region_profile::{self, Section};
 use super::skips::{self, Skips};
 use super::sleeping::{self, SleepParams};
 use super::sphere_kernel;
@@ -113,14 +115,12 @@ impl StepParams {
 /// Buffers reused between steps; nothing in them matters after a step.
 #[derive(Clone, Debug, Default)]
 pub struct StepScratch {
-    centres: Vec<Point>,
-    /// Per body: whether it is dynamic.
-    dynamic: Vec<bool>,
+    /// Per-body inputs of stage 3 (written by the drift pass) and the kept candidate list's key; its
+    /// summary's anisotropic count (dynamic bodies with unequal principal moments at the last evaluation
+    /// of the loads) chooses serial or parallel integration (never a result).
+    inputs: body_inputs::BodyInputs,
     /// Whether some body has a prescribed motion (its power enters the ledger).
     any_prescribed: bool,
-    /// Dynamic bodies with unequal principal moments at the last evaluation of the loads: they cost the
-    /// integration several times a sphere (only the choice serial/parallel depends on it, never a result).
-    anisotropic: usize,
     /// The contact model of each material pair with the skips applied.
     models: Vec<Option<ContactModel>>,
     candidates: Vec<ContactKey>,
@@ -337,15 +337,22 @@ pub fn step(
 
     // 1–2. First half kick with the kept loads, drift.
     let t = Instant::now();
-    let parallel_bodies =
-        integration_work(world.bodies.len(), scratch.anisotropic) >= params.parallel.min_bodies;
+    let parallel_bodies = integration_work(world.bodies.len(), scratch.inputs.summary.anisotropic)
+        >= params.parallel.min_bodies;
     let (loads, asleep) = (&world.loads, &world.sleep);
     let skip = params.skips;
     let splitting = match params.rotation {
         RotationScheme::Splitting { sub_rotation } => Some(sub_rotation),
         _ => None,
     };
-    for_each_item(parallel_bodies, &mut world.bodies, |i, body| {
+    // The drift pass also writes what stage 3 reads of each body (centre, flags; see [`super::body_inputs`]).
+    let inputs = &mut scratch.inputs;
+    inputs.resize(world.bodies.len());
+    let (at_build, limit_sq) = (
+        world.broad_phase.centres_at_build(),
+        world.broad_phase.rebuild_limit_sq(),
+    );
+    let kick_drift = |i: usize, body: &mut crate::dynamics::RigidBody| {
         if asleep.is_asleep(i) || (skip.non_dynamic_pairs && is_at_rest_fixed(body)) {
             return;
         }
@@ -371,7 +378,21 @@ pub fn step(
             }
         }
         integrator.drift(body, dt);
+    };
+    region_profile::region(Section::KickDrift, || {
+        for_each_item3(
+            parallel_bodies,
+            &mut world.bodies,
+            &mut inputs.centres,
+            &mut inputs.flags,
+            |i, body, centre, flags| {
+                kick_drift(i, body);
+                *centre = body.position;
+                *flags = body_inputs::flags_of(i, body, at_build, limit_sq);
+            },
+        )
     });
+    inputs.fresh = true;
     for wall in &mut world.walls {
         wall.pose.translation.vector += dt * wall.velocity;
     }
@@ -400,35 +421,43 @@ pub fn step(
     // 7–8. Second half kick, then the checks of the same body, in one pass (the first non-finite body in
     // body order is reported, for any number of threads).
     let t = Instant::now();
-    let parallel_bodies =
-        integration_work(world.bodies.len(), scratch.anisotropic) >= params.parallel.min_bodies;
+    let parallel_bodies = integration_work(world.bodies.len(), scratch.inputs.summary.anisotropic)
+        >= params.parallel.min_bodies;
     let non_finite = if std::mem::take(&mut scratch.deferred_gather) {
         // Stage 6's per-body sums, fused with 7–8: body i's force and torque over its pairs in candidate
         // order (the same additions as the gather of stage 6), then its kick and checks.
-        let adjacency = world.contacts.body_adjacency(world.bodies.len());
+        let n_bodies = world.bodies.len();
+        let adjacency = region_profile::serial(Section::SerialStore, || {
+            world.contacts.body_adjacency(n_bodies)
+        });
         report.counters.serial += t.elapsed();
         let (evaluated, asleep) = (&scratch.evaluated, &world.sleep);
         let loads = &mut world.loads;
-        for_each_item3_checked(
-            true,
-            &mut world.bodies,
-            &mut loads.forces,
-            &mut loads.torques,
-            |i, body, force, torque| {
-                sum_body_loads(adjacency, evaluated, i, force, torque);
-                if !(asleep.is_asleep(i) || (skip.non_dynamic_pairs && is_at_rest_fixed(body))) {
-                    integrator.second_half_kick(body, force, torque, dt);
-                }
-                non_finite_quantity(body, force, torque)
-            },
-        )
+        region_profile::region(Section::KickChecks, || {
+            for_each_item3_checked(
+                true,
+                &mut world.bodies,
+                &mut loads.forces,
+                &mut loads.torques,
+                |i, body, force, torque| {
+                    sum_body_loads(adjacency, evaluated, i, force, torque);
+                    if !(asleep.is_asleep(i) || (skip.non_dynamic_pairs && is_at_rest_fixed(body)))
+                    {
+                        integrator.second_half_kick(body, force, torque, dt);
+                    }
+                    non_finite_quantity(body, force, torque)
+                },
+            )
+        })
     } else {
         let (loads, asleep) = (&world.loads, &world.sleep);
-        let non_finite = for_each_item_checked(parallel_bodies, &mut world.bodies, |i, body| {
-            if !(asleep.is_asleep(i) || (skip.non_dynamic_pairs && is_at_rest_fixed(body))) {
-                integrator.second_half_kick(body, &loads.forces[i], &loads.torques[i], dt);
-            }
-            non_finite_quantity(body, &loads.forces[i], &loads.torques[i])
+        let non_finite = region_profile::region(Section::KickChecks, || {
+            for_each_item_checked(parallel_bodies, &mut world.bodies, |i, body| {
+                if !(asleep.is_asleep(i) || (skip.non_dynamic_pairs && is_at_rest_fixed(body))) {
+                    integrator.second_half_kick(body, &loads.forces[i], &loads.torques[i], dt);
+                }
+                non_finite_quantity(body, &loads.forces[i], &loads.torques[i])
+            })
         });
         if !parallel_bodies {
             report.counters.serial += t.elapsed();
@@ -481,51 +510,39 @@ fn evaluate_loads(
 
     // 3. Broad phase.
     let t = Instant::now();
-    // Per-body inputs of the stages below, in one pass over the bodies: centres (broad phase), whether
-    // dynamic (pair loops: a flag instead of a random access to a whole body per pair), whether some motion
-    // is prescribed (ledger), and the anisotropic count (the integration's parallel choice).
-    scratch.centres.clear();
-    scratch.dynamic.clear();
-    scratch.any_prescribed = false;
-    scratch.anisotropic = 0;
-    for b in &world.bodies {
-        let dynamic = b.is_dynamic();
-        scratch.centres.push(b.position);
-        scratch.dynamic.push(dynamic);
-        scratch.any_prescribed |= matches!(b.motion, Motion::Prescribed { .. });
-        scratch.anisotropic += (dynamic && !is_isotropic(&b.inertia.0)) as usize;
+    let profile_inputs = region_profile::serial_start();
+    // Per-body inputs of the stages below (centres for the broad phase, flags: dynamic, anisotropic,
+    // prescribed, moved half the skin), written by this step's drift pass, else here (the initial
+    // evaluation), then folded (see [`super::body_inputs`]).
+    let inputs = &mut scratch.inputs;
+    if !std::mem::take(&mut inputs.fresh) {
+        inputs.write(&world.bodies, &world.broad_phase);
     }
-    if !params.skips.verlet_skin {
-        world
-            .broad_phase
-            .rebuild_with_walls(&scratch.centres, &world.radii, &world.walls);
-        counters.broad_rebuilds += 1;
-    } else if world
-        .broad_phase
-        .update_with_walls(&scratch.centres, &world.radii, &world.walls)
-    {
+    inputs.summarise();
+    let summary = inputs.summary;
+    let broad = &mut world.broad_phase;
+    let rebuild = !params.skips.verlet_skin
+        || broad.rebuilds() == 0
+        || broad.centres_at_build().len() != inputs.centres.len()
+        || summary.any_far
+        || broad.walls_moved(&world.walls);
+    region_profile::serial_end(Section::SerialInputs, profile_inputs);
+    if rebuild {
+        broad.rebuild_with_walls(&inputs.centres, &world.radii, &world.walls);
         counters.broad_rebuilds += 1;
     }
-    scratch.candidates.clear();
-    let skip_non_dynamic = params.skips.non_dynamic_pairs;
-    let dynamic = &scratch.dynamic;
-    for &(a, b) in world.broad_phase.pairs() {
-        if !skip_non_dynamic || dynamic[a as usize] || dynamic[b as usize] {
-            scratch.candidates.push(ContactKey::Body { a, b });
-        }
-    }
-    counters.body_pairs_tested += scratch.candidates.len() as u64;
-    // Body–wall pairs: the broad phase's list (bodies that can reach a wall before its next rebuild).
-    let before = scratch.candidates.len();
-    for &(body, wall) in world.broad_phase.wall_pairs() {
-        if dynamic[body as usize] {
-            scratch.candidates.push(ContactKey::Wall { body, wall });
-        }
-    }
-    let wall_pairs = (scratch.candidates.len() - before) as u64;
-    let dynamic_bodies = dynamic.iter().filter(|&&d| d).count() as u64;
+    let profile_inputs = region_profile::serial_start();
+    // The candidate list: kept from the last step unless the grid was rebuilt or a dynamic flag changed.
+    inputs.update_candidates(
+        broad,
+        params.skips.non_dynamic_pairs,
+        &mut scratch.candidates,
+    );
+    counters.body_pairs_tested += inputs.body_candidates as u64;
+    let wall_pairs = inputs.wall_candidates as u64;
     counters.wall_pairs_tested += wall_pairs;
-    counters.wall_pairs_rejected += dynamic_bodies * world.walls.len() as u64 - wall_pairs;
+    counters.wall_pairs_rejected += summary.dynamic as u64 * world.walls.len() as u64 - wall_pairs;
+    scratch.any_prescribed = summary.any_prescribed;
     // The contact models of every material pair with the skips applied, once per step.
     let n_materials = world.materials.len();
     scratch.models.clear();
@@ -537,6 +554,7 @@ fn evaluate_loads(
                 .push(model.map(|m| effective_model(m, &params.skips)));
         }
     }
+    region_profile::serial_end(Section::SerialInputs, profile_inputs);
     let elapsed = t.elapsed();
     counters.broad += elapsed;
     counters.serial += elapsed.saturating_sub(world.broad_phase.take_parallel_search_time());
@@ -549,7 +567,13 @@ fn evaluate_loads(
     // writing the per-pair state; it is put back before any return.
     let mut contacts = std::mem::take(&mut world.contacts);
     let t_sync = Instant::now();
-    let sync = contacts.sync(&scratch.candidates, step_index);
+    let sync = region_profile::serial(Section::SerialStore, || {
+        contacts.sync_tagged(
+            &scratch.candidates,
+            scratch.inputs.candidates_tag,
+            step_index,
+        )
+    });
     counters.serial += t_sync.elapsed();
     counters.contacts_created += sync.created as u64;
     counters.contacts_dropped += sync.dropped as u64;
@@ -586,51 +610,53 @@ fn evaluate_loads(
         }
     };
     let t_parallel = Instant::now();
-    let evaluated = for_each_chunked(
-        parallel,
-        contacts.states_mut(),
-        &mut scratch.evaluated,
-        &mut scratch.workers,
-        |i, state, out, worker| {
-            let key = candidates[i];
-            if sleeping::is_frozen_entry(world_ref, key, state) {
-                // Kept from its last evaluation and summed in `scratch.frozen` (stage 6).
-                out.frozen = true;
-                out.overlapping = false;
-                // Frozen bodies do not move: no work.
-                out.work = ContactWork::default();
-                worker.tally += 1;
-                return Ok(());
-            }
-            // The last contact point, for the ledger of a pair that opens in this step.
-            let previous_point = state.geometry.point;
-            if let Some(spheres) = spheres {
-                if let Some(done) = sphere_kernel::evaluate(
-                    params,
-                    &pair,
-                    spheres,
-                    key,
-                    state,
-                    &previous_point,
-                    out,
-                    worker,
-                ) {
-                    done?;
-                    pick(i, out, worker);
+    let evaluated = region_profile::region(Section::Narrow, || {
+        for_each_chunked(
+            parallel,
+            contacts.states_mut(),
+            &mut scratch.evaluated,
+            &mut scratch.workers,
+            |i, state, out, worker| {
+                let key = candidates[i];
+                if sleeping::is_frozen_entry(world_ref, key, state) {
+                    // Kept from its last evaluation and summed in `scratch.frozen` (stage 6).
+                    out.frozen = true;
+                    out.overlapping = false;
+                    // Frozen bodies do not move: no work.
+                    out.work = ContactWork::default();
+                    worker.tally += 1;
                     return Ok(());
                 }
-            }
-            narrow_phase(params, world_ref, key, state, worker).map_err(|source| {
-                StepError::Contact {
-                    step: step_index,
-                    source,
+                // The last contact point, for the ledger of a pair that opens in this step.
+                let previous_point = state.geometry.point;
+                if let Some(spheres) = spheres {
+                    if let Some(done) = sphere_kernel::evaluate(
+                        params,
+                        &pair,
+                        spheres,
+                        key,
+                        state,
+                        &previous_point,
+                        out,
+                        worker,
+                    ) {
+                        done?;
+                        pick(i, out, worker);
+                        return Ok(());
+                    }
                 }
-            })?;
-            contact_law(&pair, key, state, &previous_point, out)?;
-            pick(i, out, worker);
-            Ok(())
-        },
-    );
+                narrow_phase(params, world_ref, key, state, worker).map_err(|source| {
+                    StepError::Contact {
+                        step: step_index,
+                        source,
+                    }
+                })?;
+                contact_law(&pair, key, state, &previous_point, out)?;
+                pick(i, out, worker);
+                Ok(())
+            },
+        )
+    });
     if !parallel {
         counters.serial += t_parallel.elapsed();
     }
@@ -646,6 +672,7 @@ fn evaluate_loads(
     // 6. Accumulate, in candidate order, with the report (the state at the end of the step: an initial
     // evaluation's findings are replaced by those of the step's own evaluation), in one pass.
     let t = Instant::now();
+    let profile_sums = region_profile::serial_start();
     report.contacts = 0;
     report.max_overlap_ratio = 0.0;
     report.overlap_warnings.clear();
@@ -683,12 +710,14 @@ fn evaluate_loads(
         let adjacency = world.contacts.body_adjacency(n);
         let t_gather = Instant::now();
         let evaluated = &scratch.evaluated;
-        for_each_item_pair(
-            true,
-            &mut loads.forces,
-            &mut loads.torques,
-            |i, force, torque| sum_body_loads(adjacency, evaluated, i, force, torque),
-        );
+        region_profile::region(Section::Gather, || {
+            for_each_item_pair(
+                true,
+                &mut loads.forces,
+                &mut loads.torques,
+                |i, force, torque| sum_body_loads(adjacency, evaluated, i, force, torque),
+            )
+        });
         gather_time = t_gather.elapsed();
     }
     // The serial sums visit only the candidates stages 4–5 picked (overlapping, or with ledger terms: a
@@ -774,6 +803,7 @@ fn evaluate_loads(
     }
     loads.external_power = external_power;
     loads.current = true;
+    region_profile::serial_end(Section::SerialSums, profile_sums);
     let elapsed = t.elapsed();
     counters.accumulate += elapsed;
     counters.serial += elapsed.saturating_sub(gather_time);
