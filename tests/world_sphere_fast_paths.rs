@@ -10,7 +10,10 @@
 //! - the `sphere_kernel` skip (`src/world/sphere_kernel.rs`) takes sphere–sphere and wall–sphere pairs
 //!   past the general dispatch: bodies, loads, contact store and ledger must be the same bits with it on
 //!   and off, on the Hertz–Mindlin and the linear spring–dashpot beds, and on a mixed bed of spheres and
-//!   polyhedra (where it must leave the other pairs to the general path).
+//!   polyhedra (where it must leave the other pairs to the general path). The same skip lets a world of
+//!   free spheres take the integration of `src/world/sphere_step.rs`: the comparison on the beds covers it
+//!   (it applies there with the skip on and not with it off), and it must give the same bits on one and
+//!   two threads with every stage forced onto the pool.
 
 #[path = "support/bed.rs"]
 mod bed;
@@ -18,7 +21,9 @@ mod bed;
 use std::path::Path;
 
 use polydem::scene::{load_scene, parse_scene, Simulation};
-use polydem::world::{step, Skips, StepParams, StepScratch, World};
+use polydem::world::{
+    sphere_step_applies, step, Parallelism, Skips, StepParams, StepScratch, World,
+};
 
 const SCENE: &str = "scenes/sphere_bed_a_hertz_5ms.toml";
 const STEPS: u64 = 300;
@@ -196,6 +201,16 @@ fn the_sphere_kernel_is_bit_identical_to_the_general_path_on_the_sphere_beds() {
         if let Some(d) = first_difference(&fast, &general) {
             panic!("{file}, ledger {ledger}, {STEPS} steps, sphere kernel on against off: {d}");
         }
+        // The bed is all free spheres: the kernel's world takes the sphere step, the other does not.
+        let (params_on, params_off) = (scene_at(file).params, {
+            let mut p = scene_at(file).params;
+            without_kernel(&mut p);
+            p
+        });
+        assert!(
+            sphere_step_applies(&params_on, &fast) && !sphere_step_applies(&params_off, &general),
+            "{file}: the sphere step must apply with the kernel on and not with it off"
+        );
         assert_eq!(
             ledger_bits(&fast),
             ledger_bits(&general),
@@ -240,4 +255,41 @@ fn the_sphere_kernel_leaves_polyhedra_to_the_general_path() {
         ledger_bits(&general),
         "mixed bed, {steps} steps: the ledger differs with the sphere kernel on and off"
     );
+}
+
+#[test]
+fn the_sphere_step_gives_the_same_bits_on_one_and_two_threads() {
+    // Every stage on the pool (thresholds 1), ledger on and off.
+    for ledger in [true, false] {
+        let on_threads = |threads: usize| {
+            let mut sim = scene();
+            sim.params.energy_ledger = ledger;
+            sim.params.parallel = Parallelism {
+                min_candidates: 1,
+                min_bodies: 1,
+            };
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap_or_else(|e| panic!("thread pool of {threads}: {e}"));
+            let params = sim.params;
+            let world = pool.install(|| run(sim, STEPS));
+            assert!(
+                sphere_step_applies(&params, &world),
+                "{SCENE}: the sphere step must apply to the bed"
+            );
+            world
+        };
+        let (one, two) = (on_threads(1), on_threads(2));
+        if let Some(d) = first_difference(&one, &two) {
+            panic!("{SCENE}, ledger {ledger}, {STEPS} steps, one thread against two: {d}");
+        }
+        assert_eq!(
+            ledger_bits(&one),
+            ledger_bits(&two),
+            "{SCENE}, ledger {ledger}, {STEPS} steps: the ledger differs on one ({:?}) and two ({:?}) threads",
+            one.ledger,
+            two.ledger
+        );
+    }
 }

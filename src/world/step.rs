@@ -58,6 +58,7 @@ use super::region_profile::{self, Section};
 use super::skips::{self, Skips};
 use super::sleeping::{self, SleepParams};
 use super::sphere_kernel;
+use super::sphere_step;
 use super::world::World;
 
 /// Default of [`StepParams::overlap_warning_fraction`]: 0.05. A DEM run with a stiffness that represents
@@ -118,13 +119,13 @@ pub struct StepScratch {
     /// Per-body inputs of stage 3 (written by the drift pass) and the kept candidate list's key; its
     /// summary's anisotropic count (dynamic bodies with unequal principal moments at the last evaluation
     /// of the loads) chooses serial or parallel integration (never a result).
-    inputs: body_inputs::BodyInputs,
+    pub(super) inputs: body_inputs::BodyInputs,
     /// Whether some body has a prescribed motion (its power enters the ledger).
     any_prescribed: bool,
     /// The contact model of each material pair with the skips applied.
     models: Vec<Option<ContactModel>>,
     candidates: Vec<ContactKey>,
-    evaluated: Vec<Evaluated>,
+    pub(super) evaluated: Vec<Evaluated>,
     /// One per chunk of the parallel stages (see [`super::parallel`]).
     workers: Vec<Worker>,
     /// The summed contributions of the frozen contacts (see [`super::sleeping`]).
@@ -133,7 +134,7 @@ pub struct StepScratch {
     spheres: Vec<sphere_kernel::SphereBody>,
     /// Set by stage 6 when it left the per-body force sums to the pass of stages 7–8 (the gather fused
     /// with the second half kick); consumed in the same step.
-    deferred_gather: bool,
+    pub(super) deferred_gather: bool,
 }
 
 /// Stage timers and counters of one or more steps (merge them with [`StepCounters::merge`]).
@@ -323,6 +324,9 @@ pub fn step(
             world.ledger.initial_total = Some(world.energy().mechanical());
         }
     }
+    if sphere_step::applies(params, world) {
+        return sphere_step::step_spheres(params, world, scratch, report);
+    }
     let external_power_start = world.loads.external_power;
     // Without global damping the viscous power is zero: no pass over the bodies.
     let damped = params.damping != ViscousDamping::None;
@@ -497,7 +501,7 @@ pub fn step(
 }
 
 /// Stages 3–6 at the current positions; `dt` is the tangential increment's time (0 at the initial state).
-fn evaluate_loads(
+pub(super) fn evaluate_loads(
     params: &StepParams,
     world: &mut World,
     scratch: &mut StepScratch,
@@ -813,7 +817,7 @@ fn evaluate_loads(
 /// Stage 6 for body `i`: the sum of the forces and torques of its overlapping pairs, in candidate order
 /// (side A receives the opposite of the force on B and the torque on A).
 #[inline]
-fn sum_body_loads(
+pub(super) fn sum_body_loads(
     adjacency: &BodyAdjacency,
     evaluated: &[Evaluated],
     i: usize,
@@ -1245,7 +1249,7 @@ fn is_at_rest_fixed(body: &crate::dynamics::RigidBody) -> bool {
 }
 
 /// Stage 8 for one body: the first non-finite quantity of its loads and state, if any.
-fn non_finite_quantity(
+pub(super) fn non_finite_quantity(
     body: &crate::dynamics::RigidBody,
     force: &Vector,
     torque: &Vector,
