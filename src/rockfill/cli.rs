@@ -272,6 +272,23 @@ pub fn summary(config: &ExperimentConfig, r: &ExperimentResult) -> String {
             p.ledger_balance_relative[2],
             p.wall_time.as_secs_f64()
         );
+        if let Some(c) = &p.collapse {
+            let _ = writeln!(
+                s,
+                "  pre-collapse: top {:.3} m -> {:.3} m, descent mean {:.3} m, max {:.3} m, {} moves, {} of {} rocks held by three blockers, {} pairs, {} distance queries ({} capped); {:.2} s",
+                c.top_before,
+                c.top_after,
+                c.mean_descent,
+                c.max_descent,
+                c.moves,
+                c.held_by_three,
+                c.rocks,
+                c.pairs,
+                c.queries,
+                c.capped,
+                c.wall_time.as_secs_f64()
+            );
+        }
         for (stage, c) in ["deposition", "compaction", "hold"].iter().zip(&p.counters) {
             let time = c.total_time().as_secs_f64();
             let _ = writeln!(

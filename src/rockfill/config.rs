@@ -92,6 +92,15 @@ pub struct PackingParams {
     pub compaction_pressure: Real,
     /// Time with the top wall stopped after compaction (s).
     pub hold_time: Real,
+    /// Geometric pre-collapse before the drop ([`super::collapse`]): the gap left under every rock, as a
+    /// fraction of the mean rock size. Absent: the rocks fall from where they were generated (the procedure of
+    /// the runs made before the collapse existed). A packing-procedure choice; the paper fixes none.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub collapse_gap: Option<Real>,
+    /// Deposition also waits until the rocks' kinetic energy is below this fraction of Σ m g d̄ (the work of
+    /// lifting every rock by one mean size d̄). Absent: only the speed criterion (`settle_speed`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub settle_kinetic_fraction: Option<Real>,
 }
 
 /// The impact.
@@ -260,6 +269,24 @@ impl ExperimentConfig {
             ("sleeping.rest_speed", self.sleeping.rest_speed),
             ("sleeping.rest_force", self.sleeping.rest_force),
         ];
+        for (field, value) in [
+            ("packing.collapse_gap", self.packing.collapse_gap),
+            (
+                "packing.settle_kinetic_fraction",
+                self.packing.settle_kinetic_fraction,
+            ),
+        ] {
+            if let Some(v) = value {
+                if !(v.is_finite() && v > 0.0 && v < 1.0) {
+                    return Err(ConfigError::Invalid {
+                        path: path.to_owned(),
+                        field,
+                        value: v,
+                        reason: "must lie strictly between 0 and 1",
+                    });
+                }
+            }
+        }
         if !(self.sleeping.wake_contact_fraction.is_finite()
             && self.sleeping.wake_contact_fraction >= 0.0)
         {

@@ -6,6 +6,7 @@ use std::time::Duration;
 use super::bed::{
     has_checkpoint, load_bed_checkpoint, load_bed_info, save_bed_checkpoint, BedError, BedInfo,
 };
+use super::collapse::{collapse, CollapseParams};
 use super::config::ExperimentConfig;
 use super::generation::{generate, GenerationError, GenerationParams, Sample};
 use super::packing::{load_bed, loose_world, pack, save_bed, PackingError, PackingReport};
@@ -178,10 +179,37 @@ pub fn run_experiment_with(
                 ),
             );
             let top = config.layer.height * config.packing.generation_height_factor;
-            let mut world = loose_world(config, &sample.rocks, top)?;
-            let packing = pack(config, &mut world, |stage, t, h| {
+            let mut rocks = sample.rocks;
+            let collapsed = config.packing.collapse_gap.map(|gap| {
+                let report = collapse(
+                    &mut rocks,
+                    &CollapseParams::new(
+                        config.layer.length,
+                        config.layer.width,
+                        config.rock.mean_size,
+                        gap,
+                    ),
+                );
+                progress(
+                    "collapse",
+                    format!(
+                        "top {:.3} m -> {:.3} m, mean descent {:.3} m, {} moves, {} held by three, {} distance queries, {:.2} s",
+                        report.top_before,
+                        report.top_after,
+                        report.mean_descent,
+                        report.moves,
+                        report.held_by_three,
+                        report.queries,
+                        report.wall_time.as_secs_f64()
+                    ),
+                );
+                report
+            });
+            let mut world = loose_world(config, &rocks, top)?;
+            let mut packing = pack(config, &mut world, |stage, t, h| {
                 progress(stage, format!("t = {t:.3} s, height {h:.3} m"))
             })?;
+            packing.collapse = collapsed;
             let info = BedInfo::new(
                 config.rock.mean_size,
                 config.rock.seed,

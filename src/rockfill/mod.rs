@@ -9,6 +9,8 @@
 //! - [`statistics`]: realised size distribution and shape statistics;
 //! - [`projectile`]: the ogive-nosed projectile with its internal cavity (mass properties solid − cavity);
 //! - [`config`]: the experiment's parameters as data (Table 1 and what the paper does not state), the laws;
+//! - [`collapse`]: the geometric pre-collapse of the loose sample (rocks moved straight down until nearly
+//!   supported) that the packing starts from;
 //! - [`packing`]: the container, deposition under gravity, compaction by a moving top wall, hold, bed CSV;
 //! - [`bed`]: the packed bed as an engine checkpoint, so that penetration runs start from it;
 //! - [`penetration`]: the impact run and its monitors (velocity, resistance, deflection, disturbed zone);
@@ -17,6 +19,7 @@
 
 pub mod bed;
 pub mod cli;
+pub mod collapse;
 pub mod config;
 pub mod convergence;
 pub mod experiment;

@@ -8,10 +8,17 @@
 //! the right one) without renumbering the other walls' contact-store keys.
 //!
 //! # Stages
+//! 0. Pre-collapse (when `collapse_gap` is set, [`super::collapse`], done on the rocks before the world is
+//!    built): every rock moved straight down until it nearly touches a rock or the floor.
 //! 1. Deposition: gravity with a global mass-proportional viscous damping α (a numerical device that removes
 //!    the kinetic energy of the fall; accounted in the energy ledger as viscous dissipation, and switched off
-//!    in the penetration run), until every rock is slower than `settle_speed`, at least one free-fall time
-//!    of the generation height and at most `max_deposition_time`.
+//!    in the penetration run), until every rock is slower than `settle_speed` (and, when
+//!    `settle_kinetic_fraction` is set, the kinetic energy is below that fraction of Σ m g d̄), at least a
+//!    minimum time and at most `max_deposition_time`. The minimum time is the free-fall time of the
+//!    generation height for a drop from the loose sample, and for a pre-collapsed bed the free-fall time
+//!    over the sum of the gaps under a rock at the bed's top, n g_c with n = top / d̄ rock layers and g_c the
+//!    collapse gap (the time for the top of the stack to close every gap under it: before that the bed is
+//!    still starting to move, and its speeds say nothing about rest).
 //! 2. Compaction: if the bed stands above the layer height H, the top wall is placed on the bed and moves down
 //!    at `compaction_speed` until it reaches H, slowed by a servo as its contact force F approaches the cap
 //!    F_cap = `compaction_pressure` × L W (speed × max(0, 1 − F/F_cap)). If it stalls (speed below [`STALL_FRACTION`]) for
@@ -39,6 +46,7 @@ use std::path::Path;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
+use super::collapse::CollapseReport;
 use super::config::{ConfigError, ExperimentConfig};
 use super::grading::Rock;
 use crate::dynamics::{BodyError, PrincipalInertia, RigidBody, ViscousDamping};
@@ -253,6 +261,64 @@ pub struct PackingReport {
     pub wall_time: Duration,
     /// The step's stage timers and counters summed over deposition, compaction and hold.
     pub counters: [StepCounters; 3],
+    /// The pre-collapse, when the configuration asks for one (set by the caller that collapsed the rocks).
+    pub collapse: Option<CollapseReport>,
+    /// The bed every [`TRACE_EVERY`] steps (written as `packing_trace.csv`).
+    pub trace: Vec<PackingSample>,
+}
+
+/// Steps between two rows of [`PackingReport::trace`] (and between two settle checks).
+pub const TRACE_EVERY: u64 = 100;
+
+/// One row of the packing trace.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct PackingSample {
+    /// 0 deposition, 1 compaction, 2 hold.
+    pub stage: usize,
+    pub step: u64,
+    /// Simulated time (s).
+    pub time: Real,
+    /// Largest rock speed (m/s).
+    pub max_speed: Real,
+    /// Translational + rotational kinetic energy of the rocks (J).
+    pub kinetic_energy: Real,
+    /// Kinetic energy / Σ m g d̄.
+    pub kinetic_fraction: Real,
+    /// Highest rock point and top wall (m).
+    pub bed_top: Real,
+    pub top_wall: Real,
+    /// z component of the top wall's contact force, as the compaction servo reads it (N).
+    pub wall_force: Real,
+}
+
+impl PackingSample {
+    pub const CSV_HEADER: &'static str =
+        "stage,step,time,max_speed,kinetic_energy,kinetic_fraction,bed_top,top_wall,wall_force";
+
+    pub fn csv_row(&self) -> String {
+        format!(
+            "{},{},{},{},{},{},{},{},{}",
+            ["deposition", "compaction", "hold"][self.stage.min(2)],
+            self.step,
+            self.time,
+            self.max_speed,
+            self.kinetic_energy,
+            self.kinetic_fraction,
+            self.bed_top,
+            self.top_wall,
+            self.wall_force
+        )
+    }
+}
+
+/// Writes the packing trace as CSV.
+pub fn write_packing_trace(path: &Path, trace: &[PackingSample]) -> std::io::Result<()> {
+    let mut out = std::io::BufWriter::new(std::fs::File::create(path)?);
+    writeln!(out, "{}", PackingSample::CSV_HEADER)?;
+    for row in trace {
+        writeln!(out, "{}", row.csv_row())?;
+    }
+    out.flush()
 }
 
 /// Builds the loose world from `rocks` (container top at `top`).
@@ -300,6 +366,13 @@ pub fn pack(
         .iter()
         .map(|b| b.mass * 9.81 * b.position.z)
         .sum();
+    // Energy scale of the settle criterion: Σ m g d̄.
+    let lift_energy: Real = world
+        .bodies
+        .iter()
+        .filter(|b| b.is_dynamic())
+        .map(|b| b.mass * 9.81 * config.rock.mean_size)
+        .sum();
     const DEPOSITION: usize = 0;
     const COMPACTION: usize = 1;
     const HOLD: usize = 2;
@@ -310,16 +383,42 @@ pub fn pack(
             report.counters[stage].merge(&r.counters);
             Ok(())
         };
+    let sample = |world: &World, stage: usize, step: u64| -> PackingSample {
+        let e = world.energy();
+        let kinetic = e.translational_kinetic + e.rotational_kinetic;
+        PackingSample {
+            stage,
+            step,
+            time: world.time,
+            max_speed: max_speed(world),
+            kinetic_energy: kinetic,
+            kinetic_fraction: kinetic / lift_energy,
+            bed_top: bed_top(world),
+            top_wall: top_wall_height(world),
+            wall_force: world.loads.wall_forces.get(TOP_WALL).map_or(0.0, |f| f.z),
+        }
+    };
     // 1. Deposition.
-    let fall_time = (2.0 * initial_top / 9.81).sqrt();
-    let check_every = 100;
+    let min_time = match p.collapse_gap {
+        // The free fall over the gaps stacked under the top rock (see the module docs).
+        Some(gap) => (2.0 * (bed_top(world) / config.rock.mean_size) * gap * config.rock.mean_size
+            / 9.81)
+            .sqrt(),
+        None => (2.0 * initial_top / 9.81).sqrt(),
+    };
+    let check_every = TRACE_EVERY;
     loop {
         run(world, &mut report, DEPOSITION)?;
         report.deposition_steps += 1;
         let t = world.time;
         if report.deposition_steps.is_multiple_of(check_every) {
-            progress("deposition", t, bed_top(world));
-            if (t >= fall_time && max_speed(world) < p.settle_speed) || t >= p.max_deposition_time {
+            let row = sample(world, DEPOSITION, report.deposition_steps);
+            report.trace.push(row);
+            progress("deposition", t, row.bed_top);
+            let calm = row.max_speed < p.settle_speed
+                && p.settle_kinetic_fraction
+                    .is_none_or(|f| row.kinetic_fraction < f);
+            if (t >= min_time && calm) || t >= p.max_deposition_time {
                 break;
             }
         }
@@ -345,6 +444,9 @@ pub fn pack(
             run(world, &mut report, COMPACTION)?;
             report.compaction_steps += 1;
             if report.compaction_steps.is_multiple_of(check_every) {
+                report
+                    .trace
+                    .push(sample(world, COMPACTION, report.compaction_steps));
                 progress("compaction", world.time, top_wall_height(world));
             }
             if fraction < STALL_FRACTION {
@@ -367,6 +469,7 @@ pub fn pack(
         run(world, &mut report, HOLD)?;
         report.hold_steps += 1;
         if report.hold_steps.is_multiple_of(check_every) {
+            report.trace.push(sample(world, HOLD, report.hold_steps));
             progress("hold", world.time, bed_top(world));
         }
     }

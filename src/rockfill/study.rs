@@ -265,6 +265,10 @@ pub fn run_one(
         }
     })?;
     write_monitors(&dir.join("monitors.csv"), &result.penetration.rows)?;
+    if let Some(p) = &result.packing {
+        let path = dir.join("packing_trace.csv");
+        super::packing::write_packing_trace(&path, &p.trace).map_err(io_error(&path))?;
+    }
     let text = super::cli::summary(config, &result);
     let path = dir.join("summary.txt");
     std::fs::write(&path, &text).map_err(io_error(&path))?;
