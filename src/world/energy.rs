@@ -67,6 +67,7 @@
 //! implicitly in the second, and their work differs from the trapezoid by (Δt²/8) c (v_n·a_n −
 //! v_(n+1)·a_(n+1)), which telescopes (measured: fitted order 1.93, same test).
 
+use crate::dynamics::ViscousDamping;
 use crate::law::tangential::{release_spring, rotate_into_tangent_plane};
 use crate::law::{ContactModel, ContactResponse, TangentialHistory};
 use crate::math::Real;
@@ -272,6 +273,48 @@ pub(crate) fn viscous_power(world: &World, coefficient: impl Fn(Real) -> Real) -
         .filter(|b| b.is_dynamic())
         .map(|b| coefficient(b.mass) * b.velocity.norm_squared())
         .sum()
+}
+
+/// The powers stage 9 integrates over a step by the trapezoid rule, as they were at its start: the
+/// external power of the moving walls and the global viscous damping's power. Both step paths (the
+/// general one and [`super::sphere_step`]) take them at the start and close the step with them.
+pub(super) struct StepPowers {
+    external: Real,
+    viscous: Real,
+}
+
+/// The global viscous damping's power at the current state; zero without damping (no pass over the
+/// bodies).
+fn damping_power(damping: ViscousDamping, world: &World) -> Real {
+    if damping != ViscousDamping::None {
+        viscous_power(world, |m| damping.coefficient(m))
+    } else {
+        0.0
+    }
+}
+
+impl StepPowers {
+    /// The powers at the start of a step.
+    pub(super) fn at_start(damping: ViscousDamping, world: &World) -> Self {
+        Self {
+            external: world.loads.external_power,
+            viscous: damping_power(damping, world),
+        }
+    }
+
+    /// Stage 9: books the step's contact dissipation and work, the trapezoids of the two powers over `dt`,
+    /// and advances the time and the step index.
+    pub(super) fn close_step(self, damping: ViscousDamping, dt: Real, world: &mut World) {
+        let viscous_end = damping_power(damping, world);
+        let ledger = &mut world.ledger;
+        ledger.dissipated_damping += world.loads.damping_work;
+        ledger.dissipated_friction += world.loads.friction_dissipation;
+        ledger.tangential_stiffness_work += world.loads.tangential_stiffness_work;
+        ledger.dissipated_viscous += 0.5 * (self.viscous + viscous_end) * dt;
+        ledger.external_work += 0.5 * (self.external + world.loads.external_power) * dt;
+        world.time += dt;
+        world.step_index += 1;
+    }
 }
 
 impl World {

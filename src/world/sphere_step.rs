@@ -23,12 +23,12 @@ use std::time::Instant;
 
 use crate::dynamics::rotation::{drift_isotropic, is_isotropic};
 use crate::dynamics::translation::{drift_position, first_half_kick, second_half_kick};
-use crate::dynamics::{Motion, RigidBody, RotationScheme, TranslationParams, ViscousDamping};
+use crate::dynamics::{Motion, RigidBody, RotationScheme, TranslationParams};
 use crate::math::{Real, Vector};
 use crate::shape::Shape;
 
 use super::body_inputs;
-use super::energy::viscous_power;
+use super::energy::StepPowers;
 use super::parallel::{
     for_each_item3, for_each_item3_checked, for_each_item_checked, integration_work,
 };
@@ -129,16 +129,7 @@ pub(super) fn step_spheres(
     let RotationScheme::Splitting { sub_rotation: form } = params.rotation else {
         unreachable!("applies() admits the splitting scheme only")
     };
-    let external_power_start = world.loads.external_power;
-    let damped = params.damping != ViscousDamping::None;
-    let viscous = |world: &World| {
-        if damped {
-            viscous_power(world, |m| params.damping.coefficient(m))
-        } else {
-            0.0
-        }
-    };
-    let viscous_start = viscous(world);
+    let powers = StepPowers::at_start(params.damping, world);
 
     // 1–2. First half kick with the kept loads, drift.
     let t = Instant::now();
@@ -232,15 +223,7 @@ pub(super) fn step_spheres(
     }
 
     // 9. Ledger and counters (as the general step).
-    let viscous_end = viscous(world);
-    let ledger = &mut world.ledger;
-    ledger.dissipated_damping += world.loads.damping_work;
-    ledger.dissipated_friction += world.loads.friction_dissipation;
-    ledger.tangential_stiffness_work += world.loads.tangential_stiffness_work;
-    ledger.dissipated_viscous += 0.5 * (viscous_start + viscous_end) * dt;
-    ledger.external_work += 0.5 * (external_power_start + world.loads.external_power) * dt;
-    world.time += dt;
-    world.step_index += 1;
+    powers.close_step(params.damping, dt, world);
     report.counters.steps = 1;
     Ok(report)
 }

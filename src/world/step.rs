@@ -49,7 +49,7 @@ use crate::shape::Shape;
 use super::body_inputs;
 use super::contact_store::BodyAdjacency;
 use super::contact_store::{ContactKey, ContactState};
-use super::energy::{viscous_power, ContactWork, LastForces};
+use super::energy::{ContactWork, LastForces, StepPowers};
 use super::parallel::{
     for_each_chunked, for_each_item3, for_each_item3_checked, for_each_item_checked,
     for_each_item_pair, integration_work, Parallelism, Worker,
@@ -327,17 +327,7 @@ pub fn step(
     if sphere_step::applies(params, world) {
         return sphere_step::step_spheres(params, world, scratch, report);
     }
-    let external_power_start = world.loads.external_power;
-    // Without global damping the viscous power is zero: no pass over the bodies.
-    let damped = params.damping != ViscousDamping::None;
-    let viscous = |world: &World| {
-        if damped {
-            viscous_power(world, |m| params.damping.coefficient(m))
-        } else {
-            0.0
-        }
-    };
-    let viscous_start = viscous(world);
+    let powers = StepPowers::at_start(params.damping, world);
 
     // 1–2. First half kick with the kept loads, drift.
     let t = Instant::now();
@@ -487,15 +477,7 @@ pub fn step(
     report.counters.sleeping_body_steps += world.sleep.sleeping as u64;
 
     // 9. Ledger and counters.
-    let viscous_end = viscous(world);
-    let ledger = &mut world.ledger;
-    ledger.dissipated_damping += world.loads.damping_work;
-    ledger.dissipated_friction += world.loads.friction_dissipation;
-    ledger.tangential_stiffness_work += world.loads.tangential_stiffness_work;
-    ledger.dissipated_viscous += 0.5 * (viscous_start + viscous_end) * dt;
-    ledger.external_work += 0.5 * (external_power_start + world.loads.external_power) * dt;
-    world.time += dt;
-    world.step_index += 1;
+    powers.close_step(params.damping, dt, world);
     report.counters.steps = 1;
     Ok(report)
 }
