@@ -339,30 +339,11 @@ where
     C: Send,
     F: Fn(usize, &mut A, &mut B, &mut C) + Sync + Send,
 {
-    debug_assert!(a.len() == b.len() && a.len() == c.len());
-    if on_pool(parallel, a.len()) {
-        let size = chunk_len(a.len());
-        a.par_chunks_mut(size)
-            .zip(b.par_chunks_mut(size))
-            .zip(c.par_chunks_mut(size))
-            .with_max_len(1)
-            .enumerate()
-            .for_each(|(k, ((xs, ys), zs))| {
-                let _timer = region_profile::chunk();
-                for (j, ((x, y), z)) in xs
-                    .iter_mut()
-                    .zip(ys.iter_mut())
-                    .zip(zs.iter_mut())
-                    .enumerate()
-                {
-                    f(k * size + j, x, y, z);
-                }
-            });
-    } else {
-        for (i, ((x, y), z)) in a.iter_mut().zip(b.iter_mut()).zip(c.iter_mut()).enumerate() {
-            f(i, x, y, z);
-        }
-    }
+    // The checked form with nothing to report: the same chunks, jobs and order.
+    for_each_item3_checked(parallel, a, b, c, |i, x, y, z| {
+        f(i, x, y, z);
+        None::<()>
+    });
 }
 
 /// Fills `out[i] = f(i)` for every `i` in `0..out.len()`, in parallel when `parallel` (each slot written
