@@ -213,13 +213,8 @@ pub(super) fn step_spheres(
         non_finite
     };
     report.counters.integrate += t.elapsed();
-    if let Some((body, quantity)) = non_finite {
-        return Err(StepError::NonFinite {
-            step: world.step_index + 1,
-            body,
-            name: world.names[body].clone(),
-            quantity,
-        });
+    if let Some(found) = non_finite {
+        return Err(StepError::non_finite(world, found));
     }
 
     // 9. Ledger and counters (as the general step).

@@ -291,6 +291,19 @@ pub enum StepError {
     MissingLaw { step: u64, a: u32, b: u32 },
 }
 
+impl StepError {
+    /// The error for the first body with a non-finite `quantity` found by the checks of stages 7–8, in
+    /// the step being taken.
+    pub(super) fn non_finite(world: &World, (body, quantity): (usize, &'static str)) -> Self {
+        StepError::NonFinite {
+            step: world.step_index + 1,
+            body,
+            name: world.names[body].clone(),
+            quantity,
+        }
+    }
+}
+
 /// Advances the world by one step `params.dt` (see the module docs for the stages).
 pub fn step(
     params: &StepParams,
@@ -459,13 +472,8 @@ pub fn step(
         non_finite
     };
     report.counters.integrate += t.elapsed();
-    if let Some((body, quantity)) = non_finite {
-        return Err(StepError::NonFinite {
-            step: world.step_index + 1,
-            body,
-            name: world.names[body].clone(),
-            quantity,
-        });
+    if let Some(found) = non_finite {
+        return Err(StepError::non_finite(world, found));
     }
 
     // 8b. Sleeping: calm counters, falling asleep (serial, in body order).

@@ -113,57 +113,31 @@ pub struct Quantity {
 
 /// The quantities every bed page tabulates, in their order on the page.
 pub const QUANTITIES: [Quantity; 8] = [
-    Quantity {
-        label: "final depth",
-        unit: "mm",
-        value: |m| m.final_depth,
-        scale: 1e3,
-    },
-    Quantity {
-        label: "max depth",
-        unit: "mm",
-        value: |m| m.max_depth,
-        scale: 1e3,
-    },
-    Quantity {
-        label: "final vertical velocity",
-        unit: "m/s",
-        value: |m| m.final_vz,
-        scale: 1.0,
-    },
-    Quantity {
-        label: "peak contact force",
-        unit: "N",
-        value: |m| m.peak_force,
-        scale: 1.0,
-    },
-    Quantity {
-        label: "time of peak force",
-        unit: "ms",
-        value: |m| m.peak_time,
-        scale: 1e3,
-    },
-    Quantity {
-        label: "first contact",
-        unit: "ms",
-        value: |m| m.first_contact,
-        scale: 1e3,
-    },
-    Quantity {
-        label: "speed below 10 % of v0 at",
-        unit: "ms",
-        value: |m| m.slow_time,
-        scale: 1e3,
-    },
-    Quantity {
-        label: "vertical contact impulse",
-        unit: "N s",
-        value: |m| m.impulse,
-        scale: 1.0,
-    },
+    Quantity::new("final depth", "mm", |m| m.final_depth, 1e3),
+    Quantity::new("max depth", "mm", |m| m.max_depth, 1e3),
+    Quantity::new("final vertical velocity", "m/s", |m| m.final_vz, 1.0),
+    Quantity::new("peak contact force", "N", |m| m.peak_force, 1.0),
+    Quantity::new("time of peak force", "ms", |m| m.peak_time, 1e3),
+    Quantity::new("first contact", "ms", |m| m.first_contact, 1e3),
+    Quantity::new("speed below 10 % of v0 at", "ms", |m| m.slow_time, 1e3),
+    Quantity::new("vertical contact impulse", "N s", |m| m.impulse, 1.0),
 ];
 
 impl Quantity {
+    const fn new(
+        label: &'static str,
+        unit: &'static str,
+        value: fn(&Metrics) -> Real,
+        scale: Real,
+    ) -> Self {
+        Self {
+            label,
+            unit,
+            value,
+            scale,
+        }
+    }
+
     /// The row label with its unit, as the tables print it.
     pub fn heading(&self) -> String {
         format!("{} [{}]", self.label, self.unit)
