@@ -35,6 +35,7 @@
 #[path = "../tests/support/bed.rs"]
 mod bed;
 
+use polydem::host::load_average;
 use std::time::{Duration, Instant};
 
 use polydem::world::{step, StepCounters, StepParams, StepScratch, World};
@@ -144,12 +145,6 @@ fn cpu_time() -> Duration {
     }
     let tv = |t: libc::timeval| Duration::new(t.tv_sec as u64, 1000 * t.tv_usec as u32);
     tv(usage.ru_utime) + tv(usage.ru_stime)
-}
-
-fn load_average() -> String {
-    std::fs::read_to_string("/proc/loadavg")
-        .map(|s| s.split_whitespace().take(3).collect::<Vec<_>>().join(" "))
-        .unwrap_or_else(|_| "?".into())
 }
 
 /// The bits of every body's state, for the identity check between thread counts.

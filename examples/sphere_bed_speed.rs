@@ -16,6 +16,7 @@
 //! scene's `energy_ledger` key (`scene`: keep it); `--skin` the Verlet skin of the broad phase (m; the
 //! candidate list changes, the trajectory does not).
 
+use polydem::host::{load_average, thread_cpu_time};
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -62,19 +63,6 @@ fn parse() -> Result<Options, String> {
         }
     }
     Ok(o)
-}
-
-/// CPU time of the calling thread (s), from the scheduler's statistics.
-fn thread_cpu_time() -> Option<f64> {
-    let text = std::fs::read_to_string("/proc/thread-self/schedstat").ok()?;
-    let ns: f64 = text.split_whitespace().next()?.parse().ok()?;
-    Some(ns * 1e-9)
-}
-
-fn load_average() -> String {
-    std::fs::read_to_string("/proc/loadavg")
-        .map(|s| s.split_whitespace().take(3).collect::<Vec<_>>().join(" "))
-        .unwrap_or_else(|_| "n/a".into())
 }
 
 fn main() -> anyhow::Result<()> {

@@ -16,6 +16,7 @@
 
 pub mod contact;
 pub mod dynamics;
+pub mod host;
 pub mod io;
 pub mod law;
 pub mod math;

@@ -142,18 +142,9 @@ pub fn take() -> Vec<(Section, SectionStats)> {
     out
 }
 
-/// CPU time of the calling thread (ns).
+/// CPU time of the calling thread (ns); 0 where the clock is unavailable.
 fn thread_cpu_ns() -> u64 {
-    let mut ts = libc::timespec {
-        tv_sec: 0,
-        tv_nsec: 0,
-    };
-    // SAFETY: clock_gettime only writes into the timespec we pass.
-    let rc = unsafe { libc::clock_gettime(libc::CLOCK_THREAD_CPUTIME_ID, &mut ts) };
-    if rc != 0 {
-        return 0;
-    }
-    ts.tv_sec as u64 * 1_000_000_000 + ts.tv_nsec as u64
+    crate::host::thread_cpu_ns().unwrap_or(0)
 }
 
 /// Runs the parallel region `f` as `section`: the chunks it runs are timed per thread by [`chunk`].

@@ -20,6 +20,7 @@ use crate::stats::relative_difference;
 use std::path::Path;
 use std::time::Instant;
 
+use polydem::host::{load_average, thread_cpu_time};
 use polydem::math::Real;
 use polydem::scene::load_scene;
 use serde::Deserialize;
@@ -165,19 +166,6 @@ fn rerun_reference(code: &str, variant: &str, dir: &Path) -> Result<Recorded, Su
         )));
     }
     read_recorded(&dir.join(format!("{variant}.csv")))
-}
-
-/// CPU time of the calling thread (s), from the scheduler's statistics; `None` where unavailable.
-fn thread_cpu_time() -> Option<Real> {
-    let text = std::fs::read_to_string("/proc/thread-self/schedstat").ok()?;
-    let ns: Real = text.split_whitespace().next()?.parse().ok()?;
-    Some(ns * 1e-9)
-}
-
-fn load_average() -> String {
-    std::fs::read_to_string("/proc/loadavg")
-        .map(|s| s.split_whitespace().take(3).collect::<Vec<_>>().join(" "))
-        .unwrap_or_else(|_| "n/a".into())
 }
 
 struct Run {
