@@ -149,6 +149,45 @@ pub fn query_with(
     Ok(g)
 }
 
+/// The overlap of a polyhedron pair handed to the law, from the exact geometry `g` of its query (the
+/// cache as the query left it): smoothed per `tol.pair_smoothing` ([`super::pair_smoothing`]).
+fn law_overlap(
+    pos1: &Pose,
+    a: &ConvexPolyhedron,
+    pos2: &Pose,
+    b: &ConvexPolyhedron,
+    tol: &ContactTolerances,
+    cache: &PairCache,
+    g: ContactGeometry,
+) -> ContactGeometry {
+    match tol.pair_smoothing {
+        PairSmoothing::Smoothed { band } if g.kind == ContactKind::Overlap => {
+            smooth_pair_overlap(pos1, a, pos2, b, &g, band, [cache.hint_a, cache.hint_b])
+        }
+        _ => g,
+    }
+}
+
+/// The polyhedron–polyhedron case of [`query_with`] (B at `pos12` in A's frame, as `pos1.inv_mul(pos2)`
+/// gives it) when the pair's warm start proves the overlap ([`warm_overlap_polytopes`]): `Some` with what
+/// [`query_with`] returns, pair smoothing included, and the same cache and counters; `None` with nothing
+/// changed otherwise.
+#[allow(clippy::too_many_arguments)]
+pub fn warm_overlap_with(
+    pos1: &Pose,
+    pos12: &Pose,
+    a: &ConvexPolyhedron,
+    pos2: &Pose,
+    b: &ConvexPolyhedron,
+    tol: &ContactTolerances,
+    cache: &mut PairCache,
+    scratch: &mut EpaScratch,
+    counters: &mut QueryCounters,
+) -> Option<ContactGeometry> {
+    let g = warm_overlap_polytopes(pos1, pos12, a, b, tol, cache, scratch, counters)?;
+    Some(law_overlap(pos1, a, pos2, b, tol, cache, g))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -235,43 +274,4 @@ mod tests {
         }
         assert_eq!(counters.fallbacks(), 0, "{counters}");
     }
-}
-
-/// The overlap of a polyhedron pair handed to the law, from the exact geometry `g` of its query (the
-/// cache as the query left it): smoothed per `tol.pair_smoothing` ([`super::pair_smoothing`]).
-fn law_overlap(
-    pos1: &Pose,
-    a: &ConvexPolyhedron,
-    pos2: &Pose,
-    b: &ConvexPolyhedron,
-    tol: &ContactTolerances,
-    cache: &PairCache,
-    g: ContactGeometry,
-) -> ContactGeometry {
-    match tol.pair_smoothing {
-        PairSmoothing::Smoothed { band } if g.kind == ContactKind::Overlap => {
-            smooth_pair_overlap(pos1, a, pos2, b, &g, band, [cache.hint_a, cache.hint_b])
-        }
-        _ => g,
-    }
-}
-
-/// The polyhedron–polyhedron case of [`query_with`] (B at `pos12` in A's frame, as `pos1.inv_mul(pos2)`
-/// gives it) when the pair's warm start proves the overlap ([`warm_overlap_polytopes`]): `Some` with what
-/// [`query_with`] returns, pair smoothing included, and the same cache and counters; `None` with nothing
-/// changed otherwise.
-#[allow(clippy::too_many_arguments)]
-pub fn warm_overlap_with(
-    pos1: &Pose,
-    pos12: &Pose,
-    a: &ConvexPolyhedron,
-    pos2: &Pose,
-    b: &ConvexPolyhedron,
-    tol: &ContactTolerances,
-    cache: &mut PairCache,
-    scratch: &mut EpaScratch,
-    counters: &mut QueryCounters,
-) -> Option<ContactGeometry> {
-    let g = warm_overlap_polytopes(pos1, pos12, a, b, tol, cache, scratch, counters)?;
-    Some(law_overlap(pos1, a, pos2, b, tol, cache, g))
 }
