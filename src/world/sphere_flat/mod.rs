@@ -327,10 +327,34 @@ impl SphereSim {
         if !self.outs_valid {
             return self.start_potential;
         }
+        // The law's potentials of each overlapping pair (normal k_n δ^(n+1)/(n+1), tangential ½ k_t |u|²
+        // from the spring the evaluation left), in pair order: the general step's sum.
+        let list = &self.list;
+        let model = |a: u32, b: u32| {
+            self.models[a as usize * self.n_materials + b as usize]
+                .as_ref()
+                .expect("an overlapping pair was evaluated with its model")
+        };
+        let potential = |model: &ContactModel, depth: Real, h: &crate::law::TangentialHistory| {
+            model.normal.potential(depth) + 0.5 * h.stiffness * h.displacement.norm_squared()
+        };
         let mut sum = 0.0;
-        for o in self.out.iter().chain(&self.wall_out) {
+        for (p, o) in self.out.iter().enumerate() {
             if o.overlapping {
-                sum += o.potential;
+                let (a, b) = (list.a[p] as usize, list.b[p] as usize);
+                let m = pair::scaled(
+                    model(self.props[a].material, self.props[b].material),
+                    list.root_radius[p],
+                );
+                sum += potential(&m, o.depth, &list.histories[p]);
+            }
+        }
+        for (q, o) in self.wall_out.iter().enumerate() {
+            if o.overlapping {
+                let (body, wall) = (list.wall_body[q] as usize, list.wall_of[q] as usize);
+                let m = model(self.planes[wall].material, self.props[body].material)
+                    .for_contact_radii(None, Some(self.props[body].radius));
+                sum += potential(&m, o.depth, &list.wall_histories[q]);
             }
         }
         sum
@@ -353,6 +377,15 @@ impl SphereSim {
     /// Listed body pairs (a, b), a < b, in key order.
     pub fn body_pairs(&self) -> impl Iterator<Item = (u32, u32)> + '_ {
         self.list.a.iter().copied().zip(self.list.b.iter().copied())
+    }
+
+    /// Listed body–wall pairs (body, wall), in key order.
+    pub fn wall_pairs(&self) -> impl Iterator<Item = (u32, u32)> + '_ {
+        self.list
+            .wall_body
+            .iter()
+            .copied()
+            .zip(self.list.wall_of.iter().copied())
     }
 
     /// Puts the state back into `world` (the world this simulation was made from, possibly restored

@@ -31,6 +31,7 @@
 
 use rayon::prelude::*;
 
+use crate::law::pair::effective_contact_radius;
 use crate::law::TangentialHistory;
 use crate::math::{Point, Real, Vector};
 
@@ -55,6 +56,10 @@ pub struct NeighbourList {
     /// Pair indices with body i as side B, increasing a: `as_b[as_b_start[i]..as_b_start[i + 1]]`.
     pub(crate) as_b_start: Vec<u32>,
     pub(crate) as_b: Vec<u32>,
+    /// Per body pair, √R* (R* = r_a r_b/(r_a + r_b), m^½) and the effective mass m_a m_b/(m_a + m_b) (kg):
+    /// constants of the pair, formed once per build with the operations of the general step.
+    pub(crate) root_radius: Vec<Real>,
+    pub(crate) effective_mass: Vec<Real>,
     /// The tangential spring of each body pair, and the step it entered the list.
     pub(crate) histories: Vec<TangentialHistory>,
     pub(crate) since: Vec<u64>,
@@ -395,6 +400,18 @@ impl NeighbourList {
             (0..self.a.len()).map(carry).collect()
         };
         (self.histories, self.since) = carried.into_iter().unzip();
+        (self.root_radius, self.effective_mass) = self
+            .a
+            .iter()
+            .zip(&self.b)
+            .map(|(&a, &b)| {
+                let (pa, pb) = (&props[a as usize], &props[b as usize]);
+                (
+                    effective_contact_radius(Some(pa.radius), Some(pb.radius)).sqrt(),
+                    pa.mass * pb.mass / (pa.mass + pb.mass),
+                )
+            })
+            .unzip();
         let old_wall = |body: usize, wall: u32| -> Option<usize> {
             if body + 1 >= old.wall_start.len() {
                 return None;

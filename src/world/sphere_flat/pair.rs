@@ -12,7 +12,7 @@
 //! but its flag and its cleared spring: no geometry is kept.
 
 use crate::contact::{contact_plane_sphere, contact_sphere_sphere, ContactKind, ContactTolerances};
-use crate::law::{ContactKinematics, ContactModel, TangentialHistory};
+use crate::law::{ContactKinematics, ContactModel, RadiusScaling, TangentialHistory};
 use crate::math::{Point, Real, Vector};
 
 use super::super::step::StepError;
@@ -89,14 +89,14 @@ impl WallPlane {
 
 /// The result of one candidate in one step: the loads the gather reads, then what only the write-back
 /// and the report read. Written in full for an overlapping pair; for a separated one only `overlapping`.
+/// The elastic potential is not kept: it is formed on request from the overlap and the spring
+/// ([`super::SphereSim::elastic_potential`]), with the law's own functions.
 #[derive(Clone, Copy, Debug, Default)]
 pub(crate) struct PairOut {
     pub(crate) force_on_b: Vector,
     pub(crate) torque_on_a: Vector,
     pub(crate) torque_on_b: Vector,
     pub(crate) overlapping: bool,
-    /// Elastic potential, normal + tangential (J).
-    pub(crate) potential: Real,
     /// The velocity-dependent part of the force (N), as the contact store keeps it.
     pub(crate) damping_force: Vector,
     /// Overlap (m) and overlap / the smaller particle's diameter.
@@ -131,11 +131,15 @@ impl PairContext<'_> {
     }
 
     /// The sphere pair (a, b), a < b (A = a): its output and updated spring.
+    /// `root_radius` (√R*) and `effective_mass` are the pair's constants.
+    #[allow(clippy::too_many_arguments)]
     #[inline(always)]
     pub(crate) fn body_pair(
         &self,
         a: usize,
         b: usize,
+        root_radius: Real,
+        effective_mass: Real,
         history: &mut TangentialHistory,
         out: &mut PairOut,
     ) -> Result<(), StepError> {
@@ -156,13 +160,12 @@ impl PairContext<'_> {
         if g.kind != ContactKind::Overlap {
             return Ok(separated(history, out));
         }
-        let model = self
-            .model(pa.material, pb.material)?
-            .for_contact_radii(Some(pa.radius), Some(pb.radius));
+        // `for_contact_radii(Some(r_a), Some(r_b))` with the pair's √R* formed at the list build.
+        let model = scaled(self.model(pa.material, pb.material)?, root_radius);
         let point = &g.point;
         let kinematics = ContactKinematics {
             relative_velocity: kb.velocity_at(point) - ka.velocity_at(point),
-            effective_mass: pa.mass * pb.mass / (pa.mass + pb.mass),
+            effective_mass,
             center_a: ka.position,
             center_b: kb.position,
             dt: self.dt,
@@ -174,7 +177,6 @@ impl PairContext<'_> {
             torque_on_a: response.torque_on_a,
             torque_on_b: response.torque_on_b,
             overlapping: true,
-            potential: response.normal_potential + response.tangential_potential,
             damping_force: response.damping_force,
             depth: g.depth,
             overlap_ratio: g.depth / scale,
@@ -222,12 +224,21 @@ impl PairContext<'_> {
             torque_on_a: response.torque_on_a,
             torque_on_b: response.torque_on_b,
             overlapping: true,
-            potential: response.normal_potential + response.tangential_potential,
             damping_force: response.damping_force,
             depth: g.depth,
             overlap_ratio: g.depth / (2.0 * p.radius),
         };
         Ok(())
+    }
+}
+
+/// The model of a contact from its material pair's model and √R*: [`ContactModel::for_contact_radii`]
+/// with the root of the effective radius already formed.
+#[inline(always)]
+pub(crate) fn scaled(model: &ContactModel, root_radius: Real) -> ContactModel {
+    match model.normal.radius_scaling {
+        RadiusScaling::Constant => *model,
+        RadiusScaling::SqrtEffectiveRadius => model.with_root_radius(root_radius),
     }
 }
 

@@ -265,6 +265,7 @@ impl SphereSim {
         let list = &mut self.list;
         let (a, b) = (&list.a, &list.b);
         let (wall_body, wall_of) = (&list.wall_body, &list.wall_of);
+        let (root_radius, effective_mass) = (&list.root_radius, &list.effective_mass);
         let note = |found: &mut Found, o: &PairOut, key: ContactKey| {
             if o.overlapping {
                 found.contacts += 1;
@@ -283,7 +284,14 @@ impl SphereSim {
                 let mut found = Found::default();
                 for (k, (history, out)) in histories.iter_mut().zip(outs.iter_mut()).enumerate() {
                     let p = start + k;
-                    if let Err(e) = ctx.body_pair(a[p] as usize, b[p] as usize, history, out) {
+                    if let Err(e) = ctx.body_pair(
+                        a[p] as usize,
+                        b[p] as usize,
+                        root_radius[p],
+                        effective_mass[p],
+                        history,
+                        out,
+                    ) {
                         found.error = Some(e);
                         break;
                     }
