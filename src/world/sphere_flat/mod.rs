@@ -230,7 +230,7 @@ impl SphereSim {
             outs_valid: false,
             start_potential: world.loads.elastic_potential,
             external_power: world.loads.external_power,
-            ledger: world.ledger.clone(),
+            ledger: world.ledger,
             time: world.time,
             step_index: world.step_index,
         };
@@ -400,7 +400,7 @@ impl SphereSim {
             body.orientation = self.spin[i].orientation;
         }
         world.walls.clone_from(&self.walls);
-        world.ledger = self.ledger.clone();
+        world.ledger = self.ledger;
         world.time = self.time;
         world.step_index = self.step_index;
         let loads = &mut world.loads;

@@ -78,6 +78,11 @@ pub struct NeighbourList {
     pub(crate) builds: u64,
 }
 
+/// The spring and entry step of a pair given as a body pair `(a, b)` or a body–wall pair `(body, wall)`,
+/// if known (see [`NeighbourList::rebuild`]).
+pub(crate) type ImportHistory<'a> =
+    dyn Fn(Option<(u32, u32)>, Option<(u32, u32)>) -> Option<(TangentialHistory, u64)> + Sync + 'a;
+
 /// The two largest of a set of squared displacements (order-free: the same for any split of the set).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub(crate) struct TopTwo {
@@ -246,8 +251,7 @@ impl NeighbourList {
         walls: &[WallPlane],
         parallel: bool,
         step: u64,
-        history_of: &(dyn Fn(Option<(u32, u32)>, Option<(u32, u32)>) -> Option<(TangentialHistory, u64)>
-              + Sync),
+        history_of: &ImportHistory<'_>,
     ) {
         let n = centres.len();
         let skin = self.skin;

@@ -148,7 +148,8 @@ impl PairContext<'_> {
         let reach = pa.radius + pb.radius;
         if (kb.position - ka.position).norm_squared() >= reach * reach {
             // d ≥ r_A + r_B: no overlap beyond the touching band.
-            return Ok(separated(history, out));
+            separated(history, out);
+            return Ok(());
         }
         let g = contact_sphere_sphere(
             &ka.position,
@@ -158,7 +159,8 @@ impl PairContext<'_> {
             self.tolerances,
         );
         if g.kind != ContactKind::Overlap {
-            return Ok(separated(history, out));
+            separated(history, out);
+            return Ok(());
         }
         // `for_contact_radii(Some(r_a), Some(r_b))` with the pair's √R* formed at the list build.
         let model = scaled(self.model(pa.material, pb.material)?, root_radius);
@@ -195,7 +197,8 @@ impl PairContext<'_> {
     ) -> Result<(), StepError> {
         let (k, p, wall) = (&self.kin[i], &self.props[i], &self.walls[w]);
         if wall.height(&k.position) >= p.radius {
-            return Ok(separated(history, out));
+            separated(history, out);
+            return Ok(());
         }
         let g = contact_plane_sphere(
             &wall.pose,
@@ -206,7 +209,8 @@ impl PairContext<'_> {
             self.tolerances,
         );
         if g.kind != ContactKind::Overlap {
-            return Ok(separated(history, out));
+            separated(history, out);
+            return Ok(());
         }
         let model = self
             .model(wall.material, p.material)?
