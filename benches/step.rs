@@ -213,6 +213,8 @@ fn skips(c: &mut Criterion) {
     });
     skip_pair(c, &poly, "bounding_spheres", |s| s.bounding_spheres = false);
     skip_pair(c, &poly, "cached_axis", |s| s.cached_axis = false);
+    skip_pair(c, &poly, "motion_bound", |s| s.motion_bound = false);
+    skip_pair(c, &poly, "warm_overlap", |s| s.warm_overlap = false);
     skip_pair(c, &poly, "verlet_skin", |s| s.verlet_skin = false);
     // μ = 0 (a spring with zero friction) and a zero damping coefficient: sphere beds.
     let frictionless = Lazy::new("sphere_bed_2000_mu0", 2000, || {
