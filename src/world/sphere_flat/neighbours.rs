@@ -76,6 +76,42 @@ pub struct NeighbourList {
     pub(crate) walls_at_build: Vec<Vector>,
     /// Builds so far.
     pub(crate) builds: u64,
+    /// Which bodies the grid holds (found once: the radii do not change).
+    layout: Option<Layout>,
+}
+
+/// The split of the bodies between the grid and the large ones (see the module docs).
+#[derive(Clone, Debug)]
+struct Layout {
+    bodies: usize,
+    median: Real,
+    /// Bodies above [`LARGE_RADIUS_FACTOR`] times the median radius, and the others.
+    large: Vec<u32>,
+    members: Vec<u32>,
+    /// The largest radius of the grid's bodies.
+    r_grid: Real,
+}
+
+impl Layout {
+    fn of(props: &[Props]) -> Self {
+        let n = props.len();
+        let mut sorted: Vec<Real> = props.iter().map(|p| p.radius).collect();
+        sorted.sort_by(|x, y| x.total_cmp(y));
+        let median = sorted.get(n / 2).copied().unwrap_or(0.0);
+        let is_large = |i: &u32| props[*i as usize].radius > LARGE_RADIUS_FACTOR * median;
+        let (large, members): (Vec<u32>, Vec<u32>) = (0..n as u32).partition(is_large);
+        let r_grid = members
+            .iter()
+            .map(|&i| props[i as usize].radius)
+            .fold(0.0, Real::max);
+        Self {
+            bodies: n,
+            median,
+            large,
+            members,
+            r_grid,
+        }
+    }
 }
 
 /// The spring and entry step of a pair given as a body pair `(a, b)` or a body–wall pair `(body, wall)`,
@@ -255,23 +291,16 @@ impl NeighbourList {
     ) {
         let n = centres.len();
         let skin = self.skin;
-        // Large bodies out of the grid.
-        let mut sorted: Vec<Real> = props.iter().map(|p| p.radius).collect();
-        sorted.sort_by(|x, y| x.total_cmp(y));
-        let median = sorted.get(n / 2).copied().unwrap_or(0.0);
+        // Large bodies out of the grid (the radii do not change: found on the first build).
+        if self.layout.is_none() || self.layout.as_ref().is_some_and(|l| l.bodies != n) {
+            self.layout = Some(Layout::of(props));
+        }
+        let layout = self.layout.take().unwrap_or_else(|| Layout::of(props));
+        let (large, members, r_grid, median) =
+            (&layout.large, &layout.members, layout.r_grid, layout.median);
         let is_large = |r: Real| r > LARGE_RADIUS_FACTOR * median;
-        let large: Vec<u32> = (0..n as u32)
-            .filter(|&i| is_large(props[i as usize].radius))
-            .collect();
-        let members: Vec<u32> = (0..n as u32)
-            .filter(|&i| !is_large(props[i as usize].radius))
-            .collect();
-        let r_grid = members
-            .iter()
-            .map(|&i| props[i as usize].radius)
-            .fold(0.0, Real::max);
         let cell = (2.0 * r_grid + skin).max(Real::MIN_POSITIVE);
-        let grid = Grid::build(centres, &members, cell);
+        let grid = Grid::build(centres, members, cell);
 
         // Rows of pairs (i, j > i) per body, in body order.
         let reach = |i: usize, j: usize| {
@@ -444,6 +473,7 @@ impl NeighbourList {
             }
         }
         self.centres_at_build = centres.to_vec();
+        self.layout = Some(layout);
         self.walls_at_build = walls.iter().map(|w| w.pose.translation.vector).collect();
     }
 }
