@@ -47,7 +47,12 @@ fn parse() -> Result<Options, String> {
         match a.as_str() {
             "--steps" => o.steps = value()?.parse().map_err(|e| format!("--steps: {e}"))?,
             "--warm-up" => o.warm_up = value()?.parse().map_err(|e| format!("--warm-up: {e}"))?,
-            "--repeat" => o.repeat = value()?.parse::<usize>().map_err(|e| format!("--repeat: {e}"))?.max(1),
+            "--repeat" => {
+                o.repeat = value()?
+                    .parse::<usize>()
+                    .map_err(|e| format!("--repeat: {e}"))?
+                    .max(1)
+            }
             "--threads" => {
                 o.threads = value()?
                     .split(',')
@@ -75,7 +80,8 @@ fn build(name: &str) -> Result<(World, StepParams), String> {
         params.energy_ledger = false;
         return Ok((b.world, params));
     }
-    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join(format!("scenes/sphere_bed_{name}.toml"));
+    let path =
+        PathBuf::from(env!("CARGO_MANIFEST_DIR")).join(format!("scenes/sphere_bed_{name}.toml"));
     let mut sim = load_scene(&path).map_err(|e| format!("{}: {e}", path.display()))?;
     sim.params.energy_ledger = false;
     Ok((sim.world, sim.params))
