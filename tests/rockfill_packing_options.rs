@@ -10,6 +10,7 @@ use polydem::rockfill::config::{DepositionDamping, ExperimentConfig};
 use polydem::rockfill::experiment::generate_sample;
 use polydem::rockfill::packing::{
     apply_local_damping, local_damping, loose_world, pack, packing_time_step, rock_time_step,
+    time_step_and_limit, PACKING_LIMIT_FRACTION,
 };
 use polydem::rockfill::penetration::penetration_time_step;
 use support::small;
@@ -114,11 +115,21 @@ fn packing_time_step_is_the_packings_own_and_the_penetration_keeps_its_step() {
     config.packing.packing_steps_per_contact = Some(10.0);
     let (dt10, tc10) = packing_time_step(&config, &world).unwrap();
     assert_eq!(tc, tc10);
-    let ratio = dt10 / dt20;
+    // t_c / 10, unless that exceeds 0.8 of the stability limit (then the limit's fraction).
+    let (_, _, limit) = time_step_and_limit(&config, &world, 20.0).unwrap();
+    let expected = (tc / 10.0).min(PACKING_LIMIT_FRACTION * limit);
     assert!(
-        (ratio - config.packing.steps_per_contact / 10.0).abs() <= 1e-12,
-        "packing Δt {dt10} s against {dt20} s: ratio {ratio}, expected {}",
-        config.packing.steps_per_contact / 10.0
+        dt10 == expected && dt10 > dt20,
+        "packing Δt {dt10} s: expected min(t_c/10, {PACKING_LIMIT_FRACTION} × limit) = {expected} s \
+         (t_c {tc} s, limit {limit} s), and above the default {dt20} s"
+    );
+    config.packing.packing_steps_per_contact = Some(1.0);
+    let (dt1, _) = packing_time_step(&config, &world).unwrap();
+    assert!(
+        dt1 == PACKING_LIMIT_FRACTION * limit,
+        "t_c = {} s against the limit {limit} s: packing Δt {dt1} s at N = 1, expected {} s",
+        tc,
+        PACKING_LIMIT_FRACTION * limit
     );
     assert_eq!(rock_time_step(&config, &world).unwrap().0, dt20);
     let pen_default = penetration_time_step(&small(), &world).unwrap();
@@ -132,40 +143,45 @@ fn packing_time_step_is_the_packings_own_and_the_penetration_keeps_its_step() {
 #[test]
 fn packing_with_local_damping_and_a_drop_speed_settles_the_small_bed() {
     let mut config = small();
-    config.packing.packing_steps_per_contact = Some(10.0);
     config.packing.deposition_damping = Some(DepositionDamping::Local);
     config.packing.local_damping = Some(0.3);
     config.packing.drop_speed = Some(2.0);
     let mut world = loose(&config);
-    let report = pack(&config, &mut world, |_, _, _| {}).unwrap();
-    let d = config.rock.mean_size;
-    assert!(
-        report.deposition_time < config.packing.max_deposition_time,
-        "deposition ran to its limit {} s",
-        report.deposition_time
-    );
-    assert!(
-        report.final_top < config.layer.height + d
-            && report.final_max_speed < config.packing.settle_speed,
-        "final top {} m (layer {} m, size {d} m), final max speed {} m/s (settle {} m/s)",
-        report.final_top,
-        config.layer.height,
-        report.final_max_speed,
-        config.packing.settle_speed
-    );
-    // The local damping's dissipation is booked: the packing ledger closes to the tolerance of
-    // tests/rockfill_experiment.rs (10 % of the rocks' initial potential energy, dominated by the known
-    // first-order loss of flat wall contacts); without the booking it would miss by most of the drop's energy.
-    for (stage, b) in ["deposition", "compaction", "hold"]
+    let potential0: Real = world
+        .bodies
         .iter()
-        .zip(report.ledger_balance_relative)
-    {
-        assert!(
-            b.abs() < 0.1,
-            "{stage}: ledger balance / initial potential {b}, tol 0.1"
-        );
-    }
-    assert!(world.ledger.dissipated_viscous > 0.0);
+        .map(|b| b.mass * 9.81 * b.position.z)
+        .sum();
+    let report = pack(&config, &mut world, |_, _, _| {}).unwrap();
+    assert!(
+        report.deposition_time < config.packing.max_deposition_time
+            && report.final_top < report.deposited_top,
+        "deposition {} s (limit {} s), bed top after deposition {} m, final {} m",
+        report.deposition_time,
+        config.packing.max_deposition_time,
+        report.deposited_top,
+        report.final_top
+    );
+    // The local damping removes most of the drop's energy, and books it: the ledger closes after deposition
+    // to 1 % of the rocks' initial potential energy (measured 7e-4) while the damping took more than 10 %.
+    // The compaction stage is not checked here: the servo wall's known first-order ledger error grows with
+    // the compaction's length whatever the damping (this bed, global viscous damping: −6.9 % after 4 060
+    // compaction steps; tests/rockfill_experiment.rs bounds it on its own bed).
+    let deposition = report.ledger_balance_relative[0];
+    assert!(
+        deposition.abs() < 0.01,
+        "deposition: ledger balance / initial potential {deposition}, tol 0.01"
+    );
+    let booked = world.ledger.dissipated_viscous / potential0;
+    assert!(
+        booked > 0.1,
+        "local damping booked {booked} of the initial potential energy, expected more than 0.1"
+    );
+    let hold = report.ledger_balance_relative[2] - report.ledger_balance_relative[1];
+    assert!(
+        hold.abs() < 0.01,
+        "hold: ledger balance change / initial potential {hold}, tol 0.01"
+    );
     let lowest = world
         .bodies
         .iter()

@@ -114,7 +114,10 @@ pub struct PackingParams {
     /// Coefficient α of the local damping, 0 < α < 1 (YADE's default for quasi-static packing is 0.2).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub local_damping: Option<Real>,
-    /// Initial downward speed of every rock (m/s). Absent: the rocks start at rest.
+    /// Initial downward speed v0 of every rock (m/s): a cloud in free fall moves rigidly, so this is the
+    /// loose sample as it would be after falling v0/g from v0²/(2g) higher, caught when its lowest rock is
+    /// where it was generated (under the global viscous damping, v0 = g/α starts the cloud at its terminal
+    /// speed). The rock count, sizes and arrangement (eq. 28/29) are unchanged. Absent: the rocks start at rest.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub drop_speed: Option<Real>,
 }
