@@ -9,6 +9,7 @@
 //! - [`sleeping`]: freezing bodies at rest, islands, waking.
 //! - [`parallel`]: deterministic per-item parallelism of the step's stages (rayon).
 //! - `sphere_kernel`: the sphere path of the narrow phase and laws (sphere–sphere, wall–sphere).
+//! - [`sphere_flat`]: a world of free spheres stepped from flat per-sphere arrays and a half neighbour list.
 //! - `sphere_step`: the integration stages of a world of free spheres, without the per-body tests other bodies need.
 
 mod body_inputs;
@@ -19,6 +20,7 @@ pub mod parallel;
 pub mod region_profile;
 pub mod skips;
 pub mod sleeping;
+pub mod sphere_flat;
 mod sphere_kernel;
 mod sphere_step;
 pub mod step;
@@ -31,6 +33,7 @@ pub use energy::{EnergyLedger, EnergyReport};
 pub use parallel::Parallelism;
 pub use skips::Skips;
 pub use sleeping::{SleepParams, SleepState};
+pub use sphere_flat::{NotSphereOnly, SphereSim, StepFlatError};
 pub use sphere_step::applies as sphere_step_applies;
 pub use step::{step, StepCounters, StepError, StepParams, StepReport, StepScratch};
 pub use world::{Loads, MaterialTable, Wall, World, WorldError};

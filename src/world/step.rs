@@ -1217,7 +1217,7 @@ pub(super) fn overlap_law(
 
 /// The model with the slots the skips make free: no tangential spring when μ = 0, no damping term when its
 /// coefficient is 0 (see [`super::skips`]).
-fn effective_model(model: &ContactModel, skips: &Skips) -> ContactModel {
+pub(super) fn effective_model(model: &ContactModel, skips: &Skips) -> ContactModel {
     let mut m = *model;
     if skips.frictionless_history && m.tangential.stiffness_and_friction(0.0).1 == 0.0 {
         m.tangential = TangentialLaw::None;

@@ -22,7 +22,8 @@ use std::time::Instant;
 
 use polydem::host::{load_average, thread_cpu_time};
 use polydem::math::Real;
-use polydem::scene::load_scene;
+use polydem::scene::{load_scene, Simulation};
+use polydem::world::{SphereSim, StepFlatError};
 use serde::Deserialize;
 
 use crate::case::{Case, CaseData, Profile, Target};
@@ -188,7 +189,9 @@ fn run_polydem(variant: &Variant, ctx: &mut CaseContext) -> Result<Run, SuiteErr
         sim.steps = sim.steps.min(steps);
     }
     // The case compares trajectories and speed; YADE and LIGGGHTS keep no energy ledger, so neither does
-    // this run (bodies and forces are the same bits with it: `tests/world_sphere_fast_paths.rs`).
+    // this run (bodies and forces are the same bits with it: `tests/world_sphere_fast_paths.rs`), which
+    // lets it take the flat sphere path (`polydem::world::SphereSim`; the same bits as the general step,
+    // `tests/sphere_flat_paths.rs`).
     sim.params.energy_ledger = false;
     let projectile = sim
         .world
@@ -210,36 +213,23 @@ fn run_polydem(variant: &Variant, ctx: &mut CaseContext) -> Result<Run, SuiteErr
         .build()
         .map_err(|e| fail(format!("one-thread pool: {e}")))?;
     let progress = ctx.progress();
-    let (summary, wall_time_s, cpu_time_s) = pool.install(|| {
+    let (max_overlap_ratio, wall_time_s, cpu_time_s) = pool.install(|| {
         let cpu_start = thread_cpu_time();
         let start = Instant::now();
-        let summary = sim.run(
-            |s| {
-                let b = &s.world.bodies[projectile];
-                history.t.push(s.world.time);
-                history.z.push(b.position.z);
-                history.vz.push(b.velocity.z);
-                // No loads before the first step: the projectile starts out of contact.
-                history
-                    .fz
-                    .push(s.world.loads.forces.get(projectile).map_or(0.0, |f| f.z));
-                Ok(())
-            },
-            |_, n| {
-                if n % 500 == 0 {
-                    progress.inc(500);
-                }
-                Ok(())
-            },
-        );
+        let max_overlap = run_steps(&mut sim, projectile, &mut history, &mut |n| {
+            if n % 500 == 0 {
+                progress.inc(500);
+            }
+        });
         let wall = start.elapsed().as_secs_f64();
         let cpu = match (cpu_start, thread_cpu_time()) {
             (Some(a), Some(b)) if b > a => Some(b - a),
             _ => None,
         };
-        (summary, wall, cpu)
+        (max_overlap, wall, cpu)
     });
-    let summary = summary.map_err(|e| fail(format!("{}: {e}", variant.scene)))?;
+    let max_overlap_ratio =
+        max_overlap_ratio.map_err(|e| fail(format!("{}: {e}", variant.scene)))?;
     Ok(Run {
         history,
         z0,
@@ -249,8 +239,71 @@ fn run_polydem(variant: &Variant, ctx: &mut CaseContext) -> Result<Run, SuiteErr
         wall_time_s,
         cpu_time_s,
         load,
-        max_overlap_ratio: summary.max_overlap_ratio,
+        max_overlap_ratio,
     })
+}
+
+/// The steps of `sim` from its world's step to its end, sampling the projectile at the start and every
+/// output interval (and after the last step): on the flat sphere path ([`SphereSim`], the same bits as the
+/// general step, `tests/sphere_flat_paths.rs`) when the world is one of free spheres, else the general
+/// step. `on_step` gets the number of steps done. Returns the largest overlap ratio of any step.
+fn run_steps(
+    sim: &mut Simulation,
+    projectile: usize,
+    history: &mut History,
+    on_step: &mut dyn FnMut(u64),
+) -> Result<Real, String> {
+    let mut sample = |t: Real, z: Real, vz: Real, fz: Real| {
+        history.t.push(t);
+        history.z.push(z);
+        history.vz.push(vz);
+        history.fz.push(fz);
+    };
+    let mut flat = match SphereSim::from_world(&sim.world, &sim.params) {
+        Ok(flat) => flat,
+        Err(StepFlatError::NotSphereOnly(reason)) => {
+            eprintln!("sphere_bed: the general step ({reason})");
+            let summary = sim
+                .run(
+                    |s| {
+                        let b = &s.world.bodies[projectile];
+                        // No loads before the first step: the projectile starts out of contact.
+                        let fz = s.world.loads.forces.get(projectile).map_or(0.0, |f| f.z);
+                        sample(s.world.time, b.position.z, b.velocity.z, fz);
+                        Ok(())
+                    },
+                    |_, n| {
+                        on_step(n);
+                        Ok(())
+                    },
+                )
+                .map_err(|e| e.to_string())?;
+            return Ok(summary.max_overlap_ratio);
+        }
+        Err(e) => return Err(e.to_string()),
+    };
+    // The first sample is the state before any step, as the general run's first output (its loads are
+    // not evaluated yet there: zero force, the projectile starts out of contact).
+    let b = &sim.world.bodies[projectile];
+    let fz = sim.world.loads.forces.get(projectile).map_or(0.0, |f| f.z);
+    sample(sim.world.time, b.position.z, b.velocity.z, fz);
+    let mut max_overlap: Real = 0.0;
+    let first = flat.step_index() + 1;
+    for n in first..=sim.steps {
+        let report = flat.step().map_err(|e| e.to_string())?;
+        max_overlap = max_overlap.max(report.max_overlap_ratio);
+        if n % sim.output_every == 0 || n == sim.steps {
+            sample(
+                flat.time(),
+                flat.position(projectile).z,
+                flat.velocity(projectile).z,
+                flat.forces()[projectile].z,
+            );
+        }
+        on_step(n);
+    }
+    flat.write_back(&mut sim.world);
+    Ok(max_overlap)
 }
 
 /// The metrics of `code`'s history up to `t_end` (an error names the code when it has no samples).
@@ -721,7 +774,9 @@ impl Case for SphereBed {
              suite run right after polydem's run of the same variant (full profile, codes installed), and \
              the speed ratios and checks use them when they exist. polydem's wall time is measured here, \
              with its thread's CPU time beside it; it runs without the per-contact energy ledger \
-             (`energy_ledger = false`, the same trajectory bit for bit), as YADE and LIGGGHTS keep none. \
+             (`energy_ledger = false`, the same trajectory bit for bit), as YADE and LIGGGHTS keep none, \
+             on the flat sphere path (per-sphere arrays and a half neighbour list, `SphereSim`; the same \
+             bits as the general step). \
              The machine is shared (2 cores, load averages of 6–11 were seen), so wall-time ratios between \
              runs at different moments carry an uncertainty of up to a factor of two or three.",
         );

@@ -1,0 +1,524 @@
+//! The flat sphere path: a world of free spheres stepped from compact per-sphere arrays and a half
+//! neighbour list, the way LAMMPS/LIGGGHTS step granular spheres, with the physics of the general step.
+//!
+//! # What it is
+//! [`SphereSim::from_world`] copies a world whose bodies are all free spheres (dynamic, equal principal
+//! moments) into a [`SphereSim`] that owns, for the length of a run:
+//! - per sphere, in arrays: centre, velocity and angular velocity (the pair loop's record, 72 bytes),
+//!   angular momentum and orientation (the integration's), radius, mass, moment and material, and the
+//!   last evaluation's force and torque;
+//! - the walls (planes; fixed or moving with their prescribed velocity) and their last forces;
+//! - a half neighbour list with a Verlet skin (the world's broad-phase skin) and a body–wall list, each
+//!   pair's tangential spring stored beside it and carried across rebuilds ([`neighbours`]); nothing is
+//!   stored for a separated pair but its cleared spring and a flag;
+//! - the time, step index and energy ledger of the world.
+//!
+//! [`SphereSim::step`] advances it by one step with the stages of the general step for free spheres
+//! (`super::sphere_step`): first half kick, drift (leapfrog translation, one turn about L for the
+//! orientation), walls moved, lists rebuilt when the two largest displacements since the build sum to the
+//! skin, the pair loop (closed-form geometry and the laws of [`crate::law`], [`pair`]), per-body sums, the
+//! second half kick and the finiteness checks. [`SphereSim::write_back`] puts the state back into the
+//! world (bodies, walls, loads, ledger, time, and a contact store with every listed pair's spring and
+//! last forces), so that checkpoints, outputs and the general step continue from it.
+//!
+//! # The same bits as the general step
+//! Every value is computed by the same operations in the same order as the general step: the kick,
+//! drift and turn of `super::sphere_step`, the closed forms and inlined law of `super::sphere_kernel`
+//! (the same models with the step's skips applied), and the per-body sums over the overlapping pairs in
+//! the order of the general contact keys (for body i: pairs (a, i) by increasing a, then (i, b) by
+//! increasing b, then its walls; a pair that does not overlap adds nothing on either path, so which
+//! separated pairs a list holds does not matter). So bodies, loads and springs are the same bits as the
+//! general step's (`tests/sphere_flat_paths.rs`), for any number of threads: every parallel pass
+//! computes one result per sphere or pair into its own slot, and the only sums across items (wall
+//! forces, elastic potential) are taken serially in pair order.
+//!
+//! # When it applies (else [`NotSphereOnly`])
+//! Every body a dynamic sphere with equal principal moments; the splitting rotation with the
+//! `isotropic_rotation` and `still_rotation` skips; no global viscous damping; sleeping off and nobody
+//! asleep; the per-contact energy ledger off (`energy_ledger = false`: the path books no contact
+//! damping or friction work, as the general step does not then either).
+//!
+//! # Validity of the owned state
+//! From [`SphereSim::from_world`] on, the simulation owns the state: the world it came from is stale
+//! until [`SphereSim::write_back`]. Its broad phase is reset by the write-back (the general step rebuilds
+//! its lists on its next step), and its contact store then holds the flat list's pairs, with the geometry
+//! the general step would have stored for them at the current positions.
+
+mod neighbours;
+mod pair;
+mod step;
+
+use crate::contact::{contact_plane_sphere, contact_sphere_sphere, QueryCounters};
+use crate::dynamics::rotation::{is_isotropic, SubRotation};
+use crate::dynamics::{Motion, RotationScheme, ViscousDamping};
+use crate::law::ContactModel;
+use crate::math::{Point, Real, Rotation, Vector};
+use crate::shape::Shape;
+
+use super::broad_phase::BroadPhase;
+use super::contact_store::{ContactKey, ContactState, ContactStore};
+use super::energy::EnergyLedger;
+use super::skips;
+use super::step::{effective_model, StepError, StepParams};
+use super::world::{Wall, World};
+
+pub use neighbours::{NeighbourList, LARGE_RADIUS_FACTOR, MAX_CELLS_PER_BODY};
+use pair::{Kinematic, PairOut, Props, WallPlane};
+
+/// Why a world cannot take the flat sphere path (see the module docs).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum NotSphereOnly {
+    #[error("body {body} ('{name}') is not a sphere")]
+    NotASphere { body: usize, name: String },
+    #[error("body {body} ('{name}') is not a free (dynamic) body")]
+    NotDynamic { body: usize, name: String },
+    #[error("body {body} ('{name}') has unequal principal moments")]
+    Anisotropic { body: usize, name: String },
+    #[error("the flat sphere path needs {what}")]
+    Params { what: &'static str },
+}
+
+/// The angular part of a sphere's state, read by the integration only.
+#[derive(Clone, Copy, Debug)]
+struct Spin {
+    angular_momentum: Vector,
+    orientation: Rotation,
+}
+
+/// A world of free spheres stepped on the flat path (see the module docs for the state it owns).
+#[derive(Clone, Debug)]
+pub struct SphereSim {
+    params: StepParams,
+    form: SubRotation,
+    kin: Vec<Kinematic>,
+    spin: Vec<Spin>,
+    props: Vec<Props>,
+    /// Contact force and torque of the last evaluation on each sphere.
+    force: Vec<Vector>,
+    torque: Vec<Vector>,
+    names: Vec<String>,
+    gravity: Vector,
+    walls: Vec<Wall>,
+    planes: Vec<WallPlane>,
+    wall_forces: Vec<Vector>,
+    models: Vec<Option<ContactModel>>,
+    n_materials: usize,
+    list: NeighbourList,
+    /// The last evaluation of every listed pair (aligned with the lists); valid when `outs_valid`.
+    out: Vec<PairOut>,
+    wall_out: Vec<PairOut>,
+    /// Whether `out` holds the evaluation that produced `force` (false until this simulation evaluated
+    /// the pairs: the loads were taken from the world).
+    outs_valid: bool,
+    /// The world's elastic potential when the loads were taken from it.
+    start_potential: Real,
+    external_power: Real,
+    ledger: EnergyLedger,
+    time: Real,
+    step_index: u64,
+}
+
+impl SphereSim {
+    /// The flat simulation of `world` stepped with `params` (see the module docs). When the world's loads
+    /// are not current (no step taken yet), the initial loads are evaluated here, as the general step's
+    /// stage 0 does (with its ledger's initial total).
+    pub fn from_world(world: &World, params: &StepParams) -> Result<Self, StepFlatError> {
+        let need = |ok: bool, what: &'static str| {
+            if ok {
+                Ok(())
+            } else {
+                Err(NotSphereOnly::Params { what })
+            }
+        };
+        let form = match params.rotation {
+            RotationScheme::Splitting { sub_rotation } => sub_rotation,
+            _ => {
+                return Err(NotSphereOnly::Params {
+                    what: "the splitting rotation scheme",
+                }
+                .into())
+            }
+        };
+        need(
+            params.skips.isotropic_rotation && params.skips.still_rotation,
+            "the isotropic_rotation and still_rotation skips",
+        )?;
+        need(
+            params.damping == ViscousDamping::None,
+            "no global viscous damping",
+        )?;
+        need(
+            !params.sleeping.enabled && world.sleep.sleeping == 0,
+            "sleeping off",
+        )?;
+        need(!params.energy_ledger, "energy_ledger = false")?;
+        let n = world.bodies.len();
+        let mut kin = Vec::with_capacity(n);
+        let mut spin = Vec::with_capacity(n);
+        let mut props = Vec::with_capacity(n);
+        for (i, body) in world.bodies.iter().enumerate() {
+            let name = || world.names[i].clone();
+            let Shape::Sphere(sphere) = world.shape(i) else {
+                return Err(NotSphereOnly::NotASphere {
+                    body: i,
+                    name: name(),
+                }
+                .into());
+            };
+            if !matches!(body.motion, Motion::Dynamic) {
+                return Err(NotSphereOnly::NotDynamic {
+                    body: i,
+                    name: name(),
+                }
+                .into());
+            }
+            if !is_isotropic(&body.inertia.0) {
+                return Err(NotSphereOnly::Anisotropic {
+                    body: i,
+                    name: name(),
+                }
+                .into());
+            }
+            let moment = body.inertia.0.x;
+            kin.push(Kinematic {
+                position: body.position,
+                velocity: body.velocity,
+                omega: body.angular_momentum / moment,
+            });
+            spin.push(Spin {
+                angular_momentum: body.angular_momentum,
+                orientation: body.orientation,
+            });
+            props.push(Props {
+                radius: sphere.radius(),
+                mass: body.mass,
+                moment,
+                material: world.material_of[i],
+            });
+        }
+        let n_materials = world.materials.len();
+        let mut models = Vec::with_capacity(n_materials * n_materials);
+        for a in 0..n_materials as u32 {
+            for b in 0..n_materials as u32 {
+                models.push(
+                    world
+                        .materials
+                        .model(a, b)
+                        .map(|m| effective_model(m, &params.skips)),
+                );
+            }
+        }
+        let planes: Vec<WallPlane> = world.walls.iter().map(WallPlane::of).collect();
+        let mut sim = Self {
+            params: *params,
+            form,
+            kin,
+            spin,
+            props,
+            force: vec![Vector::zeros(); n],
+            torque: vec![Vector::zeros(); n],
+            names: world.names.clone(),
+            gravity: world.gravity,
+            walls: world.walls.clone(),
+            planes,
+            wall_forces: vec![Vector::zeros(); world.walls.len()],
+            models,
+            n_materials,
+            list: NeighbourList::new(world.broad_phase.skin()),
+            out: Vec::new(),
+            wall_out: Vec::new(),
+            outs_valid: false,
+            start_potential: world.loads.elastic_potential,
+            external_power: world.loads.external_power,
+            ledger: world.ledger,
+            time: world.time,
+            step_index: world.step_index,
+        };
+        // The first build imports the springs of the world's contact store.
+        let store = &world.contacts;
+        let import = |body: Option<(u32, u32)>, wall: Option<(u32, u32)>| {
+            let key = match (body, wall) {
+                (Some((a, b)), _) => ContactKey::Body { a, b },
+                (None, Some((body, wall))) => ContactKey::Wall { body, wall },
+                (None, None) => return None,
+            };
+            store.get(&key).map(|s| (s.history, s.since_step))
+        };
+        let centres: Vec<Point> = sim.kin.iter().map(|k| k.position).collect();
+        let parallel = sim.parallel_bodies();
+        sim.list.rebuild(
+            &centres,
+            &sim.props,
+            &sim.planes,
+            parallel,
+            world.step_index,
+            &import,
+        );
+        if world.loads.current && world.loads.forces.len() == n {
+            sim.force.clone_from(&world.loads.forces);
+            sim.torque.clone_from(&world.loads.torques);
+            if world.loads.wall_forces.len() == world.walls.len() {
+                sim.wall_forces.clone_from(&world.loads.wall_forces);
+            }
+        } else {
+            // Stage 0: the loads of the initial state, no tangential increment.
+            sim.evaluate(0.0)?;
+            sim.gather_only();
+            if sim.ledger.initial_total.is_none() {
+                let mut at_start = world.clone();
+                at_start.loads.forces.clone_from(&sim.force);
+                at_start.loads.torques.clone_from(&sim.torque);
+                at_start.loads.elastic_potential = sim.elastic_potential();
+                sim.ledger.initial_total = Some(at_start.energy().mechanical());
+            }
+        }
+        Ok(sim)
+    }
+
+    /// Whether the per-sphere passes run on the pool (results are the same bits either way).
+    fn parallel_bodies(&self) -> bool {
+        rayon::current_num_threads() > 1 && self.kin.len() >= MIN_PARALLEL_BODIES
+    }
+
+    /// Number of spheres.
+    pub fn len(&self) -> usize {
+        self.kin.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.kin.is_empty()
+    }
+
+    /// Centre of sphere `i` (m).
+    pub fn position(&self, i: usize) -> Point {
+        self.kin[i].position
+    }
+
+    /// Velocity of sphere `i` (m/s).
+    pub fn velocity(&self, i: usize) -> Vector {
+        self.kin[i].velocity
+    }
+
+    /// Angular momentum (kg·m²/s) and orientation of sphere `i`.
+    pub fn angular_momentum(&self, i: usize) -> Vector {
+        self.spin[i].angular_momentum
+    }
+
+    pub fn orientation(&self, i: usize) -> Rotation {
+        self.spin[i].orientation
+    }
+
+    /// Contact force (N) and torque (N·m) on each sphere from the last evaluation.
+    pub fn forces(&self) -> &[Vector] {
+        &self.force
+    }
+
+    pub fn torques(&self) -> &[Vector] {
+        &self.torque
+    }
+
+    /// Contact force on each wall (N) from the last evaluation.
+    pub fn wall_forces(&self) -> &[Vector] {
+        &self.wall_forces
+    }
+
+    /// Σ of the elastic potentials of the contacts of the last evaluation (J), summed in pair order.
+    pub fn elastic_potential(&self) -> Real {
+        if !self.outs_valid {
+            return self.start_potential;
+        }
+        // The law's potentials of each overlapping pair (normal k_n δ^(n+1)/(n+1), tangential ½ k_t |u|²
+        // from the spring the evaluation left), in pair order: the general step's sum.
+        let list = &self.list;
+        let model = |a: u32, b: u32| {
+            self.models[a as usize * self.n_materials + b as usize]
+                .as_ref()
+                .expect("an overlapping pair was evaluated with its model")
+        };
+        let potential = |model: &ContactModel, depth: Real, h: &crate::law::TangentialHistory| {
+            model.normal.potential(depth) + 0.5 * h.stiffness * h.displacement.norm_squared()
+        };
+        let mut sum = 0.0;
+        for (p, o) in self.out.iter().enumerate() {
+            if o.overlapping {
+                let (a, b) = (list.a[p] as usize, list.b[p] as usize);
+                let m = pair::scaled(
+                    model(self.props[a].material, self.props[b].material),
+                    list.root_radius[p],
+                );
+                sum += potential(&m, o.depth, &list.histories[p]);
+            }
+        }
+        for (q, o) in self.wall_out.iter().enumerate() {
+            if o.overlapping {
+                let (body, wall) = (list.wall_body[q] as usize, list.wall_of[q] as usize);
+                let m = model(self.planes[wall].material, self.props[body].material)
+                    .for_contact_radii(None, Some(self.props[body].radius));
+                sum += potential(&m, o.depth, &list.wall_histories[q]);
+            }
+        }
+        sum
+    }
+
+    /// Simulated time (s) and completed steps.
+    pub fn time(&self) -> Real {
+        self.time
+    }
+
+    pub fn step_index(&self) -> u64 {
+        self.step_index
+    }
+
+    /// The neighbour lists as they stand.
+    pub fn neighbours(&self) -> &NeighbourList {
+        &self.list
+    }
+
+    /// Listed body pairs (a, b), a < b, in key order.
+    pub fn body_pairs(&self) -> impl Iterator<Item = (u32, u32)> + '_ {
+        self.list.a.iter().copied().zip(self.list.b.iter().copied())
+    }
+
+    /// Listed body–wall pairs (body, wall), in key order.
+    pub fn wall_pairs(&self) -> impl Iterator<Item = (u32, u32)> + '_ {
+        self.list
+            .wall_body
+            .iter()
+            .copied()
+            .zip(self.list.wall_of.iter().copied())
+    }
+
+    /// Puts the state back into `world` (the world this simulation was made from, possibly restored
+    /// since): bodies, walls, loads, ledger, time and step index, and a contact store holding every listed
+    /// pair with its spring, its last forces and the geometry the general step would have stored for it
+    /// at the current positions; the broad phase is reset so that the general step rebuilds its lists.
+    pub fn write_back(&self, world: &mut World) {
+        for (i, body) in world.bodies.iter_mut().enumerate() {
+            body.position = self.kin[i].position;
+            body.velocity = self.kin[i].velocity;
+            body.angular_momentum = self.spin[i].angular_momentum;
+            body.orientation = self.spin[i].orientation;
+        }
+        world.walls.clone_from(&self.walls);
+        world.ledger = self.ledger;
+        world.time = self.time;
+        world.step_index = self.step_index;
+        let loads = &mut world.loads;
+        loads.forces.clone_from(&self.force);
+        loads.torques.clone_from(&self.torque);
+        loads.wall_forces.clone_from(&self.wall_forces);
+        loads.elastic_potential = self.elastic_potential();
+        loads.damping_work = 0.0;
+        loads.friction_dissipation = 0.0;
+        loads.tangential_stiffness_work = 0.0;
+        loads.external_power = self.external_power;
+        loads.current = true;
+        world.broad_phase = BroadPhase::new(world.broad_phase.skin());
+        if !self.outs_valid {
+            // Nothing evaluated here: the world's store is still the state.
+            return;
+        }
+        let list = &self.list;
+        let keys: Vec<ContactKey> = self
+            .body_pairs()
+            .map(|(a, b)| ContactKey::Body { a, b })
+            .chain(
+                list.wall_body
+                    .iter()
+                    .zip(&list.wall_of)
+                    .map(|(&body, &wall)| ContactKey::Wall { body, wall }),
+            )
+            .collect();
+        let mut store = ContactStore::default();
+        store.sync(&keys, self.step_index.saturating_sub(1));
+        let tol = &self.params.tolerances;
+        let bounding = self.params.skips.bounding_spheres;
+        let mut counters = QueryCounters::default();
+        let n_body = list.a.len();
+        for (k, state) in store.states_mut().iter_mut().enumerate() {
+            let (history, since, out) = if k < n_body {
+                (list.histories[k], list.since[k], &self.out[k])
+            } else {
+                let q = k - n_body;
+                (
+                    list.wall_histories[q],
+                    list.wall_since[q],
+                    &self.wall_out[q],
+                )
+            };
+            let geometry = match keys[k] {
+                ContactKey::Body { a, b } => {
+                    let (a, b) = (a as usize, b as usize);
+                    let (xa, xb) = (&self.kin[a].position, &self.kin[b].position);
+                    let (ra, rb) = (self.props[a].radius, self.props[b].radius);
+                    let rejected = bounding
+                        .then(|| {
+                            skips::reject_by_bounding_spheres(
+                                xa,
+                                ra,
+                                xb,
+                                rb,
+                                (2.0 * ra).max(2.0 * rb),
+                                tol,
+                                &mut counters,
+                            )
+                        })
+                        .flatten();
+                    rejected.unwrap_or_else(|| contact_sphere_sphere(xa, ra, xb, rb, tol))
+                }
+                ContactKey::Wall { body, wall } => {
+                    let (x, r) = (
+                        &self.kin[body as usize].position,
+                        self.props[body as usize].radius,
+                    );
+                    let w = &self.walls[wall as usize];
+                    let rejected = bounding
+                        .then(|| {
+                            skips::reject_wall_by_bounding_sphere(
+                                w.signed_distance(x),
+                                &w.normal_world(),
+                                x,
+                                r,
+                                &mut counters,
+                            )
+                        })
+                        .flatten();
+                    rejected.unwrap_or_else(|| {
+                        contact_plane_sphere(&w.pose, w.plane.normal(), w.plane.offset(), x, r, tol)
+                    })
+                }
+            };
+            let (force_on_b, damping_force) = if out.overlapping {
+                (out.force_on_b, out.damping_force)
+            } else {
+                (Vector::zeros(), Vector::zeros())
+            };
+            *state = ContactState {
+                history,
+                since_step: since,
+                geometry,
+                force_on_b,
+                damping_force,
+                ..ContactState::new(since)
+            };
+        }
+        world.contacts = store;
+    }
+}
+
+/// Why [`SphereSim::from_world`] failed: the world does not fit the path, or its initial evaluation
+/// failed.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum StepFlatError {
+    #[error(transparent)]
+    NotSphereOnly(#[from] NotSphereOnly),
+    #[error(transparent)]
+    Step(#[from] StepError),
+}
+
+/// From this many spheres on, the per-sphere passes run on the pool when it has several threads (one
+/// pass over 1024 spheres is ~30 µs of work, well above the cost of a fork/join on a busy pool).
+pub const MIN_PARALLEL_BODIES: usize = 1024;
+
+/// From this many listed pairs on, the pair loop runs on the pool when it has several threads.
+pub const MIN_PARALLEL_PAIRS: usize = 2048;

@@ -1,0 +1,459 @@
+//! The half neighbour list of the flat sphere path, with a Verlet skin, and its body–wall list.
+//!
+//! # What is listed
+//! - Body pairs (a, b), a < b, whose spheres were closer than r_a + r_b + skin at the build, sorted by
+//!   (a, b): the pairs of body a are one contiguous run (`row_start`). This is the order of the general
+//!   step's contact keys, so every sum the step takes over pairs runs in the general step's order.
+//! - For every body, the pairs in which it is side B, in increasing a (`as_b`): with its own run, the
+//!   pairs of body i in the order (a, i) for a < i, then (i, b) for b > i — the key order, which the
+//!   per-body gather follows.
+//! - Body–wall pairs (body, wall) whose sphere came within the skin of the plane at the build, sorted by
+//!   body then wall (`wall_start`).
+//!
+//! # Validity
+//! A pair left out had a gap of at least `skin` at the build; it cannot overlap before the two largest
+//! displacements since the build (bodies, or a body and a moving wall) sum to the skin. The step rebuilds
+//! when they do ([`NeighbourList::is_stale`], the rule of the general broad phase).
+//!
+//! # Build
+//! Bodies are binned in a uniform grid of cells `2 r_grid + skin` wide, r_grid the largest radius of the
+//! grid's bodies; a body more than [`LARGE_RADIUS_FACTOR`] times the median radius (a projectile) is kept
+//! out of the grid and tested against every body, so that one large sphere does not coarsen the grid for
+//! all. The grid spans the box of the centres with at most [`MAX_CELLS_PER_BODY`] cells per body; a body
+//! beyond it is binned into the nearest edge cell (clamping keeps neighbouring cells neighbours, so the
+//! search stays complete, only slower for far outliers). Each body's row is searched independently (in
+//! parallel on several threads, rows in body order, so the list is the same for any number of threads).
+//!
+//! # Contact history across rebuilds
+//! The tangential spring of a pair lives beside the pair (`histories`, aligned with the pairs); a rebuild
+//! carries the spring of every pair that stays listed to its new slot (a merge of the old and new rows of
+//! its first body, both sorted), and a new pair starts with no spring, as the general contact store does.
+
+use rayon::prelude::*;
+
+use crate::law::pair::effective_contact_radius;
+use crate::law::TangentialHistory;
+use crate::math::{Point, Real, Vector};
+
+use super::pair::{Props, WallPlane};
+
+/// A body whose radius exceeds this many times the median radius is searched against every body
+/// instead of being binned in the grid (see the module docs).
+pub const LARGE_RADIUS_FACTOR: Real = 2.0;
+
+/// The grid holds at most this many cells per body (plus 27).
+pub const MAX_CELLS_PER_BODY: usize = 4;
+
+/// The lists and the state they were built from (see the module docs).
+#[derive(Clone, Debug, Default)]
+pub struct NeighbourList {
+    pub(crate) skin: Real,
+    /// Body pairs: first and second body (a < b), sorted by (a, b).
+    pub(crate) a: Vec<u32>,
+    pub(crate) b: Vec<u32>,
+    /// The pairs of body i as side A: `row_start[i]..row_start[i + 1]`.
+    pub(crate) row_start: Vec<u32>,
+    /// Pair indices with body i as side B, increasing a: `as_b[as_b_start[i]..as_b_start[i + 1]]`.
+    pub(crate) as_b_start: Vec<u32>,
+    pub(crate) as_b: Vec<u32>,
+    /// Per body pair, √R* (R* = r_a r_b/(r_a + r_b), m^½) and the effective mass m_a m_b/(m_a + m_b) (kg):
+    /// constants of the pair, formed once per build with the operations of the general step.
+    pub(crate) root_radius: Vec<Real>,
+    pub(crate) effective_mass: Vec<Real>,
+    /// The tangential spring of each body pair, and the step it entered the list.
+    pub(crate) histories: Vec<TangentialHistory>,
+    pub(crate) since: Vec<u64>,
+    /// Body–wall pairs sorted by (body, wall): the walls of body i are
+    /// `wall_of[wall_start[i]..wall_start[i + 1]]`.
+    pub(crate) wall_start: Vec<u32>,
+    pub(crate) wall_of: Vec<u32>,
+    /// The body of each body–wall pair.
+    pub(crate) wall_body: Vec<u32>,
+    pub(crate) wall_histories: Vec<TangentialHistory>,
+    pub(crate) wall_since: Vec<u64>,
+    /// Centres of the bodies and translations of the walls at the build.
+    pub(crate) centres_at_build: Vec<Point>,
+    pub(crate) walls_at_build: Vec<Vector>,
+    /// Builds so far.
+    pub(crate) builds: u64,
+}
+
+/// The spring and entry step of a pair given as a body pair `(a, b)` or a body–wall pair `(body, wall)`,
+/// if known (see [`NeighbourList::rebuild`]).
+pub(crate) type ImportHistory<'a> =
+    dyn Fn(Option<(u32, u32)>, Option<(u32, u32)>) -> Option<(TangentialHistory, u64)> + Sync + 'a;
+
+/// The two largest of a set of squared displacements (order-free: the same for any split of the set).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub(crate) struct TopTwo {
+    pub(crate) first: Real,
+    pub(crate) second: Real,
+}
+
+impl TopTwo {
+    #[inline(always)]
+    pub(crate) fn push(&mut self, d_sq: Real) {
+        if d_sq > self.second {
+            if d_sq > self.first {
+                self.second = self.first;
+                self.first = d_sq;
+            } else {
+                self.second = d_sq;
+            }
+        }
+    }
+
+    pub(crate) fn merge(mut self, other: TopTwo) -> TopTwo {
+        self.push(other.first);
+        self.push(other.second);
+        self
+    }
+}
+
+/// The uniform grid of one build.
+struct Grid {
+    origin: Point,
+    inv_cell: Real,
+    dims: [usize; 3],
+    /// Bodies of cell c: `bodies[start[c]..start[c + 1]]`, increasing index.
+    start: Vec<u32>,
+    bodies: Vec<u32>,
+}
+
+impl Grid {
+    #[inline(always)]
+    fn coord(&self, x: &Point) -> [usize; 3] {
+        let mut c = [0; 3];
+        for k in 0..3 {
+            let f = ((x[k] - self.origin[k]) * self.inv_cell).floor();
+            c[k] = if f.is_nan() || f <= 0.0 {
+                0
+            } else {
+                (f as usize).min(self.dims[k] - 1)
+            };
+        }
+        c
+    }
+
+    #[inline(always)]
+    fn index(&self, c: [usize; 3]) -> usize {
+        (c[2] * self.dims[1] + c[1]) * self.dims[0] + c[0]
+    }
+
+    fn build(centres: &[Point], members: &[u32], cell: Real) -> Grid {
+        let (mut lo, mut hi) = (
+            Point::new(Real::INFINITY, Real::INFINITY, Real::INFINITY),
+            Point::new(Real::NEG_INFINITY, Real::NEG_INFINITY, Real::NEG_INFINITY),
+        );
+        for &i in members {
+            let x = &centres[i as usize];
+            for k in 0..3 {
+                lo[k] = lo[k].min(x[k]);
+                hi[k] = hi[k].max(x[k]);
+            }
+        }
+        if members.is_empty() {
+            lo = Point::origin();
+            hi = Point::origin();
+        }
+        let mut dims = [1usize; 3];
+        for k in 0..3 {
+            let cells = ((hi[k] - lo[k]) / cell).floor() + 1.0;
+            dims[k] = if cells.is_finite() && cells >= 1.0 {
+                cells.min(1e6) as usize
+            } else {
+                1
+            };
+        }
+        // At most MAX_CELLS_PER_BODY cells per body: shrink the longest axis (the others clamp into it).
+        let limit = MAX_CELLS_PER_BODY * members.len() + 27;
+        while dims[0] * dims[1] * dims[2] > limit {
+            let k = (0..3).max_by_key(|&k| dims[k]).unwrap_or(0);
+            dims[k] = (dims[k] / 2).max(1);
+        }
+        let mut grid = Grid {
+            origin: lo,
+            inv_cell: 1.0 / cell,
+            dims,
+            start: vec![0; dims[0] * dims[1] * dims[2] + 1],
+            bodies: vec![0; members.len()],
+        };
+        let cells: Vec<usize> = members
+            .iter()
+            .map(|&i| grid.index(grid.coord(&centres[i as usize])))
+            .collect();
+        for &c in &cells {
+            grid.start[c + 1] += 1;
+        }
+        for c in 0..grid.start.len() - 1 {
+            grid.start[c + 1] += grid.start[c];
+        }
+        let mut fill = grid.start.clone();
+        for (&i, &c) in members.iter().zip(&cells) {
+            grid.bodies[fill[c] as usize] = i;
+            fill[c] += 1;
+        }
+        grid
+    }
+}
+
+impl NeighbourList {
+    /// An empty list with the given skin (m); the first [`rebuild`](Self::rebuild) fills it.
+    pub fn new(skin: Real) -> Self {
+        Self {
+            skin,
+            ..Self::default()
+        }
+    }
+
+    /// Builds so far.
+    pub fn builds(&self) -> u64 {
+        self.builds
+    }
+
+    /// The skin (m).
+    pub fn skin(&self) -> Real {
+        self.skin
+    }
+
+    /// Body pairs listed.
+    pub fn body_pairs(&self) -> usize {
+        self.a.len()
+    }
+
+    /// Body–wall pairs listed.
+    pub fn wall_pairs(&self) -> usize {
+        self.wall_of.len()
+    }
+
+    /// Whether a pair left out may overlap now (see the module docs): the two largest displacements since
+    /// the build, `top` (squared, bodies) and the walls' moves, sum to the skin.
+    pub(crate) fn is_stale(&self, top: TopTwo, walls: &[WallPlane]) -> bool {
+        if self.builds == 0 || walls.len() != self.walls_at_build.len() {
+            return true;
+        }
+        let w1 = walls
+            .iter()
+            .zip(&self.walls_at_build)
+            .map(|(w, then)| (w.pose.translation.vector - then).norm_squared())
+            .fold(0.0, Real::max);
+        top.first.sqrt() + top.second.max(w1).sqrt() >= self.skin * (1.0 - 1e-9)
+    }
+
+    /// Rebuilds the lists at `centres`, carrying every listed pair's spring (see the module docs).
+    /// `history_of` gives the spring and entry step of a new pair the old lists do not hold, as a body
+    /// pair `(a, b)` or a body–wall pair `(body, wall)` (the import from a world's contact store on the
+    /// first build; `None`: no spring, entering at `step`).
+    pub(crate) fn rebuild(
+        &mut self,
+        centres: &[Point],
+        props: &[Props],
+        walls: &[WallPlane],
+        parallel: bool,
+        step: u64,
+        history_of: &ImportHistory<'_>,
+    ) {
+        let n = centres.len();
+        let skin = self.skin;
+        // Large bodies out of the grid.
+        let mut sorted: Vec<Real> = props.iter().map(|p| p.radius).collect();
+        sorted.sort_by(|x, y| x.total_cmp(y));
+        let median = sorted.get(n / 2).copied().unwrap_or(0.0);
+        let is_large = |r: Real| r > LARGE_RADIUS_FACTOR * median;
+        let large: Vec<u32> = (0..n as u32)
+            .filter(|&i| is_large(props[i as usize].radius))
+            .collect();
+        let members: Vec<u32> = (0..n as u32)
+            .filter(|&i| !is_large(props[i as usize].radius))
+            .collect();
+        let r_grid = members
+            .iter()
+            .map(|&i| props[i as usize].radius)
+            .fold(0.0, Real::max);
+        let cell = (2.0 * r_grid + skin).max(Real::MIN_POSITIVE);
+        let grid = Grid::build(centres, &members, cell);
+
+        // Rows of pairs (i, j > i) per body, in body order.
+        let reach = |i: usize, j: usize| {
+            let r = props[i].radius + props[j].radius + skin;
+            (centres[j] - centres[i]).norm_squared() < r * r
+        };
+        let row = |i: usize, out: &mut Vec<u32>| {
+            let start = out.len();
+            if is_large(props[i].radius) {
+                out.extend((i as u32 + 1..n as u32).filter(|&j| reach(i, j as usize)));
+                return;
+            }
+            let c = grid.coord(&centres[i]);
+            let range = |k: usize| c[k].saturating_sub(1)..=(c[k] + 1).min(grid.dims[k] - 1);
+            for z in range(2) {
+                for y in range(1) {
+                    for x in range(0) {
+                        let cell = grid.index([x, y, z]);
+                        let bodies =
+                            &grid.bodies[grid.start[cell] as usize..grid.start[cell + 1] as usize];
+                        out.extend(
+                            bodies
+                                .iter()
+                                .copied()
+                                .filter(|&j| j as usize > i && reach(i, j as usize)),
+                        );
+                    }
+                }
+            }
+            out.extend(
+                large
+                    .iter()
+                    .copied()
+                    .filter(|&j| j as usize > i && reach(i, j as usize)),
+            );
+            out[start..].sort_unstable();
+        };
+        let wall_row = |i: usize, out: &mut Vec<u32>| {
+            for (w, plane) in walls.iter().enumerate() {
+                if plane.height(&centres[i]) - props[i].radius < skin {
+                    out.push(w as u32);
+                }
+            }
+        };
+        // Per chunk of bodies: (pair partners, row lengths, walls, wall row lengths).
+        let chunk = chunk_len(n, parallel);
+        let search = |range: std::ops::Range<usize>| {
+            let mut partners = Vec::new();
+            let mut lengths = Vec::with_capacity(range.len());
+            let mut wall_list = Vec::new();
+            let mut wall_lengths = Vec::with_capacity(range.len());
+            for i in range {
+                let (p0, w0) = (partners.len(), wall_list.len());
+                row(i, &mut partners);
+                wall_row(i, &mut wall_list);
+                lengths.push((partners.len() - p0) as u32);
+                wall_lengths.push((wall_list.len() - w0) as u32);
+            }
+            (partners, lengths, wall_list, wall_lengths)
+        };
+        let ranges: Vec<std::ops::Range<usize>> = (0..n)
+            .step_by(chunk.max(1))
+            .map(|s| s..(s + chunk).min(n))
+            .collect();
+        let parts: Vec<_> = if parallel {
+            ranges.into_par_iter().with_max_len(1).map(search).collect()
+        } else {
+            ranges.into_iter().map(search).collect()
+        };
+
+        // Assemble the new lists.
+        let old = std::mem::take(self);
+        self.skin = skin;
+        self.builds = old.builds + 1;
+        self.row_start = Vec::with_capacity(n + 1);
+        self.wall_start = Vec::with_capacity(n + 1);
+        self.row_start.push(0);
+        self.wall_start.push(0);
+        let mut i = 0u32;
+        for (partners, lengths, wall_list, wall_lengths) in parts {
+            let mut p = 0;
+            for (&len, &wall_len) in lengths.iter().zip(&wall_lengths) {
+                for &j in &partners[p..p + len as usize] {
+                    self.a.push(i);
+                    self.b.push(j);
+                }
+                p += len as usize;
+                self.row_start.push(self.a.len() as u32);
+                self.wall_body
+                    .extend(std::iter::repeat_n(i, wall_len as usize));
+                self.wall_start.push(self.wall_body.len() as u32);
+                i += 1;
+            }
+            self.wall_of.extend_from_slice(&wall_list);
+        }
+        // Side-B rows: pairs in key order appended to their second body's row (so increasing a).
+        self.as_b_start = vec![0; n + 1];
+        for &b in &self.b {
+            self.as_b_start[b as usize + 1] += 1;
+        }
+        for k in 0..n {
+            self.as_b_start[k + 1] += self.as_b_start[k];
+        }
+        self.as_b = vec![0; self.b.len()];
+        let mut fill = self.as_b_start.clone();
+        for (p, &b) in self.b.iter().enumerate() {
+            self.as_b[fill[b as usize] as usize] = p as u32;
+            fill[b as usize] += 1;
+        }
+
+        // Springs carried over from the old lists (or imported), per pair.
+        let old_row = |a: u32, b: u32| -> Option<usize> {
+            let a = a as usize;
+            if a + 1 >= old.row_start.len() {
+                return None;
+            }
+            let (s, e) = (old.row_start[a] as usize, old.row_start[a + 1] as usize);
+            old.b[s..e].binary_search(&b).ok().map(|k| s + k)
+        };
+        let carry = |p: usize| -> (TangentialHistory, u64) {
+            let (a, b) = (self.a[p], self.b[p]);
+            match old_row(a, b) {
+                Some(k) => (old.histories[k], old.since[k]),
+                None => history_of(Some((a, b)), None).unwrap_or((Default::default(), step)),
+            }
+        };
+        let carried: Vec<(TangentialHistory, u64)> = if parallel {
+            (0..self.a.len()).into_par_iter().map(carry).collect()
+        } else {
+            (0..self.a.len()).map(carry).collect()
+        };
+        (self.histories, self.since) = carried.into_iter().unzip();
+        (self.root_radius, self.effective_mass) = self
+            .a
+            .iter()
+            .zip(&self.b)
+            .map(|(&a, &b)| {
+                let (pa, pb) = (&props[a as usize], &props[b as usize]);
+                (
+                    effective_contact_radius(Some(pa.radius), Some(pb.radius)).sqrt(),
+                    pa.mass * pb.mass / (pa.mass + pb.mass),
+                )
+            })
+            .unzip();
+        let old_wall = |body: usize, wall: u32| -> Option<usize> {
+            if body + 1 >= old.wall_start.len() {
+                return None;
+            }
+            let (s, e) = (
+                old.wall_start[body] as usize,
+                old.wall_start[body + 1] as usize,
+            );
+            old.wall_of[s..e]
+                .iter()
+                .position(|&w| w == wall)
+                .map(|k| s + k)
+        };
+        self.wall_histories = Vec::with_capacity(self.wall_of.len());
+        self.wall_since = Vec::with_capacity(self.wall_of.len());
+        for body in 0..n {
+            for q in self.wall_start[body] as usize..self.wall_start[body + 1] as usize {
+                let wall = self.wall_of[q];
+                let (h, s) = match old_wall(body, wall) {
+                    Some(k) => (old.wall_histories[k], old.wall_since[k]),
+                    None => history_of(None, Some((body as u32, wall)))
+                        .unwrap_or((Default::default(), step)),
+                };
+                self.wall_histories.push(h);
+                self.wall_since.push(s);
+            }
+        }
+        self.centres_at_build = centres.to_vec();
+        self.walls_at_build = walls.iter().map(|w| w.pose.translation.vector).collect();
+    }
+}
+
+/// Items per parallel chunk: a few chunks per thread so that a thread that runs dry takes work from the
+/// other (the whole range when serial).
+pub(crate) fn chunk_len(n: usize, parallel: bool) -> usize {
+    if !parallel {
+        return n.max(1);
+    }
+    let chunks = rayon::current_num_threads() * super::super::parallel::CHUNKS_PER_THREAD / 4;
+    n.div_ceil(chunks.max(1)).max(64)
+}

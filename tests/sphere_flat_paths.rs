@@ -1,0 +1,211 @@
+//! The flat sphere path (`src/world/sphere_flat/`) steps a world of free spheres to the same bits as the
+//! general step, on one and two threads.
+//!
+//! The scenes are the sphere-bed penetrations of issue 7 (`scenes/sphere_bed_a_hertz_5ms.toml`:
+//! Hertz–Mindlin with the tangential dashpot, friction and the force limit; `scenes/sphere_bed_c_linear_5ms.toml`:
+//! the linear spring–dashpot; 3000 settled spheres in an open box of five walls, a steel ball striking at
+//! 5 m/s), run for their first 300 steps: the ball lands at step ~50, so the runs have new, persistent and
+//! opening contacts between spheres and against the walls, and the flat path's lists are rebuilt. The
+//! flat path keeps the operations and their order (see the module docs of `sphere_flat`), so the
+//! comparison is exact: bodies, loads, walls and the springs of every overlapping pair.
+
+use std::path::Path;
+
+use polydem::scene::{load_scene, Simulation};
+use polydem::world::{step, ContactKey, SphereSim, StepScratch, World};
+
+const STEPS: u64 = 300;
+
+fn scene(file: &str) -> Simulation {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join(file);
+    let mut sim = load_scene(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    // The flat path books no per-contact ledger terms; neither does the general step with this switch.
+    sim.params.energy_ledger = false;
+    sim
+}
+
+fn general(sim: &Simulation, steps: u64) -> World {
+    let mut world = sim.world.clone();
+    let mut scratch = StepScratch::default();
+    for _ in 0..steps {
+        step(&sim.params, &mut world, &mut scratch).unwrap_or_else(|e| panic!("general step: {e}"));
+    }
+    world
+}
+
+fn flat(sim: &Simulation, steps: u64) -> (SphereSim, World) {
+    let mut flat = SphereSim::from_world(&sim.world, &sim.params)
+        .unwrap_or_else(|e| panic!("the sphere bed must take the flat path: {e}"));
+    for _ in 0..steps {
+        flat.step().unwrap_or_else(|e| panic!("flat step: {e}"));
+    }
+    let mut world = sim.world.clone();
+    flat.write_back(&mut world);
+    (flat, world)
+}
+
+/// The first difference in bits between the bodies, walls, loads and time of two worlds, if any.
+fn first_difference(a: &World, b: &World) -> Option<String> {
+    let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+    for (i, (x, y)) in a.bodies.iter().zip(&b.bodies).enumerate() {
+        let state = |b: &polydem::dynamics::RigidBody| {
+            [
+                b.position.coords.as_slice(),
+                b.velocity.as_slice(),
+                b.orientation.coords.as_slice(),
+                b.angular_momentum.as_slice(),
+            ]
+            .concat()
+        };
+        let (fx, fy) = (state(x), state(y));
+        if bits(&fx) != bits(&fy) {
+            return Some(format!("body {i}: state {fx:?} against {fy:?}"));
+        }
+    }
+    let loads = |w: &World| {
+        w.loads
+            .forces
+            .iter()
+            .chain(&w.loads.torques)
+            .chain(&w.loads.wall_forces)
+            .flat_map(|v| v.iter().copied())
+            .chain([
+                w.loads.elastic_potential,
+                w.loads.external_power,
+                w.time,
+                w.ledger.external_work,
+                w.ledger.initial_total.unwrap_or(f64::NAN),
+            ])
+            .collect::<Vec<_>>()
+    };
+    let (la, lb) = (loads(a), loads(b));
+    if let Some(k) = (0..la.len()).find(|&k| la[k].to_bits() != lb[k].to_bits()) {
+        return Some(format!(
+            "loads differ at value {k} of {}: {} against {}",
+            la.len(),
+            la[k],
+            lb[k]
+        ));
+    }
+    if a.step_index != b.step_index {
+        return Some(format!("step {} against {}", a.step_index, b.step_index));
+    }
+    None
+}
+
+/// Every overlapping pair of the general store is in the written-back store with the same spring, forces
+/// and geometry, and every pair of the written-back store that the general store does not hold carries
+/// no spring and no force.
+fn compare_stores(general: &World, flat: &World) -> Result<usize, String> {
+    let mut compared = 0;
+    for (key, state) in general
+        .contacts
+        .keys()
+        .iter()
+        .zip(general.contacts.states())
+    {
+        if !state.is_active() {
+            continue;
+        }
+        let Some(other) = flat.contacts.get(key) else {
+            return Err(format!(
+                "{key:?}: overlapping in the general store, not listed by the flat path"
+            ));
+        };
+        if (
+            other.history,
+            other.force_on_b,
+            other.damping_force,
+            other.geometry,
+        ) != (
+            state.history,
+            state.force_on_b,
+            state.damping_force,
+            state.geometry,
+        ) {
+            return Err(format!(
+                "{key:?}: flat entry {other:?} against general {state:?}"
+            ));
+        }
+        compared += 1;
+    }
+    for (key, state) in flat.contacts.keys().iter().zip(flat.contacts.states()) {
+        if general.contacts.get(key).is_none()
+            && (state.history != Default::default()
+                || state.force_on_b != polydem::math::Vector::zeros())
+        {
+            return Err(format!(
+                "{key:?}: a spring or force in the flat store only: {state:?}"
+            ));
+        }
+    }
+    Ok(compared)
+}
+
+fn same_bits_as_the_general_step(file: &str) {
+    let sim = scene(file);
+    let reference = general(&sim, STEPS);
+    let (flat_sim, written) = flat(&sim, STEPS);
+    if let Some(d) = first_difference(&reference, &written) {
+        panic!("{file}, {STEPS} steps, flat against general: {d}");
+    }
+    let compared = compare_stores(&reference, &written)
+        .unwrap_or_else(|e| panic!("{file}, {STEPS} steps, contact stores: {e}"));
+    // The run must have contacts between spheres and walls, and have rebuilt the lists.
+    let walls = reference
+        .contacts
+        .keys()
+        .iter()
+        .zip(reference.contacts.states())
+        .filter(|(k, s)| matches!(k, ContactKey::Wall { .. }) && s.is_active())
+        .count();
+    assert!(
+        compared > 2000 && walls > 100 && flat_sim.neighbours().builds() > 1,
+        "{file}: {compared} overlapping pairs compared ({walls} against walls), {} list builds: \
+         expected > 2000, > 100 and > 1 for a test that can fail",
+        flat_sim.neighbours().builds()
+    );
+    // And the general step continues from the written-back world with the same bits as without the
+    // detour (its store holds the same springs, its broad phase rebuilds).
+    let mut continued = written.clone();
+    let mut scratch = StepScratch::default();
+    let mut straight = reference.clone();
+    let mut scratch2 = StepScratch::default();
+    for _ in 0..20 {
+        step(&sim.params, &mut continued, &mut scratch).expect("general step after write-back");
+        step(&sim.params, &mut straight, &mut scratch2).expect("general step");
+    }
+    if let Some(d) = first_difference(&straight, &continued) {
+        panic!("{file}: 20 general steps after the write-back differ from the straight run: {d}");
+    }
+}
+
+#[test]
+fn flat_path_is_the_general_step_bit_for_bit_hertz_mindlin() {
+    same_bits_as_the_general_step("scenes/sphere_bed_a_hertz_5ms.toml");
+}
+
+#[test]
+fn flat_path_is_the_general_step_bit_for_bit_linear() {
+    same_bits_as_the_general_step("scenes/sphere_bed_c_linear_5ms.toml");
+}
+
+#[test]
+fn flat_path_is_the_same_on_one_and_two_threads() {
+    let sim = scene("scenes/sphere_bed_a_hertz_5ms.toml");
+    let run = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .expect("pool");
+        pool.install(|| flat(&sim, STEPS).1)
+    };
+    let (one, two) = (run(1), run(2));
+    if let Some(d) = first_difference(&one, &two) {
+        panic!("sphere bed a, {STEPS} flat steps, 1 against 2 threads: {d}");
+    }
+    assert!(
+        one.contacts == two.contacts,
+        "sphere bed a: the written-back contact stores of 1 and 2 threads differ"
+    );
+}
