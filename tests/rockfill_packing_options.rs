@@ -80,10 +80,10 @@ fn local_damping_on_a_world_skips_free_rocks_and_books_what_it_removes() {
     };
     let dt = 1e-3;
     let removed = apply_local_damping(&mut world, 0.3, dt);
-    for k in 2..n {
+    for (k, (b, b0)) in world.bodies.iter().zip(&before).enumerate().skip(2) {
         assert_eq!(
-            (world.bodies[k].velocity, world.bodies[k].angular_momentum),
-            (before[k].velocity, before[k].angular_momentum),
+            (b.velocity, b.angular_momentum),
+            (b0.velocity, b0.angular_momentum),
             "rock {k} carries no load and was damped"
         );
     }
