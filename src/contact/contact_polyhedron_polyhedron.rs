@@ -129,40 +129,8 @@ where
 {
     let scale = a.length_scale().max(b.length_scale());
     let touch = tol.touching * scale;
-    if cache.has_face {
-        if let Some(start) = warm_tetrahedron(a, b, pos12, cache, pair) {
-            let er = epa(pair, &start, scale, tol, scratch);
-            counters.epa_runs += 1;
-            counters.epa_warm_starts += 1;
-            counters.epa_iterations += er.iterations as u64;
-            if let EpaOutcome::Converged {
-                depth,
-                normal,
-                point_a,
-                point_b,
-                face,
-            } = er.outcome
-            {
-                if depth > touch {
-                    counters.epa_warm_hits += 1;
-                    cache.dir = -normal * depth;
-                    cache.normal = normal;
-                    cache.face = face;
-                    cache.hint_a = pair.hint_a;
-                    cache.hint_b = pair.hint_b;
-                    return geometry_to_world(
-                        pos1,
-                        ContactKind::Overlap,
-                        depth,
-                        0.0,
-                        &normal,
-                        &point_a,
-                        &point_b,
-                        SolverStatus::Converged,
-                    );
-                }
-            }
-        }
+    if let Some(g) = warm_hit(pos1, a, b, pos12, pair, tol, cache, scratch, counters) {
+        return g;
     }
     cache.has_face = false;
     let v0 = if cache.dir != Vector::zeros() {
@@ -244,6 +212,122 @@ where
     cache.hint_a = pair.hint_a;
     cache.hint_b = pair.hint_b;
     result
+}
+
+/// Step 2 of the module docs from the warm start alone: when the pair overlapped at its last query
+/// (`cache.has_face`) and EPA from the previous terminal face proves an overlap beyond the touching band,
+/// the geometry, with the cache updated; `None` otherwise, the cache untouched (the counters count the
+/// attempt either way).
+#[allow(clippy::too_many_arguments)]
+fn warm_hit<A, B, SA, SB>(
+    pos1: &Pose,
+    a: &A,
+    b: &B,
+    pos12: &Pose,
+    pair: &mut MinkowskiPair<'_, SA, SB>,
+    tol: &ContactTolerances,
+    cache: &mut PairCache,
+    scratch: &mut EpaScratch,
+    counters: &mut QueryCounters,
+) -> Option<ContactGeometry>
+where
+    A: Polytope + ?Sized,
+    B: Polytope + ?Sized,
+    SA: SupportMap + ?Sized,
+    SB: SupportMap + ?Sized,
+{
+    if !cache.has_face {
+        return None;
+    }
+    let scale = a.length_scale().max(b.length_scale());
+    let touch = tol.touching * scale;
+    let start = warm_tetrahedron(a, b, pos12, cache, pair)?;
+    let er = epa(pair, &start, scale, tol, scratch);
+    counters.epa_runs += 1;
+    counters.epa_warm_starts += 1;
+    counters.epa_iterations += er.iterations as u64;
+    let EpaOutcome::Converged {
+        depth,
+        normal,
+        point_a,
+        point_b,
+        face,
+    } = er.outcome
+    else {
+        return None;
+    };
+    if depth <= touch {
+        return None;
+    }
+    counters.epa_warm_hits += 1;
+    cache.dir = -normal * depth;
+    cache.normal = normal;
+    cache.face = face;
+    cache.hint_a = pair.hint_a;
+    cache.hint_b = pair.hint_b;
+    Some(geometry_to_world(
+        pos1,
+        ContactKind::Overlap,
+        depth,
+        0.0,
+        &normal,
+        &point_a,
+        &point_b,
+        SolverStatus::Converged,
+    ))
+}
+
+/// [`query_polytopes_cached`] when its warm start proves the overlap, B at `pos12` in A's frame (A at
+/// `pos1`): `Some` with the same geometry, cache and counters as that query would leave; `None` when the
+/// pair did not overlap at its last query or the warm start does not prove the overlap now, with the cache
+/// and counters untouched (then the full query answers, as if this had not been called).
+#[allow(clippy::too_many_arguments)]
+pub fn warm_overlap_polytopes<A: Polytope + ?Sized, B: Polytope + ?Sized>(
+    pos1: &Pose,
+    pos12: &Pose,
+    a: &A,
+    b: &B,
+    tol: &ContactTolerances,
+    cache: &mut PairCache,
+    scratch: &mut EpaScratch,
+    counters: &mut QueryCounters,
+) -> Option<ContactGeometry> {
+    if !cache.has_face {
+        return None;
+    }
+    let mut attempt = QueryCounters::default();
+    let g = if a.vertices().len() <= SCAN_MAX_VERTICES && b.vertices().len() <= SCAN_MAX_VERTICES {
+        let (sa, sb) = (VertexScan(a.vertices()), VertexScan(b.vertices()));
+        let mut pair = MinkowskiPair::new(&sa, &sb, pos12, cache.hint_a, cache.hint_b);
+        warm_hit(
+            pos1,
+            a,
+            b,
+            pos12,
+            &mut pair,
+            tol,
+            cache,
+            scratch,
+            &mut attempt,
+        )
+    } else {
+        let mut pair = MinkowskiPair::new(a, b, pos12, cache.hint_a, cache.hint_b);
+        warm_hit(
+            pos1,
+            a,
+            b,
+            pos12,
+            &mut pair,
+            tol,
+            cache,
+            scratch,
+            &mut attempt,
+        )
+    }?;
+    counters.polyhedron_polyhedron += 1;
+    counters.merge(&attempt);
+    counters.record(&g);
+    Some(g)
 }
 
 /// The warm-start tetrahedron: the previous terminal face rebuilt at the current pose from its vertex

@@ -19,6 +19,9 @@ pub struct QueryCounters {
     pub bounding_sphere_rejections: u64,
     /// Pairs rejected by the cached separating direction (one support call per shape).
     pub cached_axis_rejections: u64,
+    /// Pairs whose cached-axis test was skipped because their motion since it last proved them separated
+    /// cannot have closed the gap (`crate::world::skips::still_separated`; no support call).
+    pub motion_bound_skips: u64,
     /// GJK runs and their total iterations.
     pub gjk_runs: u64,
     pub gjk_iterations: u64,
@@ -50,6 +53,7 @@ impl QueryCounters {
         self.sphere_polyhedron += other.sphere_polyhedron;
         self.bounding_sphere_rejections += other.bounding_sphere_rejections;
         self.cached_axis_rejections += other.cached_axis_rejections;
+        self.motion_bound_skips += other.motion_bound_skips;
         self.gjk_runs += other.gjk_runs;
         self.gjk_iterations += other.gjk_iterations;
         self.epa_runs += other.epa_runs;
@@ -97,12 +101,13 @@ impl fmt::Display for QueryCounters {
         )?;
         writeln!(
             f,
-            "results: overlap {}, touching {}, separated {}; early rejections: bounding sphere {}, cached axis {}",
+            "results: overlap {}, touching {}, separated {}; early rejections: bounding sphere {}, cached axis {}, motion bound {}",
             self.overlapping,
             self.touching,
             self.separated,
             self.bounding_sphere_rejections,
-            self.cached_axis_rejections
+            self.cached_axis_rejections,
+            self.motion_bound_skips
         )?;
         writeln!(
             f,

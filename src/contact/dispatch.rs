@@ -12,7 +12,9 @@
 //! query is a typed error, not a panic.
 
 use super::contact_polyhedron_plane::contact_plane_polytope;
-use super::contact_polyhedron_polyhedron::{query_polytopes_cached, PairCache};
+use super::contact_polyhedron_polyhedron::{
+    query_polytopes_cached, warm_overlap_polytopes, PairCache,
+};
 use super::contact_sphere_plane::contact_plane_sphere;
 use super::contact_sphere_polyhedron::contact_polytope_sphere;
 use super::contact_sphere_sphere::contact_sphere_sphere;
@@ -22,7 +24,7 @@ use super::pair_smoothing::{smooth_pair_overlap, PairSmoothing};
 use super::tolerances::ContactTolerances;
 use super::{ContactGeometry, ContactKind};
 use crate::math::{Point, Pose};
-use crate::shape::Shape;
+use crate::shape::{ConvexPolyhedron, Shape};
 
 /// A query that has no meaning.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
@@ -89,20 +91,7 @@ pub fn query_with(
                 scratch,
                 counters,
             );
-            match tol.pair_smoothing {
-                PairSmoothing::Smoothed { band } if g.kind == ContactKind::Overlap => {
-                    smooth_pair_overlap(
-                        pos1,
-                        a.as_ref(),
-                        pos2,
-                        b.as_ref(),
-                        &g,
-                        band,
-                        [cache.hint_a, cache.hint_b],
-                    )
-                }
-                _ => g,
-            }
+            law_overlap(pos1, a.as_ref(), pos2, b.as_ref(), tol, cache, g)
         }
         (Shape::Polyhedron(a), Shape::Sphere(s)) => contact_polytope_sphere(
             pos1,
@@ -158,6 +147,45 @@ pub fn query_with(
         (Shape::Plane(_), Shape::Plane(_)) => return Err(ContactError::PlanePlane),
     };
     Ok(g)
+}
+
+/// The overlap of a polyhedron pair handed to the law, from the exact geometry `g` of its query (the
+/// cache as the query left it): smoothed per `tol.pair_smoothing` ([`super::pair_smoothing`]).
+fn law_overlap(
+    pos1: &Pose,
+    a: &ConvexPolyhedron,
+    pos2: &Pose,
+    b: &ConvexPolyhedron,
+    tol: &ContactTolerances,
+    cache: &PairCache,
+    g: ContactGeometry,
+) -> ContactGeometry {
+    match tol.pair_smoothing {
+        PairSmoothing::Smoothed { band } if g.kind == ContactKind::Overlap => {
+            smooth_pair_overlap(pos1, a, pos2, b, &g, band, [cache.hint_a, cache.hint_b])
+        }
+        _ => g,
+    }
+}
+
+/// The polyhedron–polyhedron case of [`query_with`] (B at `pos12` in A's frame, as `pos1.inv_mul(pos2)`
+/// gives it) when the pair's warm start proves the overlap ([`warm_overlap_polytopes`]): `Some` with what
+/// [`query_with`] returns, pair smoothing included, and the same cache and counters; `None` with nothing
+/// changed otherwise.
+#[allow(clippy::too_many_arguments)]
+pub fn warm_overlap_with(
+    pos1: &Pose,
+    pos12: &Pose,
+    a: &ConvexPolyhedron,
+    pos2: &Pose,
+    b: &ConvexPolyhedron,
+    tol: &ContactTolerances,
+    cache: &mut PairCache,
+    scratch: &mut EpaScratch,
+    counters: &mut QueryCounters,
+) -> Option<ContactGeometry> {
+    let g = warm_overlap_polytopes(pos1, pos12, a, b, tol, cache, scratch, counters)?;
+    Some(law_overlap(pos1, a, pos2, b, tol, cache, g))
 }
 
 #[cfg(test)]

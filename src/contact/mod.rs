@@ -42,13 +42,14 @@ mod tests_oracle;
 pub use contact_polyhedron_plane::contact_plane_polytope;
 pub use contact_polyhedron_polyhedron::{
     intersect_polyhedra_cached, intersect_polytopes_cached, query_polyhedra,
-    query_polyhedra_cached, query_polyhedra_with, query_polytopes_cached, sat_polyhedra, PairCache,
+    query_polyhedra_cached, query_polyhedra_with, query_polytopes_cached, sat_polyhedra,
+    warm_overlap_polytopes, PairCache,
 };
 pub use contact_sphere_plane::contact_plane_sphere;
 pub use contact_sphere_polyhedron::contact_polytope_sphere;
 pub use contact_sphere_sphere::contact_sphere_sphere;
 pub use counters::QueryCounters;
-pub use dispatch::{query, query_with, swap_pair, ContactError};
+pub use dispatch::{query, query_with, swap_pair, warm_overlap_with, ContactError};
 pub use epa::EpaScratch;
 pub use geometry::{ContactGeometry, ContactKind, SolverStatus};
 pub use pair_smoothing::PairSmoothing;

@@ -37,6 +37,8 @@ use crate::contact::{swap_pair, ContactGeometry, ContactKind, PairCache, SolverS
 use crate::law::TangentialHistory;
 use crate::math::{Point, Vector};
 
+use super::skips::SeparationBound;
+
 /// The ordered pair a contact belongs to (see the module docs for the orientation).
 #[derive(
     Copy, Clone, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, serde::Serialize, serde::Deserialize,
@@ -53,6 +55,9 @@ pub enum ContactKey {
 pub struct ContactState {
     /// Warm start of GJK/EPA (in A's frame).
     pub cache: PairCache,
+    /// The last proof that the pair was separated along `cache`'s axis, for the motion-bound skip (see
+    /// [`super::skips`]; polyhedron pairs only, none otherwise).
+    pub separation: SeparationBound,
     /// The tangential spring (B relative to A) and the normal it is expressed in.
     pub history: TangentialHistory,
     /// The step at which the pair entered the candidate list (the last step it was in the list is the
@@ -72,6 +77,7 @@ impl ContactState {
     pub fn new(step: u64) -> Self {
         Self {
             cache: PairCache::default(),
+            separation: SeparationBound::default(),
             history: TangentialHistory::default(),
             since_step: step,
             geometry: ContactGeometry {
@@ -93,6 +99,7 @@ impl ContactState {
     pub fn swapped(&self) -> Self {
         Self {
             cache: PairCache::default(),
+            separation: SeparationBound::default(),
             history: self.history.swapped(),
             geometry: swap_pair(&self.geometry),
             force_on_b: -self.force_on_b,

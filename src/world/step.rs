@@ -995,20 +995,17 @@ fn narrow_phase(
             }
             pose_a = world.pose(a);
             pose_b = world.pose(b);
-            if params.skips.cached_axis {
-                if let Some((pa, pb)) = skips::polyhedra(shape_a, shape_b) {
-                    if let Some(g) = skips::reject_by_cached_axis(
-                        &pose_a,
-                        pa,
-                        &pose_b,
-                        pb,
-                        tol,
-                        &mut state.cache,
-                        &mut worker.query,
-                    ) {
-                        state.geometry = g;
-                        return Ok(());
-                    }
+            if let Some((pa, pb)) = skips::polyhedra(shape_a, shape_b) {
+                if skips::polyhedron_pair(
+                    &params.skips,
+                    (&pose_a, pa),
+                    (&pose_b, pb),
+                    tol,
+                    state,
+                    &mut worker.epa,
+                    &mut worker.query,
+                ) {
+                    return Ok(());
                 }
             }
         }

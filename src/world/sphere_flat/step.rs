@@ -95,10 +95,11 @@ impl SphereSim {
         let (props, force, torque) = (&self.props, &self.force, &self.torque);
         let (gravity, damping, form) = (self.gravity, self.params.damping, self.form);
         let at_build = &self.list.centres_at_build;
-        let top = {
+        let large_flags = &self.list.large_flags;
+        let (top, large) = {
             let spin = &mut self.spin;
             let drift = |start: usize, kin: &mut [Kinematic], spin: &mut [Spin]| {
-                let mut top = TopTwo::default();
+                let (mut top, mut large) = (TopTwo::default(), TopTwo::default());
                 for (k, (kin, spin)) in kin.iter_mut().zip(spin.iter_mut()).enumerate() {
                     let i = start + k;
                     let p = &props[i];
@@ -116,9 +117,14 @@ impl SphereSim {
                         );
                     }
                     kin.omega = spin.angular_momentum / p.moment;
-                    top.push((kin.position - at_build[i]).norm_squared());
+                    let moved = (kin.position - at_build[i]).norm_squared();
+                    if large_flags[i] {
+                        large.push(moved);
+                    } else {
+                        top.push(moved);
+                    }
                 }
-                top
+                (top, large)
             };
             let chunk = chunk_len(self.kin.len(), parallel);
             if parallel {
@@ -128,7 +134,10 @@ impl SphereSim {
                     .with_max_len(1)
                     .enumerate()
                     .map(|(c, (kin, spin))| drift(c * chunk, kin, spin))
-                    .reduce(TopTwo::default, TopTwo::merge)
+                    .reduce(
+                        || (TopTwo::default(), TopTwo::default()),
+                        |(a, b), (c, d)| (a.merge(c), b.merge(d)),
+                    )
             } else {
                 drift(0, &mut self.kin, spin)
             }
@@ -141,7 +150,7 @@ impl SphereSim {
 
         // 3. Lists.
         let t = Instant::now();
-        if self.list.is_stale(top, &self.planes) {
+        if self.list.is_stale(top, large, &self.planes) {
             let centres: Vec<Point> = self.kin.iter().map(|k| k.position).collect();
             self.list.rebuild(
                 &centres,
