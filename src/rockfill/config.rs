@@ -101,6 +101,33 @@ pub struct PackingParams {
     /// lifting every rock by one mean size d̄). Absent: only the speed criterion (`settle_speed`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub settle_kinetic_fraction: Option<Real>,
+    /// Δt = t_c,min / this during packing only (deposition, compaction, hold); the penetration keeps
+    /// `steps_per_contact`. Absent: packing uses `steps_per_contact` too.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub packing_steps_per_contact: Option<Real>,
+    /// Deposition damping: `viscous` (the global mass-proportional `viscous_rate` on every rock, which also
+    /// slows the free fall: terminal speed g / α) or `local` (Cundall's non-viscous local damping with the
+    /// coefficient `local_damping`, only on rocks that touch something, so a rock in free flight falls
+    /// undamped; see [`super::packing::local_damping`]). Absent: `viscous`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub deposition_damping: Option<DepositionDamping>,
+    /// Coefficient α of the local damping, 0 < α < 1 (YADE's default for quasi-static packing is 0.2).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub local_damping: Option<Real>,
+    /// Initial downward speed v0 of every rock (m/s): a cloud in free fall moves rigidly, so this is the
+    /// loose sample as it would be after falling v0/g from v0²/(2g) higher, caught when its lowest rock is
+    /// where it was generated (under the global viscous damping, v0 = g/α starts the cloud at its terminal
+    /// speed). The rock count, sizes and arrangement (eq. 28/29) are unchanged. Absent: the rocks start at rest.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub drop_speed: Option<Real>,
+}
+
+/// The damping of the deposition stage (see [`PackingParams::deposition_damping`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Deserialize, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum DepositionDamping {
+    Viscous,
+    Local,
 }
 
 /// The impact.
@@ -275,6 +302,7 @@ impl ExperimentConfig {
                 "packing.settle_kinetic_fraction",
                 self.packing.settle_kinetic_fraction,
             ),
+            ("packing.local_damping", self.packing.local_damping),
         ] {
             if let Some(v) = value {
                 if !(v.is_finite() && v > 0.0 && v < 1.0) {
@@ -286,6 +314,34 @@ impl ExperimentConfig {
                     });
                 }
             }
+        }
+        for (field, value) in [
+            (
+                "packing.packing_steps_per_contact",
+                self.packing.packing_steps_per_contact,
+            ),
+            ("packing.drop_speed", self.packing.drop_speed),
+        ] {
+            if let Some(v) = value {
+                if !(v.is_finite() && v > 0.0) {
+                    return Err(ConfigError::Invalid {
+                        path: path.to_owned(),
+                        field,
+                        value: v,
+                        reason: "must be finite and positive",
+                    });
+                }
+            }
+        }
+        if self.packing.deposition_damping == Some(DepositionDamping::Local)
+            && self.packing.local_damping.is_none()
+        {
+            return Err(ConfigError::Invalid {
+                path: path.to_owned(),
+                field: "packing.local_damping",
+                value: Real::NAN,
+                reason: "must be given when deposition_damping = \"local\"",
+            });
         }
         if !(self.sleeping.wake_contact_fraction.is_finite()
             && self.sleeping.wake_contact_fraction >= 0.0)

@@ -47,7 +47,7 @@ use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 use super::collapse::CollapseReport;
-use super::config::{ConfigError, ExperimentConfig};
+use super::config::{ConfigError, DepositionDamping, ExperimentConfig};
 use super::grading::Rock;
 use crate::dynamics::{BodyError, PrincipalInertia, RigidBody, ViscousDamping};
 use crate::math::{Point, Pose, Real, Rotation, Vector};
@@ -191,11 +191,56 @@ pub fn skin_for(mean_size: Real) -> Real {
     0.05 * mean_size
 }
 
-/// Δt and the shortest contact time for rocks of the lightest mass `m_min` (see the module docs).
+/// Δt and the shortest contact time for rocks of the lightest mass `m_min` (see the module docs), with
+/// N = `steps_per_contact` (the penetration's step).
 pub fn rock_time_step(
     config: &ExperimentConfig,
     world: &World,
 ) -> Result<(Real, Real), PackingError> {
+    rock_time_step_with(config, world, config.packing.steps_per_contact)
+}
+
+/// The packing's Δt may not exceed this fraction of the stability limit 2/ω_max (see
+/// [`crate::scene::time_step`]): the limit is a bound at the edge of stability, and the packing keeps a margin.
+pub const PACKING_LIMIT_FRACTION: Real = 0.8;
+
+/// The packing's Δt: t_c,min / `steps_per_contact`, or, when `packing_steps_per_contact` = N is given,
+/// min(t_c,min / N, [`PACKING_LIMIT_FRACTION`] × the stability limit) (the limit of the most elongated rock
+/// binds at N ≈ 12 for 290 mm rocks: seed 2 of the quick variant has 2/ω_max = t_c/11.7).
+pub fn packing_time_step(
+    config: &ExperimentConfig,
+    world: &World,
+) -> Result<(Real, Real), PackingError> {
+    let p = &config.packing;
+    match p.packing_steps_per_contact {
+        None => rock_time_step(config, world),
+        Some(n) => {
+            // The limit does not depend on N; t_c / 1e6 is always stable.
+            let (_, t_c, limit) = time_step_and_limit(config, world, 1e6)?;
+            Ok(((t_c / n).min(PACKING_LIMIT_FRACTION * limit), t_c))
+        }
+    }
+}
+
+/// Δt = t_c,min / `steps_per_contact` and t_c,min, checked against the stability limit.
+pub fn rock_time_step_with(
+    config: &ExperimentConfig,
+    world: &World,
+    steps_per_contact: Real,
+) -> Result<(Real, Real), PackingError> {
+    let (dt, t_c, limit) = time_step_and_limit(config, world, steps_per_contact)?;
+    if dt > limit {
+        return Err(PackingError::UnstableStep { dt, limit });
+    }
+    Ok((dt, t_c))
+}
+
+/// (t_c,min / `steps_per_contact`, t_c,min, stability limit).
+pub fn time_step_and_limit(
+    config: &ExperimentConfig,
+    world: &World,
+    steps_per_contact: Real,
+) -> Result<(Real, Real, Real), PackingError> {
     let models = config.contact_models()?;
     let m_min = world
         .bodies
@@ -224,11 +269,7 @@ pub fn rock_time_step(
     ];
     let (t_c, limit) =
         contact_time_and_limit(&pairs, kappa, None).map_err(|_| PackingError::NoRocks)?;
-    let dt = t_c / config.packing.steps_per_contact;
-    if dt > limit {
-        return Err(PackingError::UnstableStep { dt, limit });
-    }
-    Ok((dt, t_c))
+    Ok((t_c / steps_per_contact, t_c, limit))
 }
 
 /// What packing did.
@@ -348,10 +389,22 @@ pub fn pack(
     mut progress: impl FnMut(&str, Real, Real),
 ) -> Result<PackingReport, PackingError> {
     let start = Instant::now();
-    let (dt, contact_time) = rock_time_step(config, world)?;
+    let (dt, contact_time) = packing_time_step(config, world)?;
     let p = &config.packing;
     let mut params = StepParams::new(dt);
-    params.damping = ViscousDamping::MassProportional(p.viscous_rate);
+    let local_alpha = match p.deposition_damping {
+        Some(DepositionDamping::Local) => p.local_damping,
+        _ => None,
+    };
+    params.damping = match local_alpha {
+        Some(_) => ViscousDamping::None,
+        None => ViscousDamping::MassProportional(p.viscous_rate),
+    };
+    if let Some(v0) = p.drop_speed {
+        for b in world.bodies.iter_mut().filter(|b| b.is_dynamic()) {
+            b.velocity = Vector::new(0.0, 0.0, -v0);
+        }
+    }
     params.sleeping = config.sleeping.params(config.sleeping.packing);
     let mut scratch = StepScratch::default();
     let mut report = PackingReport {
@@ -379,6 +432,9 @@ pub fn pack(
     let mut run =
         |world: &mut World, report: &mut PackingReport, stage: usize| -> Result<(), PackingError> {
             let r = step(&params, world, &mut scratch)?;
+            if let Some(alpha) = local_alpha {
+                world.ledger.dissipated_viscous += apply_local_damping(world, alpha, dt);
+            }
             report.max_overlap_ratio = report.max_overlap_ratio.max(r.max_overlap_ratio);
             report.counters[stage].merge(&r.counters);
             Ok(())
@@ -404,7 +460,11 @@ pub fn pack(
         Some(gap) => (2.0 * (bed_top(world) / config.rock.mean_size) * gap * config.rock.mean_size
             / 9.81)
             .sqrt(),
-        None => (2.0 * initial_top / 9.81).sqrt(),
+        // The fall of the generation height from the drop speed v0: (√(v0² + 2 g h) − v0) / g.
+        None => {
+            let v0 = p.drop_speed.unwrap_or(0.0);
+            ((v0 * v0 + 2.0 * 9.81 * initial_top).sqrt() - v0) / 9.81
+        }
     };
     let check_every = TRACE_EVERY;
     loop {
@@ -486,6 +546,66 @@ pub fn pack(
     report.ledger_balance_relative[2] = world.energy().balance / potential0;
     report.wall_time = start.elapsed();
     Ok(report)
+}
+
+/// Cundall's local (non-viscous) damping of one vector quantity over a step: every component of `value`
+/// (a velocity, or an angular momentum) moves towards zero by α |load_i| `scale` (the load's impulse over the
+/// step divided by what turns impulse into `value`: Δt/m for a velocity, Δt for an angular momentum), against
+/// the sign of the matching component of `rate` (the velocity, or the angular velocity), and never past zero.
+/// A component whose `value` and `rate` differ in sign is left alone. The damping force is thus α times
+/// the unbalanced force, opposed to the motion: it vanishes for a body at rest under balanced loads and
+/// whatever the body's speed when no force acts, which is why it removes the energy of rattling without
+/// slowing a steady fall more than α (the deposition applies it only to rocks in contact, so a rock in free
+/// flight is not slowed at all).
+pub fn local_damping(
+    value: &Vector,
+    rate: &Vector,
+    load: &Vector,
+    alpha: Real,
+    scale: Real,
+) -> Vector {
+    Vector::from_fn(|i, _| {
+        let (v, w) = (value[i], rate[i]);
+        if v == 0.0 || w == 0.0 || v.signum() != w.signum() {
+            return v;
+        }
+        let cut = (alpha * load[i].abs() * scale).min(v.abs());
+        v - v.signum() * cut
+    })
+}
+
+/// Applies [`local_damping`] to every dynamic rock that carries a contact load (translation with the unbalanced
+/// force F + m g, rotation with the contact torque) and returns the kinetic energy it removed (J, ≥ 0: a
+/// change that would raise a body's kinetic energy is not applied).
+pub fn apply_local_damping(world: &mut World, alpha: Real, dt: Real) -> Real {
+    let gravity = world.gravity;
+    let mut removed = 0.0;
+    for (i, b) in world.bodies.iter_mut().enumerate() {
+        if !b.is_dynamic() {
+            continue;
+        }
+        let (force, torque) = match (world.loads.forces.get(i), world.loads.torques.get(i)) {
+            (Some(f), Some(t)) => (*f, *t),
+            _ => continue,
+        };
+        if force == Vector::zeros() && torque == Vector::zeros() {
+            continue;
+        }
+        let before = b.translational_kinetic_energy() + b.rotational_kinetic_energy();
+        let (v, l) = (b.velocity, b.angular_momentum);
+        let unbalanced = force + b.mass * gravity;
+        b.velocity = local_damping(&v, &v, &unbalanced, alpha, dt / b.mass);
+        let omega = b.angular_velocity();
+        b.angular_momentum = local_damping(&l, &omega, &torque, alpha, dt);
+        let after = b.translational_kinetic_energy() + b.rotational_kinetic_energy();
+        if after > before {
+            b.velocity = v;
+            b.angular_momentum = l;
+        } else {
+            removed += before - after;
+        }
+    }
+    removed
 }
 
 fn bed_error(path: &Path, message: impl Into<String>) -> PackingError {
