@@ -9,6 +9,9 @@
 //! flat path keeps the operations and their order (see the module docs of `sphere_flat`), so the
 //! comparison is exact: bodies, loads, walls and the springs of every overlapping pair.
 
+#[path = "support/world_bits.rs"]
+mod world_bits;
+
 use std::path::Path;
 
 use polydem::scene::{load_scene, Simulation};
@@ -46,45 +49,24 @@ fn flat(sim: &Simulation, steps: u64) -> (SphereSim, World) {
 
 /// The first difference in bits between the bodies, walls, loads and time of two worlds, if any.
 fn first_difference(a: &World, b: &World) -> Option<String> {
-    let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
-    for (i, (x, y)) in a.bodies.iter().zip(&b.bodies).enumerate() {
-        let state = |b: &polydem::dynamics::RigidBody| {
-            [
-                b.position.coords.as_slice(),
-                b.velocity.as_slice(),
-                b.orientation.coords.as_slice(),
-                b.angular_momentum.as_slice(),
-            ]
-            .concat()
-        };
-        let (fx, fy) = (state(x), state(y));
-        if bits(&fx) != bits(&fy) {
-            return Some(format!("body {i}: state {fx:?} against {fy:?}"));
-        }
+    if let Some(d) = world_bits::body_difference(a, b) {
+        return Some(d);
     }
-    let loads = |w: &World| {
-        w.loads
-            .forces
-            .iter()
-            .chain(&w.loads.torques)
-            .chain(&w.loads.wall_forces)
-            .flat_map(|v| v.iter().copied())
-            .chain([
-                w.loads.elastic_potential,
-                w.loads.external_power,
-                w.time,
-                w.ledger.external_work,
-                w.ledger.initial_total.unwrap_or(f64::NAN),
-            ])
-            .collect::<Vec<_>>()
+    let extra = |w: &World| {
+        [
+            w.time,
+            w.ledger.external_work,
+            w.ledger.initial_total.unwrap_or(f64::NAN),
+        ]
     };
-    let (la, lb) = (loads(a), loads(b));
-    if let Some(k) = (0..la.len()).find(|&k| la[k].to_bits() != lb[k].to_bits()) {
+    let (la, lb) = (
+        world_bits::load_values(a, &extra(a)),
+        world_bits::load_values(b, &extra(b)),
+    );
+    if let Some((k, x, y)) = world_bits::first_value_difference(&la, &lb) {
         return Some(format!(
-            "loads differ at value {k} of {}: {} against {}",
-            la.len(),
-            la[k],
-            lb[k]
+            "loads differ at value {k} of {}: {x} against {y}",
+            la.len()
         ));
     }
     if a.step_index != b.step_index {

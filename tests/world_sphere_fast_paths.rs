@@ -17,6 +17,8 @@
 
 #[path = "support/bed.rs"]
 mod bed;
+#[path = "support/world_bits.rs"]
+mod world_bits;
 
 use std::path::Path;
 
@@ -67,38 +69,15 @@ fn ledger_bits(w: &World) -> Vec<u64> {
 
 /// The first difference in bits between the bodies, loads and contact stores of two worlds, if any.
 fn first_difference(a: &World, b: &World) -> Option<String> {
-    let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
-    for (i, (x, y)) in a.bodies.iter().zip(&b.bodies).enumerate() {
-        let fx = [
-            x.position.coords.as_slice(),
-            x.velocity.as_slice(),
-            x.orientation.coords.as_slice(),
-            x.angular_momentum.as_slice(),
-        ]
-        .concat();
-        let fy = [
-            y.position.coords.as_slice(),
-            y.velocity.as_slice(),
-            y.orientation.coords.as_slice(),
-            y.angular_momentum.as_slice(),
-        ]
-        .concat();
-        if bits(&fx) != bits(&fy) {
-            return Some(format!("body {i}: state {fx:?} against {fy:?}"));
-        }
+    if let Some(d) = world_bits::body_difference(a, b) {
+        return Some(d);
     }
-    let loads = |w: &World| {
-        w.loads
-            .forces
-            .iter()
-            .chain(&w.loads.torques)
-            .chain(&w.loads.wall_forces)
-            .flat_map(|v| v.iter().copied())
-            .chain([w.loads.elastic_potential, w.loads.external_power])
-            .collect::<Vec<_>>()
-    };
-    if bits(&loads(a)) != bits(&loads(b)) {
-        return Some("loads differ".into());
+    let (la, lb) = (
+        world_bits::load_values(a, &[]),
+        world_bits::load_values(b, &[]),
+    );
+    if let Some((k, x, y)) = world_bits::first_value_difference(&la, &lb) {
+        return Some(format!("loads differ at value {k}: {x} against {y}"));
     }
     if a.contacts != b.contacts {
         return Some("contact stores differ".into());

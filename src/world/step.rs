@@ -1243,18 +1243,38 @@ pub(super) fn non_finite_quantity(
     force: &Vector,
     torque: &Vector,
 ) -> Option<&'static str> {
+    first_non_finite(
+        force,
+        torque,
+        &body.position,
+        &body.velocity,
+        &body.orientation,
+        &body.angular_momentum,
+    )
+}
+
+/// The first non-finite quantity among a body's loads and state, in the order the step's error names
+/// them; shared by the general step and the flat sphere path so both report the same quantity.
+pub(super) fn first_non_finite(
+    force: &Vector,
+    torque: &Vector,
+    position: &Point,
+    velocity: &Vector,
+    orientation: &crate::math::Rotation,
+    angular_momentum: &Vector,
+) -> Option<&'static str> {
     let finite = |v: &Vector| v.iter().all(|x| x.is_finite());
     if !finite(force) {
         Some("contact force")
     } else if !finite(torque) {
         Some("contact torque")
-    } else if !finite(&body.position.coords) {
+    } else if !finite(&position.coords) {
         Some("position")
-    } else if !finite(&body.velocity) {
+    } else if !finite(velocity) {
         Some("velocity")
-    } else if !body.orientation.coords.iter().all(|x| x.is_finite()) {
+    } else if !orientation.coords.iter().all(|x| x.is_finite()) {
         Some("orientation")
-    } else if !finite(&body.angular_momentum) {
+    } else if !finite(angular_momentum) {
         Some("angular momentum")
     } else {
         None

@@ -19,7 +19,7 @@ use crate::dynamics::rotation::drift_isotropic;
 use crate::law::TangentialHistory;
 use crate::math::{Point, Real, Vector};
 
-use super::super::step::{OverlapWarning, StepError, StepReport};
+use super::super::step::{first_non_finite, OverlapWarning, StepError, StepReport};
 use super::super::ContactKey;
 use super::neighbours::{chunk_len, TopTwo};
 use super::pair::{Kinematic, PairContext, PairOut, WallPlane};
@@ -414,20 +414,12 @@ fn non_finite_quantity(
     kin: &Kinematic,
     spin: &Spin,
 ) -> Option<&'static str> {
-    let finite = |v: &Vector| v.iter().all(|x| x.is_finite());
-    if !finite(force) {
-        Some("contact force")
-    } else if !finite(torque) {
-        Some("contact torque")
-    } else if !finite(&kin.position.coords) {
-        Some("position")
-    } else if !finite(&kin.velocity) {
-        Some("velocity")
-    } else if !spin.orientation.coords.iter().all(|x| x.is_finite()) {
-        Some("orientation")
-    } else if !finite(&spin.angular_momentum) {
-        Some("angular momentum")
-    } else {
-        None
-    }
+    first_non_finite(
+        force,
+        torque,
+        &kin.position,
+        &kin.velocity,
+        &spin.orientation,
+        &spin.angular_momentum,
+    )
 }

@@ -42,6 +42,23 @@ const HEADER: [&str; 8] = [
     "ratio",
 ];
 
+/// How many recorded runs of a figure the regression baseline takes the median of.
+const BASELINE_RUNS: usize = 5;
+
+/// The median of `values` (the mean of the middle two for an even count); `None` when empty.
+fn median(mut values: Vec<f64>) -> Option<f64> {
+    if values.is_empty() {
+        return None;
+    }
+    values.sort_by(f64::total_cmp);
+    let mid = values.len() / 2;
+    Some(if values.len() % 2 == 1 {
+        values[mid]
+    } else {
+        0.5 * (values[mid - 1] + values[mid])
+    })
+}
+
 fn case_err(msg: impl Into<String>) -> SuiteError {
     SuiteError::case(NAME, msg)
 }
@@ -130,12 +147,17 @@ impl Case for Perf {
         };
         let path = dir.join(HISTORY);
         let mut history = read_history(&path)?;
+        // The baseline is the median of the last BASELINE_RUNS ratios of the figure on this machine: a
+        // single earlier run is as noisy as the new one (back-to-back runs here differ by up to ~40 %).
         let baseline = |fig: &str| {
-            history
+            let recent: Vec<f64> = history
                 .iter()
                 .rev()
-                .find(|r| r.len() == HEADER.len() && r[2] == machine && r[3] == fig)
-                .and_then(|r| r[7].parse::<f64>().ok())
+                .filter(|r| r.len() == HEADER.len() && r[2] == machine && r[3] == fig)
+                .filter_map(|r| r[7].parse::<f64>().ok())
+                .take(BASELINE_RUNS)
+                .collect();
+            median(recent)
         };
         let mut rows = Vec::new();
         let mut new_rows = Vec::new();
@@ -187,12 +209,18 @@ impl Case for Perf {
         ctx.text(&format!(
             "Machine: {machine}. Each figure: ns per query (minimum over {} passes over {} pairs), ours and \
              parry3d-f64 measured in this run; ratio = ours / parry. A check fails when a ratio exceeds {threshold} \
-             × the last ratio recorded for the same figure on the same machine. History: [perf/{HISTORY}](perf/{HISTORY}).",
+             × the median of the last {BASELINE_RUNS} ratios recorded for the same figure on the same machine. History: [perf/{HISTORY}](perf/{HISTORY}).",
             p.repeats, p.pairs_per_class
         ));
         ctx.table(
             None,
-            &["figure", "ours ns", "parry ns", "ratio", "baseline ratio"],
+            &[
+                "figure",
+                "ours ns",
+                "parry ns",
+                "ratio",
+                "baseline ratio (median)",
+            ],
             &rows,
         )?;
         for (prefix, what) in [
@@ -225,5 +253,17 @@ impl Case for Perf {
             })?;
         }
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::median;
+
+    #[test]
+    fn median_of_odd_even_and_empty_lists() {
+        assert_eq!(median(vec![]), None);
+        assert_eq!(median(vec![3.0, 1.0, 2.0]), Some(2.0));
+        assert_eq!(median(vec![4.0, 1.0, 3.0, 2.0]), Some(2.5));
     }
 }
