@@ -26,6 +26,7 @@ use anyhow::{Context, Result};
 use super::config::ExperimentConfig;
 use super::convergence::{run_convergence, ConvergenceParams};
 use super::experiment::ExperimentResult;
+use super::packing::STAGE_NAMES;
 use super::study::{run_one, run_study, StudyParams};
 
 /// Options of `polydem rockfill`.
@@ -289,7 +290,33 @@ pub fn summary(config: &ExperimentConfig, r: &ExperimentResult) -> String {
                 c.wall_time.as_secs_f64()
             );
         }
-        for (stage, c) in ["deposition", "compaction", "hold"].iter().zip(&p.counters) {
+        if p.density_scale != 1.0 {
+            let _ = writeln!(
+                s,
+                "  density scale {} (packing dt = sqrt(s) x the true-mass dt {:.3e} s): restore {} steps at {:.3e} s, top wall {:.4} m up, its force {:.4e} N -> {:.4e} N\n  bed overlap / mean size: after the hold (scaled masses) max {:.3e}, mean {:.3e}; final max {:.3e}, mean {:.3e}",
+                p.density_scale,
+                p.restore_dt,
+                p.restore_steps,
+                p.restore_dt,
+                p.restore_wall_rise,
+                p.restore_wall_force[0],
+                p.restore_wall_force[1],
+                p.bed_overlap_after_hold[0],
+                p.bed_overlap_after_hold[1],
+                p.bed_overlap_final[0],
+                p.bed_overlap_final[1]
+            );
+        } else {
+            let _ = writeln!(
+                s,
+                "  bed overlap / mean size at the end: max {:.3e}, mean {:.3e}",
+                p.bed_overlap_final[0], p.bed_overlap_final[1]
+            );
+        }
+        for (stage, c) in STAGE_NAMES.iter().zip(&p.counters) {
+            if c.steps == 0 && *stage == "restore" {
+                continue;
+            }
             let time = c.total_time().as_secs_f64();
             let _ = writeln!(
                 s,

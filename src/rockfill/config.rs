@@ -120,6 +120,18 @@ pub struct PackingParams {
     /// speed). The rock count, sizes and arrangement (eq. 28/29) are unchanged. Absent: the rocks start at rest.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub drop_speed: Option<Real>,
+    /// Density (mass) scaling during packing only: the rocks pack with density s ρ (mass and inertia × s), so
+    /// the contact time and the packing Δt grow by √s while the gravity-driven motion (fall, viscous
+    /// damping, settling) keeps its physical time; the compaction cap is scaled by s with the weights, so the
+    /// packing is the one of a bed of true mass with the stiffness k/s. After the hold the true density is
+    /// restored and the bed is relaxed for `restore_time` at the true Δt (see [`super::packing`]). Absent:
+    /// the rocks pack at their true density.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub packing_density_scale: Option<Real>,
+    /// Time (s) at the true density after the scaled packing, with the top wall backed off to the force it
+    /// would carry at the true weights; required with `packing_density_scale`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub restore_time: Option<Real>,
 }
 
 /// The damping of the deposition stage (see [`PackingParams::deposition_damping`]).
@@ -321,6 +333,11 @@ impl ExperimentConfig {
                 self.packing.packing_steps_per_contact,
             ),
             ("packing.drop_speed", self.packing.drop_speed),
+            (
+                "packing.packing_density_scale",
+                self.packing.packing_density_scale,
+            ),
+            ("packing.restore_time", self.packing.restore_time),
         ] {
             if let Some(v) = value {
                 if !(v.is_finite() && v > 0.0) {
@@ -341,6 +358,14 @@ impl ExperimentConfig {
                 field: "packing.local_damping",
                 value: Real::NAN,
                 reason: "must be given when deposition_damping = \"local\"",
+            });
+        }
+        if self.packing.packing_density_scale.is_some() && self.packing.restore_time.is_none() {
+            return Err(ConfigError::Invalid {
+                path: path.to_owned(),
+                field: "packing.restore_time",
+                value: Real::NAN,
+                reason: "must be given with packing_density_scale",
             });
         }
         if !(self.sleeping.wake_contact_fraction.is_finite()

@@ -27,11 +27,29 @@
 //!    ledger then fails to close by many times the wall's work (measured: 24× the rocks' initial potential
 //!    energy on a 50-rock bed at 0.5 m/s; 1.1× at t_c/60).
 //! 3. Hold: the top wall stops; the bed relaxes for `hold_time`.
+//! 4. Restore (only with `packing_density_scale` = s): stages 1–3 ran with every rock's density s ρ (mass and
+//!    inertia × s, velocities kept at the start); the true masses and inertias are now set again (recomputed
+//!    from the shape and ρ, so they are the bits of an unscaled bed; the angular momentum is divided by s so
+//!    that the angular velocity is kept), the change of the kinetic and gravitational energy is booked in the
+//!    ledger as external work, and the bed runs for `restore_time`: over its first half the density goes
+//!    from s ρ down to ρ geometrically (s^(1−τ) ρ, every step at the Δt of its masses), so that the elastic
+//!    energy the scaled weights stored is released slowly and damped by the contacts, over its second half at
+//!    ρ and the true Δt; meanwhile the top wall backs off (servo upwards at up to `compaction_speed`) while
+//!    its force exceeds the one it would carry at the current weights, F σ/s (F at the end of the hold). Why s changes nothing but the time step: dividing the equations of motion by s,
+//!    s m ẍ = s m g + F_c(k, x) is m ẍ = m g + F_c(k/s, x) (the restitution damping is set from e and
+//!    scales as √(m k) with the pair, the viscous damping is mass-proportional, the compaction cap is scaled
+//!    by s), so the scaled packing is the one of a bed of true mass with the stiffness k/s: Δt ∝ √(m/k) grows
+//!    by √s, the overlaps under the weights and the wall by s, the impact overlaps by √s; the fall and the
+//!    settling keep their physical time. Restoring the mass puts the overlaps back towards 1/s of their
+//!    scaled values, which is what the restore stage lets happen (the bed expands by the excess, a few
+//!    millimetres for 100 mm rocks).
 //!
 //! # Time step
 //! Δt = t_c / N with t_c = π √(m*/k_n) for the lightest rock pair (m* = m_min/2, the shortest contact of the
 //! linear law) and N = `steps_per_contact`; it is checked against the stability limit of
-//! [`crate::scene::time_step::contact_time_and_limit`].
+//! [`crate::scene::time_step::contact_time_and_limit`]. Both are computed from the world's masses, so with
+//! `packing_density_scale` = s the packing's Δt is √s times the unscaled one and the restore stage's Δt is
+//! the unscaled one.
 //!
 //! # Bed file
 //! Two CSV files: `bed_shapes.csv` (`shape,vertex,x,y,z`: every rock's vertices in its principal frame, m)
@@ -300,13 +318,28 @@ pub struct PackingReport {
     /// energy of the rocks relative to the floor.
     pub ledger_balance_relative: [Real; 3],
     pub wall_time: Duration,
-    /// The step's stage timers and counters summed over deposition, compaction and hold.
-    pub counters: [StepCounters; 3],
+    /// The step's stage timers and counters summed over deposition, compaction, hold and restore.
+    pub counters: [StepCounters; 4],
+    /// `packing_density_scale` (1 without it).
+    pub density_scale: Real,
+    /// The restore stage (density scaling only): its Δt (s, the unscaled packing Δt), steps, the top wall's
+    /// rise (m) and its force before and after (N).
+    pub restore_dt: Real,
+    pub restore_steps: u64,
+    pub restore_wall_rise: Real,
+    pub restore_wall_force: [Real; 2],
+    /// Largest and mean overlap of the rock–rock and rock–wall contacts of the bed at the end of the hold
+    /// (scaled masses) and at the end, over the mean rock size.
+    pub bed_overlap_after_hold: [Real; 2],
+    pub bed_overlap_final: [Real; 2],
     /// The pre-collapse, when the configuration asks for one (set by the caller that collapsed the rocks).
     pub collapse: Option<CollapseReport>,
     /// The bed every [`TRACE_EVERY`] steps (written as `packing_trace.csv`).
     pub trace: Vec<PackingSample>,
 }
+
+/// Names of the packing stages, as in the trace and the summary.
+pub const STAGE_NAMES: [&str; 4] = ["deposition", "compaction", "hold", "restore"];
 
 /// Steps between two rows of [`PackingReport::trace`] (and between two settle checks).
 pub const TRACE_EVERY: u64 = 100;
@@ -314,7 +347,7 @@ pub const TRACE_EVERY: u64 = 100;
 /// One row of the packing trace.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct PackingSample {
-    /// 0 deposition, 1 compaction, 2 hold.
+    /// 0 deposition, 1 compaction, 2 hold, 3 restore.
     pub stage: usize,
     pub step: u64,
     /// Simulated time (s).
@@ -339,7 +372,7 @@ impl PackingSample {
     pub fn csv_row(&self) -> String {
         format!(
             "{},{},{},{},{},{},{},{},{}",
-            ["deposition", "compaction", "hold"][self.stage.min(2)],
+            STAGE_NAMES[self.stage.min(3)],
             self.step,
             self.time,
             self.max_speed,
@@ -381,6 +414,50 @@ pub fn loose_world(
     Ok(world)
 }
 
+/// Sets every dynamic polyhedral body's mass and principal inertia to those of its shape at `density`
+/// (recomputed from the shape, so the values are the bits [`body_for`] gives), keeping its velocity and its
+/// angular velocity (the angular momentum is scaled with the inertia). Returns the change of the
+/// mechanical energy (J: kinetic and gravitational change, the elastic energy does not depend on the mass).
+pub fn set_rock_density(world: &mut World, density: Real) -> Result<Real, PackingError> {
+    let before = world.energy().mechanical();
+    for i in 0..world.bodies.len() {
+        if !world.bodies[i].is_dynamic() {
+            continue;
+        }
+        let Shape::Polyhedron(shape) = world.shape(i) else {
+            continue;
+        };
+        let mp = shape.mass_properties();
+        let (mass, inertia) = (
+            mp.mass(density),
+            PrincipalInertia::new(mp.principal_inertia(density))?,
+        );
+        let b = &mut world.bodies[i];
+        let ratio = mass / b.mass;
+        b.mass = mass;
+        b.inertia = inertia;
+        b.angular_momentum *= ratio;
+    }
+    Ok(world.energy().mechanical() - before)
+}
+
+/// Largest and mean overlap (depth) of the active contacts in the store, over `size`.
+pub fn bed_overlap(world: &World, size: Real) -> [Real; 2] {
+    let depths: Vec<Real> = world
+        .contacts
+        .states()
+        .iter()
+        .filter(|c| c.is_active())
+        .map(|c| c.geometry.depth)
+        .collect();
+    if depths.is_empty() {
+        return [0.0, 0.0];
+    }
+    let max = depths.iter().copied().fold(0.0, Real::max);
+    let mean = depths.iter().sum::<Real>() / depths.len() as Real;
+    [max / size, mean / size]
+}
+
 /// Deposition, compaction and hold (see the module docs). `progress` is called every few hundred steps
 /// with (stage, simulated time, bed top).
 pub fn pack(
@@ -389,8 +466,13 @@ pub fn pack(
     mut progress: impl FnMut(&str, Real, Real),
 ) -> Result<PackingReport, PackingError> {
     let start = Instant::now();
-    let (dt, contact_time) = packing_time_step(config, world)?;
     let p = &config.packing;
+    let scale = p.packing_density_scale.unwrap_or(1.0);
+    if p.packing_density_scale.is_some() {
+        // Before the first step: the ledger has no initial energy yet, nothing to book.
+        set_rock_density(world, config.rock.density * scale)?;
+    }
+    let (dt, contact_time) = packing_time_step(config, world)?;
     let mut params = StepParams::new(dt);
     let local_alpha = match p.deposition_damping {
         Some(DepositionDamping::Local) => p.local_damping,
@@ -411,6 +493,7 @@ pub fn pack(
         rocks: world.bodies.len(),
         dt,
         contact_time,
+        density_scale: scale,
         ..Default::default()
     };
     let initial_top = top_wall_height(world);
@@ -419,26 +502,33 @@ pub fn pack(
         .iter()
         .map(|b| b.mass * 9.81 * b.position.z)
         .sum();
-    // Energy scale of the settle criterion: Σ m g d̄.
-    let lift_energy: Real = world
-        .bodies
-        .iter()
-        .filter(|b| b.is_dynamic())
-        .map(|b| b.mass * 9.81 * config.rock.mean_size)
-        .sum();
+    // Energy scale of the settle criterion: Σ m g d̄ (at the masses of the moment: scaled or true).
+    let lift_energy = |world: &World| -> Real {
+        world
+            .bodies
+            .iter()
+            .filter(|b| b.is_dynamic())
+            .map(|b| b.mass * 9.81 * config.rock.mean_size)
+            .sum()
+    };
     const DEPOSITION: usize = 0;
     const COMPACTION: usize = 1;
     const HOLD: usize = 2;
-    let mut run =
-        |world: &mut World, report: &mut PackingReport, stage: usize| -> Result<(), PackingError> {
-            let r = step(&params, world, &mut scratch)?;
-            if let Some(alpha) = local_alpha {
-                world.ledger.dissipated_viscous += apply_local_damping(world, alpha, dt);
-            }
-            report.max_overlap_ratio = report.max_overlap_ratio.max(r.max_overlap_ratio);
-            report.counters[stage].merge(&r.counters);
-            Ok(())
-        };
+    const RESTORE: usize = 3;
+    let mut run = |world: &mut World,
+                   report: &mut PackingReport,
+                   stage: usize,
+                   dt: Real|
+     -> Result<(), PackingError> {
+        params.dt = dt;
+        let r = step(&params, world, &mut scratch)?;
+        if let Some(alpha) = local_alpha {
+            world.ledger.dissipated_viscous += apply_local_damping(world, alpha, dt);
+        }
+        report.max_overlap_ratio = report.max_overlap_ratio.max(r.max_overlap_ratio);
+        report.counters[stage].merge(&r.counters);
+        Ok(())
+    };
     let sample = |world: &World, stage: usize, step: u64| -> PackingSample {
         let e = world.energy();
         let kinetic = e.translational_kinetic + e.rotational_kinetic;
@@ -448,7 +538,7 @@ pub fn pack(
             time: world.time,
             max_speed: max_speed(world),
             kinetic_energy: kinetic,
-            kinetic_fraction: kinetic / lift_energy,
+            kinetic_fraction: kinetic / lift_energy(world),
             bed_top: bed_top(world),
             top_wall: top_wall_height(world),
             wall_force: world.loads.wall_forces.get(TOP_WALL).map_or(0.0, |f| f.z),
@@ -468,7 +558,7 @@ pub fn pack(
     };
     let check_every = TRACE_EVERY;
     loop {
-        run(world, &mut report, DEPOSITION)?;
+        run(world, &mut report, DEPOSITION, dt)?;
         report.deposition_steps += 1;
         let t = world.time;
         if report.deposition_steps.is_multiple_of(check_every) {
@@ -494,14 +584,15 @@ pub fn pack(
         let lift = report.deposited_top - initial_top;
         world.walls[TOP_WALL].pose.translation.vector.z += lift;
         world.loads.current = false;
-        let force_cap = p.compaction_pressure * config.layer.length * config.layer.width;
+        // The cap scales with the weights (density scaling, see the module docs).
+        let force_cap = scale * p.compaction_pressure * config.layer.length * config.layer.width;
         let mut stalled_since: Option<Real> = None;
         while top_wall_height(world) > target {
             // Servo: full speed on a loose bed, slowing to a stop as the wall force nears the cap.
             let force = world.loads.wall_forces.get(TOP_WALL).map_or(0.0, |f| f.z);
             let fraction = (1.0 - force / force_cap).clamp(0.0, 1.0);
             world.walls[TOP_WALL].velocity = Vector::new(0.0, 0.0, -p.compaction_speed * fraction);
-            run(world, &mut report, COMPACTION)?;
+            run(world, &mut report, COMPACTION, dt)?;
             report.compaction_steps += 1;
             if report.compaction_steps.is_multiple_of(check_every) {
                 report
@@ -526,13 +617,70 @@ pub fn pack(
     // 3. Hold.
     let hold_end = world.time + p.hold_time;
     while world.time < hold_end {
-        run(world, &mut report, HOLD)?;
+        run(world, &mut report, HOLD, dt)?;
         report.hold_steps += 1;
         if report.hold_steps.is_multiple_of(check_every) {
             report.trace.push(sample(world, HOLD, report.hold_steps));
             progress("hold", world.time, bed_top(world));
         }
     }
+    report.bed_overlap_after_hold = bed_overlap(world, config.rock.mean_size);
+    // 4. Restore the true density (density scaling only): a geometric ramp of the density from s ρ to ρ over
+    // the first half of `restore_time`, then the true density for the second half (see the module docs).
+    if p.packing_density_scale.is_some() {
+        let wall_force = |world: &World| world.loads.wall_forces.get(TOP_WALL).map_or(0.0, |f| f.z);
+        let force0 = wall_force(world);
+        let restore_time = p.restore_time.unwrap_or(0.0);
+        let (t0, top0) = (world.time, top_wall_height(world));
+        let mut sigma = scale;
+        loop {
+            let tau = ((world.time - t0) / (0.5 * restore_time)).min(1.0);
+            let next = if tau >= 1.0 {
+                1.0
+            } else {
+                scale.powf(1.0 - tau)
+            };
+            if next != sigma {
+                // Exactly ρ at the end (the bits of an unscaled bed), s^(1−τ) ρ on the way.
+                let density = if next == 1.0 {
+                    config.rock.density
+                } else {
+                    config.rock.density * next
+                };
+                let changed = set_rock_density(world, density)?;
+                if world.ledger.initial_total.is_some() {
+                    world.ledger.external_work += changed;
+                }
+                sigma = next;
+            }
+            if world.time >= t0 + restore_time {
+                break;
+            }
+            let (dt_now, _) = packing_time_step(config, world)?;
+            // Servo: back off at up to the compaction speed while the wall pushes harder than F σ/s.
+            let target = force0 * sigma / scale;
+            let force = wall_force(world);
+            let excess = if target > 0.0 {
+                (force / target - 1.0).clamp(0.0, 1.0)
+            } else {
+                0.0
+            };
+            world.walls[TOP_WALL].velocity = Vector::new(0.0, 0.0, p.compaction_speed * excess);
+            run(world, &mut report, RESTORE, dt_now)?;
+            report.restore_steps += 1;
+            if report.restore_steps.is_multiple_of(check_every) {
+                report
+                    .trace
+                    .push(sample(world, RESTORE, report.restore_steps));
+                progress("restore", world.time, top_wall_height(world));
+            }
+        }
+        world.walls[TOP_WALL].velocity = Vector::zeros();
+        report.restore_dt = packing_time_step(config, world)?.0;
+        report.restore_wall_rise = top_wall_height(world) - top0;
+        report.restore_wall_force = [force0, wall_force(world)];
+    }
+    report.bed_overlap_final = bed_overlap(world, config.rock.mean_size);
     report.final_top = bed_top(world);
     report.top_wall = top_wall_height(world);
     let volume: Real = (0..world.bodies.len())
