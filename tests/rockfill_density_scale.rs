@@ -161,3 +161,24 @@ fn packing_with_density_scale_ends_at_the_true_masses_with_the_ledger_closed_and
         .fold(Real::INFINITY, Real::min);
     assert!(lowest > 0.0, "a rock centre below the floor: {lowest} m");
 }
+
+#[test]
+fn the_density_scaled_file_is_paper_toml_but_for_its_density_scaling_lines() {
+    let path = "scenes/rockfill/paper_density_scaled.toml";
+    let scaled = ExperimentConfig::parse(
+        include_str!("../scenes/rockfill/paper_density_scaled.toml"),
+        path,
+    )
+    .unwrap();
+    assert_eq!(scaled.packing.packing_density_scale, Some(16.0), "{path}");
+    assert_eq!(scaled.packing.restore_time, Some(0.1), "{path}");
+    let mut expected = ExperimentConfig::paper();
+    expected.rock.mean_size = 0.10;
+    expected.packing.max_deposition_time = 2.0;
+    expected.packing.packing_density_scale = Some(16.0);
+    expected.packing.restore_time = Some(0.1);
+    assert_eq!(
+        scaled, expected,
+        "{path} differs from paper.toml elsewhere than in mean_size, max_deposition_time and the density scaling"
+    );
+}
