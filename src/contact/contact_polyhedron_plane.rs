@@ -397,6 +397,52 @@ mod tests {
         }
     }
 
+    /// The smoothing from the heights computed once ([`smoothed_point_of_heights`], the path of polytopes of
+    /// up to `STACK_BAND` vertices) gives the bits of the reference that recomputes them where it needs them
+    /// ([`smoothed_point`]): a box landing flat, on an edge and tilted (bands of 1, 2 and 4 vertices and
+    /// everything between), at sizes 1e-3, 1 and 1e3 m.
+    #[test]
+    fn smoothing_from_the_heights_is_bit_identical_to_the_reference() {
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(23);
+        let mut band_sizes = [0usize; 9];
+        for scale in [1e-3, 1.0, 1e3] {
+            let bx = TestPolytope::cuboid(Vector::new(1.0, 0.5, 0.25) * scale);
+            let h = 1e-4 * bx.length_scale();
+            for k in 0..300 {
+                // Tilts from exactly flat to a few bands: ties of 4, 2 and single leading vertices.
+                let tilt = [0.0, 1e-6, 1e-4, 1e-2][k % 4];
+                let axis = Vector::new(
+                    rng.random_range(-1.0..1.0),
+                    rng.random_range(-1.0..1.0),
+                    if k % 8 < 4 {
+                        0.0
+                    } else {
+                        rng.random_range(-1.0..1.0)
+                    },
+                );
+                let rot = crate::math::Rotation::from_scaled_axis(axis * tilt);
+                let n2 = rot.inverse_transform_vector(&Vector::z());
+                let heights: Vec<Real> = bx.verts.iter().map(|v| n2.dot(&v.coords)).collect();
+                let lowest = heights.iter().copied().fold(Real::INFINITY, Real::min);
+                let o2 = lowest + rng.random_range(0.0..4.0) * h;
+                let count = heights.iter().filter(|&&x| x < lowest + 2.0 * h).count();
+                band_sizes[count] += 1;
+                let (p_ref, d_ref) = smoothed_point(&bx.verts, &n2, o2, lowest, h);
+                let (p, d) = smoothed_point_of_heights(&bx.verts, &heights, &n2, o2, lowest, h);
+                assert!(
+                    d.to_bits() == d_ref.to_bits()
+                        && (0..3).all(|i| p[i].to_bits() == p_ref[i].to_bits()),
+                    "scale {scale}, pose {k} (tilt {tilt}, band of {count}): heights path D = {d:e}, \
+                     c2 = {p:?}; reference D = {d_ref:e}, c2 = {p_ref:?} (tolerance: equal bits)"
+                );
+            }
+        }
+        assert!(
+            band_sizes[1] > 0 && band_sizes[2] > 0 && band_sizes[4] > 0,
+            "band sizes seen {band_sizes:?}: want bands of 1, 2 and 4 vertices"
+        );
+    }
+
     /// Smoothed wall depth: the force point is the gradient point of the law's depth D. With the body
     /// nearly flat (several vertices within the band), central differences of D give dD/dθ about each axis
     /// = −((c2 − x_B) × n)·e, dD/dx along −n = 1 and 0 along the wall: a force −U'(D) n at c_M is the
