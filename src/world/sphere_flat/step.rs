@@ -9,7 +9,11 @@
 //!  9.   wall forces and the walls' power (serial, pair order), ledger, time
 //! ```
 //! Every per-sphere and per-pair pass writes only its own items' slots, so it runs on rayon's current
-//! pool in chunks with the same bits for any number of threads.
+//! pool in chunks with the same bits for any number of threads. When the pair loop runs serially (one
+//! thread, or a small list), it adds each overlapping pair's loads to its two spheres as it goes
+//! instead of the gather of stage 6: in pair order, body i receives its pairs (a, i) by increasing a
+//! (rows of a < i come first), then its own row (i, b) by increasing b, then its walls — the gather's
+//! order, so the same sums, bit for bit.
 
 use std::time::Instant;
 
@@ -28,6 +32,8 @@ use super::{SphereSim, Spin, MIN_PARALLEL_PAIRS};
 /// What the pair loop found, summed over its chunks in pair order.
 #[derive(Default)]
 pub(super) struct Found {
+    /// Whether the loads of every sphere were summed by the pair loop itself (serial pass).
+    pub(super) scattered: bool,
     contacts: usize,
     max_overlap_ratio: Real,
     warnings: Vec<OverlapWarning>,
@@ -36,6 +42,7 @@ pub(super) struct Found {
 
 impl Found {
     fn merge(mut self, other: Found) -> Found {
+        self.scattered |= other.scattered;
         self.contacts += other.contacts;
         self.max_overlap_ratio = self.max_overlap_ratio.max(other.max_overlap_ratio);
         self.warnings.extend(other.warnings);
@@ -94,6 +101,7 @@ impl SphereSim {
         let h = 0.5 * dt;
         let (props, force, torque) = (&self.props, &self.force, &self.torque);
         let (gravity, damping, form) = (self.gravity, self.params.damping, self.form);
+        let track_orientation = self.track_orientation;
         let at_build = &self.list.centres_at_build;
         let large_flags = &self.list.large_flags;
         let (top, large) = {
@@ -107,7 +115,7 @@ impl SphereSim {
                     kin.velocity += h * (force[i] / p.mass + gravity - (c / p.mass) * kin.velocity);
                     spin.angular_momentum += h * torque[i];
                     kin.position += dt * kin.velocity;
-                    if spin.angular_momentum != Vector::zeros() {
+                    if track_orientation && spin.angular_momentum != Vector::zeros() {
                         drift_isotropic(
                             form,
                             &mut spin.orientation,
@@ -160,6 +168,7 @@ impl SphereSim {
                 self.step_index,
                 &|_, _| None,
             );
+            self.prepare_pairs(parallel);
             report.counters.broad_rebuilds += 1;
         }
         report.counters.body_pairs_tested += self.list.body_pairs() as u64;
@@ -169,6 +178,7 @@ impl SphereSim {
         // 4–5. Pair loop.
         let t = Instant::now();
         let found = self.evaluate(dt)?;
+        let scattered = found.scattered;
         report.contacts = found.contacts;
         report.max_overlap_ratio = found.max_overlap_ratio;
         report.overlap_warnings = found.warnings;
@@ -190,9 +200,14 @@ impl SphereSim {
              -> Option<(usize, &'static str)> {
                 for k in 0..force.len() {
                     let i = start + k;
-                    let (f, t) = sum_body(list, out, wall_out, i);
-                    force[k] = f;
-                    torque[k] = t;
+                    let (f, t) = if scattered {
+                        (force[k], torque[k])
+                    } else {
+                        let (f, t) = sum_body(list, out, wall_out, i);
+                        force[k] = f;
+                        torque[k] = t;
+                        (f, t)
+                    };
                     let p = &props[i];
                     let c = damping.coefficient(p.mass);
                     let (kin, spin) = (&mut kin[k], &mut spin[k]);
@@ -264,17 +279,15 @@ impl SphereSim {
             kin: &self.kin,
             props: &self.props,
             walls: &self.planes,
-            models: &self.models,
-            n_materials: self.n_materials,
-            tolerances: &self.params.tolerances,
             dt,
             step_index: self.step_index,
         };
+        let (reach, constants, wall_constants) =
+            (&self.reach, &self.pair_constants, &self.wall_constants);
         let fraction = self.params.overlap_warning_fraction;
         let list = &mut self.list;
         let (a, b) = (&list.a, &list.b);
         let (wall_body, wall_of) = (&list.wall_body, &list.wall_of);
-        let (root_radius, effective_mass) = (&list.root_radius, &list.effective_mass);
         let note = |found: &mut Found, o: &PairOut, key: ContactKey| {
             if o.overlapping {
                 found.contacts += 1;
@@ -296,8 +309,8 @@ impl SphereSim {
                     if let Err(e) = ctx.body_pair(
                         a[p] as usize,
                         b[p] as usize,
-                        root_radius[p],
-                        effective_mass[p],
+                        reach[p],
+                        &constants[p],
                         history,
                         out,
                     ) {
@@ -314,7 +327,9 @@ impl SphereSim {
                 for (k, (history, out)) in histories.iter_mut().zip(outs.iter_mut()).enumerate() {
                     let q = start + k;
                     let (body, wall) = (wall_body[q], wall_of[q]);
-                    if let Err(e) = ctx.wall_pair(wall as usize, body as usize, history, out) {
+                    if let Err(e) =
+                        ctx.wall_pair(wall as usize, body as usize, &wall_constants[q], history, out)
+                    {
                         found.error = Some(e);
                         break;
                     }
@@ -322,6 +337,55 @@ impl SphereSim {
                 }
                 found
             };
+        if !parallel {
+            // One pass in pair order that also sums the loads (see the module docs).
+            let (force, torque) = (&mut self.force, &mut self.torque);
+            force.fill(Vector::zeros());
+            torque.fill(Vector::zeros());
+            let mut found = Found {
+                scattered: true,
+                ..Found::default()
+            };
+            for (p, (history, out)) in list.histories.iter_mut().zip(&mut self.out).enumerate() {
+                let (i, j) = (a[p] as usize, b[p] as usize);
+                if let Err(e) = ctx.body_pair(i, j, reach[p], &constants[p], history, out) {
+                    found.error = Some(e);
+                    break;
+                }
+                if out.overlapping {
+                    force[i] -= out.force_on_b;
+                    torque[i] += out.torque_on_a;
+                    force[j] += out.force_on_b;
+                    torque[j] += out.torque_on_b;
+                    note(&mut found, out, ContactKey::Body { a: a[p], b: b[p] });
+                }
+            }
+            if found.error.is_none() {
+                for (q, (history, out)) in list
+                    .wall_histories
+                    .iter_mut()
+                    .zip(&mut self.wall_out)
+                    .enumerate()
+                {
+                    let (body, wall) = (wall_body[q], wall_of[q]);
+                    let (i, w) = (body as usize, wall as usize);
+                    if let Err(e) = ctx.wall_pair(w, i, &wall_constants[q], history, out) {
+                        found.error = Some(e);
+                        break;
+                    }
+                    if out.overlapping {
+                        force[i] += out.force_on_b;
+                        torque[i] += out.torque_on_b;
+                        note(&mut found, out, ContactKey::Wall { body, wall });
+                    }
+                }
+            }
+            self.outs_valid = true;
+            return match found.error {
+                Some(e) => Err(e),
+                None => Ok(found),
+            };
+        }
         let found = chunked2(
             parallel,
             &mut list.histories,
@@ -345,13 +409,16 @@ impl SphereSim {
         }
     }
 
-    /// Stage 6 alone (the evaluation of an initial state): every sphere's sums, the walls'.
-    pub(super) fn gather_only(&mut self) {
-        let (list, out, wall_out) = (&self.list, &self.out, &self.wall_out);
-        for i in 0..self.kin.len() {
-            let (f, t) = sum_body(list, out, wall_out, i);
-            self.force[i] = f;
-            self.torque[i] = t;
+    /// Stage 6 alone (the evaluation of an initial state): every sphere's sums (unless the pair loop
+    /// `scattered` them), the walls'.
+    pub(super) fn gather_only(&mut self, scattered: bool) {
+        if !scattered {
+            let (list, out, wall_out) = (&self.list, &self.out, &self.wall_out);
+            for i in 0..self.kin.len() {
+                let (f, t) = sum_body(list, out, wall_out, i);
+                self.force[i] = f;
+                self.torque[i] = t;
+            }
         }
         self.sum_walls();
     }
