@@ -120,6 +120,8 @@ pub struct SphereSim {
     wall_constants: Vec<WallConstants>,
     /// Whether the drift turns the orientations (see [`SphereSim::set_track_orientation`]).
     track_orientation: bool,
+    /// The pair loop's blocks (made for the current lists and pool).
+    blocks: step::Blocks,
     /// The last evaluation of every listed pair (aligned with the lists); valid when `outs_valid`.
     out: Vec<PairOut>,
     wall_out: Vec<PairOut>,
@@ -245,6 +247,7 @@ impl SphereSim {
             pair_constants: Vec::new(),
             wall_constants: Vec::new(),
             track_orientation: true,
+            blocks: step::Blocks::default(),
             out: Vec::new(),
             wall_out: Vec::new(),
             outs_valid: false,
