@@ -363,6 +363,56 @@ impl SphereSim {
                 }
             }
         };
+        if blocks.bodies.len() == 1 {
+            // One block of every sphere: the same pass without the test of which spheres it sums.
+            let (force, torque) = (&mut self.force, &mut self.torque);
+            force.fill(Vector::zeros());
+            torque.fill(Vector::zeros());
+            let mut found = Found {
+                scattered: true,
+                ..Found::default()
+            };
+            for (p, (history, out)) in list.histories.iter_mut().zip(&mut self.out).enumerate() {
+                let (i, j) = (a[p] as usize, b[p] as usize);
+                if let Err(e) = ctx.body_pair(i, j, reach[p], &constants[p], history, out) {
+                    found.error = Some(e);
+                    break;
+                }
+                if out.overlapping {
+                    force[i] -= out.force_on_b;
+                    torque[i] += out.torque_on_a;
+                    force[j] += out.force_on_b;
+                    torque[j] += out.torque_on_b;
+                    note(&mut found, out, ContactKey::Body { a: a[p], b: b[p] }, false);
+                }
+            }
+            if found.error.is_none() {
+                for (q, (history, out)) in list
+                    .wall_histories
+                    .iter_mut()
+                    .zip(&mut self.wall_out)
+                    .enumerate()
+                {
+                    let (body, wall) = (wall_body[q], wall_of[q]);
+                    let i = body as usize;
+                    if let Err(e) = ctx.wall_pair(wall as usize, i, &wall_constants[q], history, out)
+                    {
+                        found.error = Some(e);
+                        break;
+                    }
+                    if out.overlapping {
+                        force[i] += out.force_on_b;
+                        torque[i] += out.torque_on_b;
+                        note(&mut found, out, ContactKey::Wall { body, wall }, true);
+                    }
+                }
+            }
+            self.outs_valid = true;
+            return match found.error {
+                Some(e) => Err(e),
+                None => Ok(found),
+            };
+        }
         // One block: bodies `first..first + force.len()`, their rows of pairs and their walls, in pair
         // order; the loads of every body of the block that no other block's pair reaches are summed here.
         let block = |first: usize, part: BlockPart<'_>| -> Found {
