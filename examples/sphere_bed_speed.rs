@@ -161,10 +161,7 @@ fn main() -> anyhow::Result<()> {
 }
 
 /// The run of `sim` on the flat sphere path, written back into its world at the end.
-fn run_flat(
-    sim: &mut polydem::scene::Simulation,
-    orientation: bool,
-) -> anyhow::Result<RunSummary> {
+fn run_flat(sim: &mut polydem::scene::Simulation, orientation: bool) -> anyhow::Result<RunSummary> {
     let start = Instant::now();
     let mut flat = SphereSim::from_world(&sim.world, &sim.params)?;
     flat.set_track_orientation(orientation);

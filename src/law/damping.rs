@@ -104,9 +104,13 @@ impl DampingLaw {
 pub enum PreparedDamping {
     None,
     /// f_d = factor · δ^((n−1)/2) · δ̇, factor = ζ̂ √(m* k_n) (N s/m^((n+1)/2)).
-    Viscous { factor: Real },
+    Viscous {
+        factor: Real,
+    },
     /// f_d = c_n δ̇.
-    Dashpot { coefficient: Real },
+    Dashpot {
+        coefficient: Real,
+    },
 }
 
 impl PreparedDamping {

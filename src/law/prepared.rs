@@ -29,9 +29,7 @@ impl ContactModel {
     pub fn prepared(&self, effective_mass: Real) -> PreparedModel {
         PreparedModel {
             normal: self.normal,
-            damping: self
-                .damping
-                .prepared(self.normal.stiffness, effective_mass),
+            damping: self.damping.prepared(self.normal.stiffness, effective_mass),
             tangential: self.tangential,
             effective_mass,
         }

@@ -38,13 +38,15 @@
 //! asleep; the per-contact energy ledger off (`energy_ledger = false`: the path books no contact
 //! damping or friction work, as the general step does not then either).
 //!
-//! # Cost (callgrind, sphere bed a, 5000 steps, one thread, 2026-11-22)
-//! 1517 instructions per particle-step against 2169 for the general step with the ledger off (4.55e6
-//! against 6.51e6 per step of 3001 spheres, 3132 contacts and ~10 750 listed pairs per step): the pair
-//! loop takes 62 % (the law of an overlapping pair, ~550 instructions, dominates: the spring's rotation
-//! into the new tangent plane, a dozen square roots and divisions), integration and per-sphere sums 31 %
-//! (the orientation's turn ~90 per sphere), list rebuilds 6 %. Keeping the same bits as the general step
-//! fixes those operations; the target (≤ ~900) is not reached.
+//! # Cost (callgrind instructions, one thread, 2026-11-22)
+//! The first 1000 steps of sphere beds a / b / c (`examples/sphere_bed_speed.rs`, run under
+//! `valgrind --tool=callgrind --toggle-collect='*run_flat*'`), per particle-step: 1757 / 2219 / 1444,
+//! from 2256 / 2745 / 1865 before the pair constants, the inlined geometry, the loads summed by the pair
+//! loop, the untracked orientations and the cheaper list search (−22 / −19 / −23 %; the same final
+//! bits); over 5000 steps of bed a, 1118 from 1510 (−26 %). What remains: the law of an overlapping pair (about 2.2 per sphere in those steps; the exact
+//! rotation of the spring into the new tangent plane is ~100 instructions of it), list rebuilds (bed b:
+//! ~100 in 1000 steps, ~20 % of its instructions), integration. The target (≤ ~900) is not
+//! reached.
 //!
 //! # Validity of the owned state
 //! From [`SphereSim::from_world`] on, the simulation owns the state: the world it came from is stale

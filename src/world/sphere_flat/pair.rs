@@ -4,16 +4,19 @@
 //! A candidate first takes the cheap test that needs no square root: two spheres whose centres are at
 //! least r_A + r_B apart, or a sphere whose centre is at least r above a wall, cannot overlap by more than
 //! the touching band, so the pair is separated (its spring is released, as the law does for a pair that
-//! does not overlap). Any other candidate goes through the same closed forms as the general narrow phase
-//! ([`contact_sphere_sphere`], [`contact_plane_sphere`]), the model scaled by √R* of the two radii
-//! ([`ContactModel::for_contact_radii`]) and the law inlined ([`ContactModel::evaluate_inlined`]), with the
-//! same arguments and operations as the sphere kernel of the general step (`super::super::sphere_kernel`),
-//! so an overlapping pair gives the same bits on both paths. Nothing is written for a separated pair
-//! but its flag and its cleared spring: no geometry is kept.
+//! does not overlap). Any other candidate takes the operations of the general narrow phase's closed forms
+//! ([`contact_sphere_sphere`], [`contact_plane_sphere`]; the distance is the square root of the squared
+//! distance of the cheap test, as `norm` forms it) and the law of the pair's model scaled by its √R*
+//! ([`ContactModel::for_contact_radii`]) with the constants of the pair formed once per list build
+//! ([`PairConstants`], [`WallConstants`]: radii, touching band, [`ContactModel::prepared`] with the
+//! pair's m*), then [`PreparedModel::respond`] — what [`ContactModel::evaluate`] does in one call — so an
+//! overlapping pair gives the same bits as the sphere kernel of the general step
+//! (`super::super::sphere_kernel`). Nothing is written for a separated pair but its flag and its cleared
+//! spring: no geometry is kept.
 
+use crate::contact::ContactTolerances;
 #[cfg(doc)]
 use crate::contact::{contact_plane_sphere, contact_sphere_sphere};
-use crate::contact::ContactTolerances;
 use crate::law::{ContactModel, PreparedModel, RadiusScaling, TangentialHistory};
 use crate::math::{Point, Real, Vector};
 

@@ -383,7 +383,12 @@ impl SphereSim {
                     torque[i] += out.torque_on_a;
                     force[j] += out.force_on_b;
                     torque[j] += out.torque_on_b;
-                    note(&mut found, out, ContactKey::Body { a: a[p], b: b[p] }, false);
+                    note(
+                        &mut found,
+                        out,
+                        ContactKey::Body { a: a[p], b: b[p] },
+                        false,
+                    );
                 }
             }
             if found.error.is_none() {
@@ -395,7 +400,8 @@ impl SphereSim {
                 {
                     let (body, wall) = (wall_body[q], wall_of[q]);
                     let i = body as usize;
-                    if let Err(e) = ctx.wall_pair(wall as usize, i, &wall_constants[q], history, out)
+                    if let Err(e) =
+                        ctx.wall_pair(wall as usize, i, &wall_constants[q], history, out)
                     {
                         found.error = Some(e);
                         break;
@@ -449,7 +455,12 @@ impl SphereSim {
                         force[j - first] += out.force_on_b;
                         torque[j - first] += out.torque_on_b;
                     }
-                    note(&mut found, out, ContactKey::Body { a: a[p], b: b[p] }, false);
+                    note(
+                        &mut found,
+                        out,
+                        ContactKey::Body { a: a[p], b: b[p] },
+                        false,
+                    );
                 }
             }
             for (k, (history, out)) in wall_histories
