@@ -183,8 +183,8 @@ fn flat_path_is_the_same_on_one_two_and_four_threads() {
         pool.install(|| flat(&sim, STEPS).1)
     };
     let one = run(1);
-    // 2 and 4 threads: 4 and 8 blocks of the pair loop, with 15 % and 35 % of the spheres' loads
-    // gathered instead of summed by the pair loop (one block on one thread).
+    // 2 and 4 threads: 4 and 8 blocks of the pair loop, with roughly 15 % and 35 % of the spheres'
+    // loads gathered instead of summed by the pair loop (one block on one thread).
     for threads in [2, 4] {
         let other = run(threads);
         if let Some(d) = first_difference(&one, &other) {

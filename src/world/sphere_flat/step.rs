@@ -63,8 +63,10 @@ impl Found {
 }
 
 /// Blocks per thread of the parallel pair loop: few, because a sphere reached by a pair of another
-/// block has its loads gathered in stage 6 instead of summed by the pair loop (on sphere bed a, whose
-/// spheres are numbered by height, 5 % of the spheres with 2 blocks, 15 % with 4, 74 % with 16).
+/// block has its loads gathered in stage 6 instead of summed by the pair loop (on the settled bed of
+/// the sphere-bed scenes, whose spheres are numbered by height, about 5 % of the spheres with 2 blocks
+/// of equal numbers of spheres, 15 % with 4, 35 % with 8 and 74 % with 16: counted once on its initial
+/// list, not measured in a run).
 pub(super) const BLOCKS_PER_THREAD: usize = 2;
 
 /// The split of the pair loop into blocks of consecutive spheres, each with the pairs of its spheres'
