@@ -10,13 +10,15 @@
 //!
 //! ```text
 //! cargo run --release --example sphere_bed_speed -- [--steps N] [--path flat|general] [--threads N]
-//!     [--ledger on|off|scene] [--skin M] [SCENE.toml ...]
+//!     [--ledger on|off|scene] [--skin M] [--orientation on|off] [SCENE.toml ...]
 //! ```
 //! Default: 5000 steps (0.01 s of the bed) of the three variants a, b, c, on the flat sphere path
 //! (`polydem::world::SphereSim`, which runs without the per-contact ledger: `--ledger` is then `off`)
 //! on one thread. `--path general` runs the general step (`World::step`; the same bits). `--ledger`
 //! overrides the scene's `energy_ledger` key (`scene`: keep it); `--skin` the Verlet skin of the broad
-//! phase (m; the candidate list changes, the trajectory does not); `--threads` the size of the pool.
+//! phase (m; the candidate list changes, the trajectory does not); `--threads` the size of the pool;
+//! `--orientation` whether the flat path turns the spheres' orientations (default off, as the suite's
+//! `sphere_bed` case runs it: no output reads them, and positions and velocities are the same bits).
 
 use polydem::host::{load_average, thread_cpu_time};
 use std::path::PathBuf;
@@ -32,6 +34,7 @@ struct Options {
     threads: usize,
     ledger: Option<bool>,
     skin: Option<f64>,
+    orientation: bool,
     scenes: Vec<PathBuf>,
 }
 
@@ -42,6 +45,7 @@ fn parse() -> Result<Options, String> {
         threads: 1,
         ledger: None,
         skin: None,
+        orientation: false,
         scenes: Vec::new(),
     };
     let mut args = std::env::args().skip(1);
@@ -62,6 +66,13 @@ fn parse() -> Result<Options, String> {
                     "flat" => true,
                     "general" => false,
                     v => return Err(format!("--path: '{v}' is not flat or general")),
+                }
+            }
+            "--orientation" => {
+                o.orientation = match value()?.as_str() {
+                    "on" => true,
+                    "off" => false,
+                    v => return Err(format!("--orientation: '{v}' is not on or off")),
                 }
             }
             "--threads" => o.threads = value()?.parse().map_err(|e| format!("--threads: {e}"))?,
@@ -103,7 +114,7 @@ fn main() -> anyhow::Result<()> {
             let cpu0 = thread_cpu_time();
             let t = Instant::now();
             let summary = if o.flat {
-                run_flat(&mut sim)
+                run_flat(&mut sim, o.orientation)
             } else {
                 sim.run(|_| Ok(()), |_, _| Ok(()))
                     .map_err(anyhow::Error::from)
@@ -150,9 +161,10 @@ fn main() -> anyhow::Result<()> {
 }
 
 /// The run of `sim` on the flat sphere path, written back into its world at the end.
-fn run_flat(sim: &mut polydem::scene::Simulation) -> anyhow::Result<RunSummary> {
+fn run_flat(sim: &mut polydem::scene::Simulation, orientation: bool) -> anyhow::Result<RunSummary> {
     let start = Instant::now();
     let mut flat = SphereSim::from_world(&sim.world, &sim.params)?;
+    flat.set_track_orientation(orientation);
     let mut summary = RunSummary::default();
     let first = flat.step_index() + 1;
     for _ in first..=sim.steps {

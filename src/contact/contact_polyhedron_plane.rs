@@ -48,17 +48,32 @@ pub fn contact_plane_polytope<B: Polytope + ?Sized>(
     let n2 = pos2.rotation.inverse_transform_vector(&n);
     let o2 = o - n.dot(&pos2.translation.vector);
     let verts = b.vertices();
-    let lowest = verts
-        .iter()
-        .map(|v| n2.dot(&v.coords))
-        .fold(Real::INFINITY, Real::min);
+    // The heights n2·v of the vertices, computed once (up to `STACK_BAND` vertices) and read by the
+    // smoothing below: the same values in the same order as computing them where they are used.
+    let mut heights_buf = [0.0; STACK_BAND];
+    let heights = (verts.len() <= STACK_BAND).then(|| {
+        for (x, v) in heights_buf.iter_mut().zip(verts) {
+            *x = n2.dot(&v.coords);
+        }
+        &heights_buf[..verts.len()]
+    });
+    let lowest = match heights {
+        Some(heights) => heights.iter().copied().fold(Real::INFINITY, Real::min),
+        None => verts
+            .iter()
+            .map(|v| n2.dot(&v.coords))
+            .fold(Real::INFINITY, Real::min),
+    };
     let signed = o2 - lowest;
     let touch = tol.touching * b.length_scale();
     let (kind, depth, distance) = classify(signed, touch);
     let (c2_local, law_depth) = match tol.wall_depth {
         WallDepth::Smoothed { band } if kind == ContactKind::Overlap => {
             let h = band * b.length_scale();
-            let (point, d) = smoothed_point(verts, &n2, o2, lowest, h);
+            let (point, d) = match heights {
+                Some(heights) => smoothed_point_of_heights(verts, heights, &n2, o2, lowest, h),
+                None => smoothed_point(verts, &n2, o2, lowest, h),
+            };
             (point, d.max(0.0))
         }
         _ => {
@@ -92,6 +107,54 @@ pub fn contact_plane_polytope<B: Polytope + ?Sized>(
         point_b,
         SolverStatus::Exact,
     )
+}
+
+/// [`smoothed_point`] from the vertex heights `heights[i]` = n2·v_i (at most `STACK_BAND` vertices),
+/// the same arithmetic on the same values, so the same bits: one pass finds the band; a single vertex in
+/// it (the usual case) is its own smoothed depth with weight 1 (D = 2 S_h − S_2h = 2d − d = d exactly, and
+/// Newton stops at once with ψ(0) = 1), so the two Newton solves are not run for it.
+fn smoothed_point_of_heights(
+    verts: &[Point],
+    heights: &[Real],
+    n2: &Vector,
+    o2: Real,
+    lowest: Real,
+    h: Real,
+) -> (Vector, Real) {
+    let limit = lowest + 2.0 * h;
+    let mut band = [0u8; STACK_BAND];
+    let mut count = 0;
+    for (i, &x) in heights.iter().enumerate() {
+        if x < limit {
+            band[count] = i as u8;
+            count += 1;
+        }
+    }
+    let band = &band[..count];
+    let mut xbar = Vector::zeros();
+    let d = if let [i] = band {
+        let (i, weight) = (*i as usize, 1.0);
+        xbar += verts[i].coords * weight;
+        o2 - heights[i]
+    } else {
+        let mut stack = [[0.0; STACK_BAND]; 3];
+        let [depths, weights, scratch] = &mut stack;
+        let (depths, weights, scratch) = (
+            &mut depths[..count],
+            &mut weights[..count],
+            &mut scratch[..count],
+        );
+        for (d, &i) in depths.iter_mut().zip(band) {
+            *d = o2 - heights[i as usize];
+        }
+        let d = smoothed_depth(depths, h, weights, scratch);
+        for (w, &i) in weights.iter().zip(band) {
+            xbar += verts[i as usize].coords * *w;
+        }
+        d
+    };
+    // Level of the overlap: n2·c2 = o2 − D.
+    (xbar - n2 * (n2.dot(&xbar) - (o2 - d)), d)
 }
 
 /// The smoothed depth D of the vertices within 2h of the deepest one (depths d_i = o2 − n2·v_i, deepest
@@ -332,6 +395,52 @@ mod tests {
                 );
             }
         }
+    }
+
+    /// The smoothing from the heights computed once ([`smoothed_point_of_heights`], the path of polytopes of
+    /// up to `STACK_BAND` vertices) gives the bits of the reference that recomputes them where it needs them
+    /// ([`smoothed_point`]): a box landing flat, on an edge and tilted (bands of 1, 2 and 4 vertices and
+    /// everything between), at sizes 1e-3, 1 and 1e3 m.
+    #[test]
+    fn smoothing_from_the_heights_is_bit_identical_to_the_reference() {
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(23);
+        let mut band_sizes = [0usize; 9];
+        for scale in [1e-3, 1.0, 1e3] {
+            let bx = TestPolytope::cuboid(Vector::new(1.0, 0.5, 0.25) * scale);
+            let h = 1e-4 * bx.length_scale();
+            for k in 0..300 {
+                // Tilts from exactly flat to a few bands: ties of 4, 2 and single leading vertices.
+                let tilt = [0.0, 1e-6, 1e-4, 1e-2][k % 4];
+                let axis = Vector::new(
+                    rng.random_range(-1.0..1.0),
+                    rng.random_range(-1.0..1.0),
+                    if k % 8 < 4 {
+                        0.0
+                    } else {
+                        rng.random_range(-1.0..1.0)
+                    },
+                );
+                let rot = crate::math::Rotation::from_scaled_axis(axis * tilt);
+                let n2 = rot.inverse_transform_vector(&Vector::z());
+                let heights: Vec<Real> = bx.verts.iter().map(|v| n2.dot(&v.coords)).collect();
+                let lowest = heights.iter().copied().fold(Real::INFINITY, Real::min);
+                let o2 = lowest + rng.random_range(0.0..4.0) * h;
+                let count = heights.iter().filter(|&&x| x < lowest + 2.0 * h).count();
+                band_sizes[count] += 1;
+                let (p_ref, d_ref) = smoothed_point(&bx.verts, &n2, o2, lowest, h);
+                let (p, d) = smoothed_point_of_heights(&bx.verts, &heights, &n2, o2, lowest, h);
+                assert!(
+                    d.to_bits() == d_ref.to_bits()
+                        && (0..3).all(|i| p[i].to_bits() == p_ref[i].to_bits()),
+                    "scale {scale}, pose {k} (tilt {tilt}, band of {count}): heights path D = {d:e}, \
+                     c2 = {p:?}; reference D = {d_ref:e}, c2 = {p_ref:?} (tolerance: equal bits)"
+                );
+            }
+        }
+        assert!(
+            band_sizes[1] > 0 && band_sizes[2] > 0 && band_sizes[4] > 0,
+            "band sizes seen {band_sizes:?}: want bands of 1, 2 and 4 vertices"
+        );
     }
 
     /// Smoothed wall depth: the force point is the gradient point of the law's depth D. With the body

@@ -81,9 +81,46 @@ impl DampingLaw {
         overlap: Real,
         overlap_rate: Real,
     ) -> Real {
+        self.prepared(stiffness, mass)
+            .force(exponent, overlap, overlap_rate)
+    }
+
+    /// The law with the constants of one contact (k_n, m*) formed: ζ̂ √(m* k_n) for the viscous law.
+    #[inline]
+    pub fn prepared(&self, stiffness: Real, mass: Real) -> PreparedDamping {
+        match *self {
+            Self::None => PreparedDamping::None,
+            Self::Viscous { coefficient } => PreparedDamping::Viscous {
+                factor: coefficient * (mass * stiffness).sqrt(),
+            },
+            Self::Dashpot { coefficient } => PreparedDamping::Dashpot { coefficient },
+        }
+    }
+}
+
+/// A [`DampingLaw`] with the constants of one contact formed ([`DampingLaw::prepared`]): what the force
+/// needs besides the overlap and its rate.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum PreparedDamping {
+    None,
+    /// f_d = factor · δ^((n−1)/2) · δ̇, factor = ζ̂ √(m* k_n) (N s/m^((n+1)/2)).
+    Viscous {
+        factor: Real,
+    },
+    /// f_d = c_n δ̇.
+    Dashpot {
+        coefficient: Real,
+    },
+}
+
+impl PreparedDamping {
+    /// The damping force (N, along n on B) at overlap δ and overlap rate δ̇ for the exponent n of the
+    /// normal law; zero for δ ≤ 0.
+    #[inline(always)]
+    pub fn force(&self, exponent: Real, overlap: Real, overlap_rate: Real) -> Real {
         match *self {
             Self::None => 0.0,
-            Self::Viscous { coefficient } => {
+            Self::Viscous { factor } => {
                 if overlap <= 0.0 {
                     return 0.0;
                 }
@@ -94,7 +131,7 @@ impl DampingLaw {
                 } else {
                     overlap.powf(0.5 * (exponent - 1.0))
                 };
-                coefficient * (mass * stiffness).sqrt() * shape * overlap_rate
+                factor * shape * overlap_rate
             }
             Self::Dashpot { coefficient } => {
                 if overlap <= 0.0 {

@@ -10,7 +10,8 @@
 //!   caller and rotated into the current tangent plane here.
 //! - [`hertz_mindlin`]: the sphere laws parameterised as YADE and LIGGGHTS do (E, ν, e, μ → k_n, k_t,
 //!   damping), and the linear spring–dashpot.
-//! - [`model`]: the slot composition, evaluated on a [`crate::contact::ContactGeometry`].
+//! - [`model`]: the slot composition, evaluated on a [`crate::contact::ContactGeometry`]; [`prepared`]:
+//!   the same with the constants of one contact formed once.
 //!
 //! Sign conventions: the contact normal n points from body A to body B; forces are reported as the force on
 //! B (the force on A is its opposite); the relative velocity is v_B − v_A at the contact point c_M, so the
@@ -21,11 +22,13 @@ pub mod hertz_mindlin;
 pub mod model;
 pub mod normal;
 pub mod pair;
+pub mod prepared;
 pub mod tangential;
 
 pub use damping::DampingLaw;
 pub use model::{ContactKinematics, ContactModel, ContactResponse};
 pub use normal::{NormalLaw, RadiusScaling};
+pub use prepared::PreparedModel;
 pub use tangential::{TangentialHistory, TangentialLaw};
 
 /// Invalid law parameters.

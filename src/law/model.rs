@@ -7,7 +7,7 @@
 
 use super::damping::DampingLaw;
 use super::normal::NormalLaw;
-use super::tangential::{incremental_spring_damped, TangentialHistory, TangentialLaw};
+use super::tangential::{TangentialHistory, TangentialLaw};
 use crate::contact::{ContactGeometry, ContactKind};
 use crate::math::{Point, Real, Vector};
 
@@ -99,93 +99,16 @@ impl ContactModel {
             *history = TangentialHistory::default();
             return ContactResponse::default();
         }
-        let n = geometry.normal;
-        let overlap = geometry.depth;
-        let v = kinematics.relative_velocity;
-        let overlap_rate = -v.dot(&n);
-        let (k, exponent) = (self.normal.stiffness, self.normal.exponent);
-        let elastic = self.normal.force(overlap);
-        let mut damping = self.damping.force(
-            k,
-            exponent,
-            kinematics.effective_mass,
-            overlap,
-            overlap_rate,
-        );
-        if self.normal.never_attractive && elastic + damping < 0.0 {
-            // The clamp removes the part of the damping force that would pull: what acts is −elastic.
-            damping = -elastic;
-        }
-        let normal_force = elastic + damping;
-
-        let (
-            tangential_force,
-            tangential_potential,
-            friction_dissipation,
-            sliding,
-            tangential_power,
-            dashpot_force,
-            tangential_stiffness_work,
-            previous_displacement,
-        ) = match self.tangential {
-            TangentialLaw::None => (
-                Vector::zeros(),
-                0.0,
-                0.0,
-                false,
-                0.0,
-                Vector::zeros(),
-                0.0,
-                None,
-            ),
-            law => {
-                let (stiffness, friction) = law.stiffness_and_friction(overlap);
-                let dashpot = match law {
-                    TangentialLaw::DampedMindlin { damping, .. } => {
-                        damping * (kinematics.effective_mass * stiffness).sqrt()
-                    }
-                    _ => 0.0,
-                };
-                let v_t = v - n * v.dot(&n);
-                let r = incremental_spring_damped(
-                    stiffness,
-                    friction,
-                    dashpot,
-                    &n,
-                    normal_force,
-                    &v_t,
-                    kinematics.dt,
-                    history,
-                );
-                (
-                    r.force,
-                    r.spring_energy,
-                    r.friction_dissipation,
-                    r.sliding,
-                    r.damping_power,
-                    r.damping_force,
-                    r.stiffness_work,
-                    Some(r.previous_displacement),
-                )
-            }
-        };
-        let force_on_b = n * normal_force + tangential_force;
-        let point = geometry.point;
-        ContactResponse {
-            force_on_b,
-            torque_on_a: (point - kinematics.center_a).cross(&(-force_on_b)),
-            torque_on_b: (point - kinematics.center_b).cross(&force_on_b),
-            normal_force,
-            tangential_force,
-            normal_potential: self.normal.potential(overlap),
-            tangential_potential,
-            damping_power: damping * overlap_rate + tangential_power,
-            damping_force: n * damping + dashpot_force,
-            friction_dissipation,
-            tangential_stiffness_work,
-            sliding,
-            previous_displacement,
-        }
+        self.prepared(kinematics.effective_mass).respond(
+            geometry.depth,
+            &geometry.normal,
+            &geometry.point,
+            &kinematics.relative_velocity,
+            &kinematics.center_a,
+            &kinematics.center_b,
+            kinematics.dt,
+            history,
+        )
     }
 }
 

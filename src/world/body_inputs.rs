@@ -16,7 +16,7 @@
 
 use crate::dynamics::rotation::is_isotropic;
 use crate::dynamics::{Motion, RigidBody};
-use crate::math::{Point, Real};
+use crate::math::{Point, Real, Vector};
 
 use super::broad_phase::BroadPhase;
 use super::contact_store::ContactKey;
@@ -39,6 +39,13 @@ pub(super) struct BodyInputs {
     /// Whether `centres` and `flags` were written for the current positions by this step's drift pass
     /// (consumed by stage 3 of the same step).
     pub(super) fresh: bool,
+    /// The world angular velocity of every body ([`omega_of`]), written by the general step's drift pass
+    /// for stages 4–5 (the velocity of a contact point reads it instead of recomputing R J̄⁻¹ Rᵀ L for
+    /// every contact, up to four times per pair: the same function of the same state, so the same bits).
+    pub(super) omegas: Vec<Vector>,
+    /// Whether `omegas` was written for the current state by this step's drift pass (consumed by the
+    /// stages 4–5 of the same step; the initial evaluation and the sphere step compute ω per contact).
+    pub(super) omegas_fresh: bool,
     /// The fold of the flags ([`BodyInputs::summarise`]).
     pub(super) summary: Summary,
     /// The broad-phase generation and `non_dynamic_pairs` skip the candidate list was built for.
@@ -87,12 +94,29 @@ pub(super) fn flags_of(i: usize, body: &RigidBody, at_build: &[Point], limit_sq:
     f
 }
 
+/// The world angular velocity ω (rad/s) at which stages 4–5 move the material points of `body`:
+/// [`RigidBody::angular_velocity`], or L/J for a body with equal principal moments when `isotropic` (the
+/// `isotropic_rotation` skip: ω = R J̄⁻¹ Rᵀ L = L/J when J̄ = J·I).
+#[inline]
+pub(super) fn omega_of(body: &RigidBody, isotropic: bool) -> Vector {
+    if isotropic && is_isotropic(&body.inertia.0) {
+        body.angular_momentum / body.inertia.0.x
+    } else {
+        body.angular_velocity()
+    }
+}
+
 impl BodyInputs {
     /// Sizes the per-body slots for `n` bodies (their values are written by the drift pass or
     /// [`BodyInputs::write`]).
     pub(super) fn resize(&mut self, n: usize) {
         self.centres.resize(n, Point::origin());
         self.flags.resize(n, 0);
+    }
+
+    /// Sizes the per-body angular velocities for `n` bodies (written by the drift pass).
+    pub(super) fn resize_omegas(&mut self, n: usize) {
+        self.omegas.resize(n, Vector::zeros());
     }
 
     /// Writes the inputs of every body serially (the initial evaluation, which has no drift pass).

@@ -330,6 +330,56 @@ where
     }
 }
 
+/// Calls `f(i, &mut a[i], &mut b[i], &mut c[i], &mut d[i])` for every item, in parallel when `parallel`
+/// (the chunks and jobs of [`for_each_item3`]; `f` must not depend on the order).
+pub fn for_each_item4<A, B, C, D, F>(
+    parallel: bool,
+    a: &mut [A],
+    b: &mut [B],
+    c: &mut [C],
+    d: &mut [D],
+    f: F,
+) where
+    A: Send,
+    B: Send,
+    C: Send,
+    D: Send,
+    F: Fn(usize, &mut A, &mut B, &mut C, &mut D) + Sync + Send,
+{
+    debug_assert!(a.len() == b.len() && a.len() == c.len() && a.len() == d.len());
+    if on_pool(parallel, a.len()) {
+        let size = chunk_len(a.len());
+        a.par_chunks_mut(size)
+            .zip(b.par_chunks_mut(size))
+            .zip(c.par_chunks_mut(size))
+            .zip(d.par_chunks_mut(size))
+            .with_max_len(1)
+            .enumerate()
+            .for_each(|(k, (((xs, ys), zs), ws))| {
+                let _timer = region_profile::chunk();
+                for (j, (((x, y), z), w)) in xs
+                    .iter_mut()
+                    .zip(ys.iter_mut())
+                    .zip(zs.iter_mut())
+                    .zip(ws.iter_mut())
+                    .enumerate()
+                {
+                    f(k * size + j, x, y, z, w);
+                }
+            });
+    } else {
+        for (i, (((x, y), z), w)) in a
+            .iter_mut()
+            .zip(b.iter_mut())
+            .zip(c.iter_mut())
+            .zip(d.iter_mut())
+            .enumerate()
+        {
+            f(i, x, y, z, w);
+        }
+    }
+}
+
 /// Calls `f(i, &mut a[i], &mut b[i], &mut c[i])` for every item, in parallel when `parallel` (chunks of
 /// items, each a job; `f` must not depend on the order).
 pub fn for_each_item3<A, B, C, F>(parallel: bool, a: &mut [A], b: &mut [B], c: &mut [C], f: F)

@@ -51,7 +51,7 @@ use super::contact_store::BodyAdjacency;
 use super::contact_store::{ContactKey, ContactState};
 use super::energy::{ContactWork, LastForces, StepPowers};
 use super::parallel::{
-    for_each_chunked, for_each_item3, for_each_item3_checked, for_each_item_checked,
+    for_each_chunked, for_each_item3_checked, for_each_item4, for_each_item_checked,
     for_each_item_pair, integration_work, Parallelism, Worker,
 };
 use super::region_profile::{self, Section};
@@ -217,13 +217,14 @@ impl std::fmt::Display for StepCounters {
         let ms = |d: Duration| d.as_secs_f64() * 1e3;
         writeln!(
             f,
-            "stage times (ms): broad {:.1}, narrow {:.1}, laws {:.1}, accumulate {:.1}, integrate {:.1}, checks {:.1}",
+            "stage times (ms): broad {:.1}, narrow {:.1}, laws {:.1}, accumulate {:.1}, integrate {:.1}, checks {:.1}; on one thread whatever the pool {:.1}",
             ms(self.broad),
             ms(self.narrow),
             ms(self.laws),
             ms(self.accumulate),
             ms(self.integrate),
-            ms(self.checks)
+            ms(self.checks),
+            ms(self.serial)
         )?;
         writeln!(
             f,
@@ -355,6 +356,7 @@ pub fn step(
     // The drift pass also writes what stage 3 reads of each body (centre, flags; see [`super::body_inputs`]).
     let inputs = &mut scratch.inputs;
     inputs.resize(world.bodies.len());
+    inputs.resize_omegas(world.bodies.len());
     let (at_build, limit_sq) = (
         world.broad_phase.centres_at_build(),
         world.broad_phase.rebuild_limit_sq(),
@@ -387,19 +389,22 @@ pub fn step(
         integrator.drift(body, dt);
     };
     region_profile::region(Section::KickDrift, || {
-        for_each_item3(
+        for_each_item4(
             parallel_bodies,
             &mut world.bodies,
             &mut inputs.centres,
             &mut inputs.flags,
-            |i, body, centre, flags| {
+            &mut inputs.omegas,
+            |i, body, centre, flags, omega| {
                 kick_drift(i, body);
                 *centre = body.position;
                 *flags = body_inputs::flags_of(i, body, at_build, limit_sq);
+                *omega = body_inputs::omega_of(body, skip.isotropic_rotation);
             },
         )
     });
     inputs.fresh = true;
+    inputs.omegas_fresh = true;
     for wall in &mut world.walls {
         wall.pose.translation.vector += dt * wall.velocity;
     }
@@ -501,6 +506,8 @@ pub(super) fn evaluate_loads(
 ) -> Result<(), StepError> {
     let step_index = world.step_index;
     let counters = &mut report.counters;
+    // The angular velocities of this step's drift pass, if it ran (consumed first: never read stale).
+    let omegas_fresh = std::mem::take(&mut scratch.inputs.omegas_fresh);
 
     // 3. Broad phase.
     let t = Instant::now();
@@ -593,6 +600,7 @@ pub(super) fn evaluate_loads(
     let pair = PairInputs {
         world: world_ref,
         isotropic: params.skips.isotropic_rotation,
+        omegas: omegas_fresh.then_some(scratch.inputs.omegas.as_slice()),
         models: &scratch.models,
         n_materials,
         dt,
@@ -900,6 +908,8 @@ pub(super) struct PairInputs<'a> {
     pub(super) world: &'a World,
     /// Whether ω of a body with equal principal moments is taken as L/J (the `isotropic_rotation` skip).
     isotropic: bool,
+    /// Every body's ω as [`body_inputs::omega_of`] gives it, when the drift pass wrote them this step.
+    omegas: Option<&'a [Vector]>,
     /// The contact model of each material pair (row-major `n_materials²`), with the skips applied.
     models: &'a [Option<ContactModel>],
     n_materials: usize,
@@ -928,10 +938,9 @@ impl PairInputs<'_> {
     #[inline]
     fn velocity_at(&self, i: usize, point: &Point) -> Vector {
         let body = &self.world.bodies[i];
-        let omega = if self.isotropic && is_isotropic(&body.inertia.0) {
-            body.angular_momentum / body.inertia.0.x
-        } else {
-            body.angular_velocity()
+        let omega = match self.omegas {
+            Some(omegas) => omegas[i],
+            None => body_inputs::omega_of(body, self.isotropic),
         };
         body.velocity + omega.cross(&(point - body.position))
     }

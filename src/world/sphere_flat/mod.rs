@@ -38,13 +38,15 @@
 //! asleep; the per-contact energy ledger off (`energy_ledger = false`: the path books no contact
 //! damping or friction work, as the general step does not then either).
 //!
-//! # Cost (callgrind, sphere bed a, 5000 steps, one thread, 2026-11-22)
-//! 1517 instructions per particle-step against 2169 for the general step with the ledger off (4.55e6
-//! against 6.51e6 per step of 3001 spheres, 3132 contacts and ~10 750 listed pairs per step): the pair
-//! loop takes 62 % (the law of an overlapping pair, ~550 instructions, dominates: the spring's rotation
-//! into the new tangent plane, a dozen square roots and divisions), integration and per-sphere sums 31 %
-//! (the orientation's turn ~90 per sphere), list rebuilds 6 %. Keeping the same bits as the general step
-//! fixes those operations; the target (≤ ~900) is not reached.
+//! # Cost (callgrind instructions, one thread, 2026-11-22)
+//! The first 1000 steps of sphere beds a / b / c (`examples/sphere_bed_speed.rs`, run under
+//! `valgrind --tool=callgrind --toggle-collect='*run_flat*'`), per particle-step: 1757 / 2219 / 1444,
+//! from 2256 / 2745 / 1865 before the pair constants, the inlined geometry, the loads summed by the pair
+//! loop, the untracked orientations and the cheaper list search (−22 / −19 / −23 %; the same final
+//! bits); over 5000 steps of bed a, 1118 from 1510 (−26 %). What remains: the law of an overlapping pair (about 2.2 per sphere in those steps; the exact
+//! rotation of the spring into the new tangent plane is ~100 instructions of it), list rebuilds (bed b:
+//! ~100 in 1000 steps, ~20 % of its instructions), integration. The target (≤ ~900) is not
+//! reached.
 //!
 //! # Validity of the owned state
 //! From [`SphereSim::from_world`] on, the simulation owns the state: the world it came from is stale
@@ -62,6 +64,7 @@ use crate::dynamics::{Motion, RotationScheme, ViscousDamping};
 use crate::law::ContactModel;
 use crate::math::{Point, Real, Rotation, Vector};
 use crate::shape::Shape;
+use rayon::prelude::*;
 
 use super::broad_phase::BroadPhase;
 use super::contact_store::{ContactKey, ContactState, ContactStore};
@@ -71,7 +74,7 @@ use super::step::{effective_model, StepError, StepParams};
 use super::world::{Wall, World};
 
 pub use neighbours::{NeighbourList, LARGE_RADIUS_FACTOR, MAX_CELLS_PER_BODY};
-use pair::{Kinematic, PairOut, Props, WallPlane};
+use pair::{Kinematic, PairConstants, PairOut, Props, WallConstants, WallPlane};
 
 /// Why a world cannot take the flat sphere path (see the module docs).
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -112,6 +115,15 @@ pub struct SphereSim {
     models: Vec<Option<ContactModel>>,
     n_materials: usize,
     list: NeighbourList,
+    /// Per listed body pair, r_a + r_b (m) and the constants of the pair loop; per listed wall pair, its
+    /// constants (formed after every build of the lists, aligned with them).
+    reach: Vec<Real>,
+    pair_constants: Vec<PairConstants>,
+    wall_constants: Vec<WallConstants>,
+    /// Whether the drift turns the orientations (see [`SphereSim::set_track_orientation`]).
+    track_orientation: bool,
+    /// The pair loop's blocks (made for the current lists and pool).
+    blocks: step::Blocks,
     /// The last evaluation of every listed pair (aligned with the lists); valid when `outs_valid`.
     out: Vec<PairOut>,
     wall_out: Vec<PairOut>,
@@ -233,6 +245,11 @@ impl SphereSim {
             models,
             n_materials,
             list: NeighbourList::new(world.broad_phase.skin()),
+            reach: Vec::new(),
+            pair_constants: Vec::new(),
+            wall_constants: Vec::new(),
+            track_orientation: true,
+            blocks: step::Blocks::default(),
             out: Vec::new(),
             wall_out: Vec::new(),
             outs_valid: false,
@@ -262,6 +279,7 @@ impl SphereSim {
             world.step_index,
             &import,
         );
+        sim.prepare_pairs(parallel);
         if world.loads.current && world.loads.forces.len() == n {
             sim.force.clone_from(&world.loads.forces);
             sim.torque.clone_from(&world.loads.torques);
@@ -270,8 +288,8 @@ impl SphereSim {
             }
         } else {
             // Stage 0: the loads of the initial state, no tangential increment.
-            sim.evaluate(0.0)?;
-            sim.gather_only();
+            let found = sim.evaluate(0.0)?;
+            sim.gather_only(found.scattered);
             if sim.ledger.initial_total.is_none() {
                 let mut at_start = world.clone();
                 at_start.loads.forces.clone_from(&sim.force);
@@ -281,6 +299,59 @@ impl SphereSim {
             }
         }
         Ok(sim)
+    }
+
+    /// Forms the constants of every listed pair (after a build of the lists).
+    fn prepare_pairs(&mut self, parallel: bool) {
+        let (list, props, models, n_materials) =
+            (&self.list, &self.props, &self.models, self.n_materials);
+        let tol = &self.params.tolerances;
+        let model = |a: u32, b: u32| models[a as usize * n_materials + b as usize].as_ref();
+        let body = |p: usize| {
+            let (pa, pb) = (&props[list.a[p] as usize], &props[list.b[p] as usize]);
+            (
+                pa.radius + pb.radius,
+                PairConstants::of(
+                    pa,
+                    pb,
+                    list.root_radius[p],
+                    list.effective_mass[p],
+                    model(pa.material, pb.material),
+                    tol,
+                ),
+            )
+        };
+        let n = list.a.len();
+        (self.reach, self.pair_constants) = if parallel && n >= MIN_PARALLEL_PAIRS {
+            (0..n).into_par_iter().map(body).unzip()
+        } else {
+            (0..n).map(body).unzip()
+        };
+        self.wall_constants = list
+            .wall_body
+            .iter()
+            .zip(&list.wall_of)
+            .map(|(&i, &w)| {
+                let p = &props[i as usize];
+                WallConstants::of(p, model(self.planes[w as usize].material, p.material), tol)
+            })
+            .collect();
+    }
+
+    /// Whether the drift turns each sphere's orientation (on by default). A sphere's orientation enters
+    /// no force, torque or motion of this path (the spheres are isotropic: the angular velocity is L/J
+    /// whatever the orientation), so with tracking off the positions, velocities, angular momenta,
+    /// loads and springs are the same bits (`tests/sphere_flat_orientation.rs`) and only the
+    /// orientations stay at their value when tracking was turned off (and are written back so). For runs
+    /// whose outputs read no orientation (the sphere-bed benchmark): it saves the turn of every sphere in
+    /// every step.
+    pub fn set_track_orientation(&mut self, on: bool) {
+        self.track_orientation = on;
+    }
+
+    /// Whether the drift turns the orientations (see [`SphereSim::set_track_orientation`]).
+    pub fn tracks_orientation(&self) -> bool {
+        self.track_orientation
     }
 
     /// Whether the per-sphere passes run on the pool (results are the same bits either way).

@@ -348,7 +348,8 @@ impl NeighbourList {
                 out.extend((i as u32 + 1..n as u32).filter(|&j| reach(i, j as usize)));
                 return;
             }
-            let c = grid.coord(&centres[i]);
+            let (x_i, r_i) = (centres[i], props[i].radius);
+            let c = grid.coord(&x_i);
             let range = |k: usize| c[k].saturating_sub(1)..=(c[k] + 1).min(grid.dims[k] - 1);
             for z in range(2) {
                 for y in range(1) {
@@ -356,12 +357,14 @@ impl NeighbourList {
                         let cell = grid.index([x, y, z]);
                         let bodies =
                             &grid.bodies[grid.start[cell] as usize..grid.start[cell + 1] as usize];
-                        out.extend(
-                            bodies
-                                .iter()
-                                .copied()
-                                .filter(|&j| j as usize > i && reach(i, j as usize)),
-                        );
+                        // Neither i nor a body of the grid is large: the plain skin.
+                        out.extend(bodies.iter().copied().filter(|&j| {
+                            let j = j as usize;
+                            j > i && {
+                                let r = r_i + props[j].radius + skin;
+                                (centres[j] - x_i).norm_squared() < r * r
+                            }
+                        }));
                     }
                 }
             }

@@ -4,15 +4,20 @@
 //! A candidate first takes the cheap test that needs no square root: two spheres whose centres are at
 //! least r_A + r_B apart, or a sphere whose centre is at least r above a wall, cannot overlap by more than
 //! the touching band, so the pair is separated (its spring is released, as the law does for a pair that
-//! does not overlap). Any other candidate goes through the same closed forms as the general narrow phase
-//! ([`contact_sphere_sphere`], [`contact_plane_sphere`]), the model scaled by √R* of the two radii
-//! ([`ContactModel::for_contact_radii`]) and the law inlined ([`ContactModel::evaluate_inlined`]), with the
-//! same arguments and operations as the sphere kernel of the general step (`super::super::sphere_kernel`),
-//! so an overlapping pair gives the same bits on both paths. Nothing is written for a separated pair
-//! but its flag and its cleared spring: no geometry is kept.
+//! does not overlap). Any other candidate takes the operations of the general narrow phase's closed forms
+//! ([`contact_sphere_sphere`], [`contact_plane_sphere`]; the distance is the square root of the squared
+//! distance of the cheap test, as `norm` forms it) and the law of the pair's model scaled by its √R*
+//! ([`ContactModel::for_contact_radii`]) with the constants of the pair formed once per list build
+//! ([`PairConstants`], [`WallConstants`]: radii, touching band, [`ContactModel::prepared`] with the
+//! pair's m*), then [`PreparedModel::respond`] — what [`ContactModel::evaluate`] does in one call — so an
+//! overlapping pair gives the same bits as the sphere kernel of the general step
+//! (`super::super::sphere_kernel`). Nothing is written for a separated pair but its flag and its cleared
+//! spring: no geometry is kept.
 
-use crate::contact::{contact_plane_sphere, contact_sphere_sphere, ContactKind, ContactTolerances};
-use crate::law::{ContactKinematics, ContactModel, RadiusScaling, TangentialHistory};
+use crate::contact::ContactTolerances;
+#[cfg(doc)]
+use crate::contact::{contact_plane_sphere, contact_sphere_sphere};
+use crate::law::{ContactModel, PreparedModel, RadiusScaling, TangentialHistory};
 use crate::math::{Point, Real, Vector};
 
 use super::super::step::StepError;
@@ -47,13 +52,10 @@ pub(crate) struct Props {
 }
 
 /// A wall as the pair loop sees it in one step: the world normal and offset of the plane (the values
-/// [`contact_plane_sphere`] forms from the pose), with the pose itself for that function.
+/// [`contact_plane_sphere`] forms from the pose), with the pose.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct WallPlane {
     pub(crate) pose: crate::math::Pose,
-    /// The plane's normal and offset in its own frame (the arguments of [`contact_plane_sphere`]).
-    pub(crate) local_normal: Vector,
-    pub(crate) local_offset: Real,
     /// World normal n and offset o: the signed height of a point x is n·x − o.
     pub(crate) normal: Vector,
     pub(crate) offset: Real,
@@ -65,14 +67,11 @@ impl WallPlane {
     /// The plane of `wall` at its current pose.
     pub(crate) fn of(wall: &super::super::Wall) -> Self {
         let pose = wall.pose;
-        let (local_normal, local_offset) = (*wall.plane.normal(), wall.plane.offset());
         // The same operations as `contact_plane_sphere`.
-        let normal = pose.rotation * local_normal;
-        let offset = local_offset + normal.dot(&pose.translation.vector);
+        let normal = pose.rotation * wall.plane.normal();
+        let offset = wall.plane.offset() + normal.dot(&pose.translation.vector);
         Self {
             pose,
-            local_normal,
-            local_offset,
             normal,
             offset,
             velocity: wall.velocity,
@@ -109,128 +108,186 @@ pub(crate) struct PairContext<'a> {
     pub(crate) kin: &'a [Kinematic],
     pub(crate) props: &'a [Props],
     pub(crate) walls: &'a [WallPlane],
-    /// The model of each material pair with the step's skips applied (row-major, `n_materials`²).
-    pub(crate) models: &'a [Option<ContactModel>],
-    pub(crate) n_materials: usize,
-    pub(crate) tolerances: &'a ContactTolerances,
     /// The tangential increment's time (s; 0 for the evaluation of an initial state).
     pub(crate) dt: Real,
     pub(crate) step_index: u64,
 }
 
+/// The constants of one listed sphere pair, formed at the list build ([`PairConstants::of`]).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct PairConstants {
+    pub(crate) radius_a: Real,
+    pub(crate) radius_b: Real,
+    /// The touching band of [`contact_sphere_sphere`]: tolerance × the larger diameter (m).
+    pub(crate) touch: Real,
+    /// The smaller diameter (m): the overlap ratio's scale.
+    pub(crate) scale: Real,
+    /// The pair's model scaled by its √R* and prepared with its m*; `None` when its materials have no
+    /// law (an error if the pair overlaps).
+    pub(crate) law: Option<PreparedModel>,
+}
+
+impl PairConstants {
+    /// The constants of the pair (A, B) with √R* `root_radius` and m* `effective_mass` (formed with the
+    /// operations of the general step), for the material pair's `model`.
+    pub(crate) fn of(
+        pa: &Props,
+        pb: &Props,
+        root_radius: Real,
+        effective_mass: Real,
+        model: Option<&ContactModel>,
+        tolerances: &ContactTolerances,
+    ) -> Self {
+        Self {
+            radius_a: pa.radius,
+            radius_b: pb.radius,
+            touch: tolerances.touching * (2.0 * pa.radius.max(pb.radius)),
+            scale: (2.0 * pa.radius).min(2.0 * pb.radius),
+            law: model.map(|m| scaled(m, root_radius).prepared(effective_mass)),
+        }
+    }
+}
+
+/// The constants of one listed wall–sphere pair, formed at the list build.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct WallConstants {
+    /// The touching band of [`contact_plane_sphere`]: tolerance × the diameter (m).
+    pub(crate) touch: Real,
+    pub(crate) law: Option<PreparedModel>,
+}
+
+impl WallConstants {
+    pub(crate) fn of(
+        p: &Props,
+        model: Option<&ContactModel>,
+        tolerances: &ContactTolerances,
+    ) -> Self {
+        Self {
+            touch: tolerances.touching * 2.0 * p.radius,
+            law: model.map(|m| m.for_contact_radii(None, Some(p.radius)).prepared(p.mass)),
+        }
+    }
+}
+
 impl PairContext<'_> {
-    #[inline(always)]
-    fn model(&self, a: u32, b: u32) -> Result<&ContactModel, StepError> {
-        self.models[a as usize * self.n_materials + b as usize]
-            .as_ref()
-            .ok_or(StepError::MissingLaw {
-                step: self.step_index,
-                a,
-                b,
-            })
+    #[cold]
+    fn missing_law(&self, a: u32, b: u32) -> StepError {
+        StepError::MissingLaw {
+            step: self.step_index,
+            a,
+            b,
+        }
     }
 
-    /// The sphere pair (a, b), a < b (A = a): its output and updated spring.
-    /// `root_radius` (√R*) and `effective_mass` are the pair's constants.
+    /// The sphere pair (a, b), a < b (A = a): its output and updated spring. `reach` is r_a + r_b and
+    /// `c` the pair's constants.
+    ///
+    /// The geometry is [`contact_sphere_sphere`]'s, by its operations (the distance's square root taken
+    /// from the squared distance of the cheap test, as `norm` forms it), and the law is the model's
+    /// ([`PreparedModel::respond`]), so the pair gives the bits of the general step's sphere kernel.
     #[allow(clippy::too_many_arguments)]
     #[inline(always)]
     pub(crate) fn body_pair(
         &self,
         a: usize,
         b: usize,
-        root_radius: Real,
-        effective_mass: Real,
+        reach: Real,
+        c: &PairConstants,
         history: &mut TangentialHistory,
         out: &mut PairOut,
     ) -> Result<(), StepError> {
         let (ka, kb) = (&self.kin[a], &self.kin[b]);
-        let (pa, pb) = (&self.props[a], &self.props[b]);
-        let reach = pa.radius + pb.radius;
-        if (kb.position - ka.position).norm_squared() >= reach * reach {
+        let d_vec = kb.position - ka.position;
+        let d_squared = d_vec.norm_squared();
+        if d_squared >= reach * reach {
             // d ≥ r_A + r_B: no overlap beyond the touching band.
             separated(history, out);
             return Ok(());
         }
-        let g = contact_sphere_sphere(
-            &ka.position,
-            pa.radius,
-            &kb.position,
-            pb.radius,
-            self.tolerances,
-        );
-        if g.kind != ContactKind::Overlap {
+        let d = d_squared.sqrt();
+        let normal = if d > 0.0 { d_vec / d } else { Vector::x() };
+        let depth = reach - d;
+        if !(depth > c.touch && depth > 0.0) {
             separated(history, out);
             return Ok(());
         }
-        // `for_contact_radii(Some(r_a), Some(r_b))` with the pair's √R* formed at the list build.
-        let model = scaled(self.model(pa.material, pb.material)?, root_radius);
-        let point = &g.point;
-        let kinematics = ContactKinematics {
-            relative_velocity: kb.velocity_at(point) - ka.velocity_at(point),
-            effective_mass,
-            center_a: ka.position,
-            center_b: kb.position,
-            dt: self.dt,
+        let Some(law) = &c.law else {
+            return Err(self.missing_law(self.props[a].material, self.props[b].material));
         };
-        let response = model.evaluate_inlined(&g, &kinematics, history);
-        let scale = (2.0 * pa.radius).min(2.0 * pb.radius);
+        let point_a = ka.position + normal * c.radius_a;
+        let point_b = kb.position - normal * c.radius_b;
+        let point = nalgebra::center(&point_a, &point_b);
+        let relative_velocity = kb.velocity_at(&point) - ka.velocity_at(&point);
+        let response = law.respond(
+            depth,
+            &normal,
+            &point,
+            &relative_velocity,
+            &ka.position,
+            &kb.position,
+            self.dt,
+            history,
+        );
         *out = PairOut {
             force_on_b: response.force_on_b,
             torque_on_a: response.torque_on_a,
             torque_on_b: response.torque_on_b,
             overlapping: true,
             damping_force: response.damping_force,
-            depth: g.depth,
-            overlap_ratio: g.depth / scale,
+            depth,
+            overlap_ratio: depth / c.scale,
         };
         Ok(())
     }
 
-    /// The wall–sphere pair (A = wall `w`, B = sphere `i`).
+    /// The wall–sphere pair (A = wall `w`, B = sphere `i`) with its constants `c`: the geometry of
+    /// [`contact_plane_sphere`] by its operations, then the model.
     #[inline(always)]
     pub(crate) fn wall_pair(
         &self,
         w: usize,
         i: usize,
+        c: &WallConstants,
         history: &mut TangentialHistory,
         out: &mut PairOut,
     ) -> Result<(), StepError> {
         let (k, p, wall) = (&self.kin[i], &self.props[i], &self.walls[w]);
-        if wall.height(&k.position) >= p.radius {
+        let height = wall.height(&k.position);
+        if height >= p.radius {
             separated(history, out);
             return Ok(());
         }
-        let g = contact_plane_sphere(
-            &wall.pose,
-            &wall.local_normal,
-            wall.local_offset,
-            &k.position,
-            p.radius,
-            self.tolerances,
-        );
-        if g.kind != ContactKind::Overlap {
+        let depth = p.radius - height;
+        if !(depth > c.touch && depth > 0.0) {
             separated(history, out);
             return Ok(());
         }
-        let model = self
-            .model(wall.material, p.material)?
-            .for_contact_radii(None, Some(p.radius));
-        let kinematics = ContactKinematics {
-            relative_velocity: k.velocity_at(&g.point) - wall.velocity,
-            effective_mass: p.mass,
-            center_a: g.point_a,
-            center_b: k.position,
-            dt: self.dt,
+        let Some(law) = &c.law else {
+            return Err(self.missing_law(wall.material, p.material));
         };
-        let response = model.evaluate_inlined(&g, &kinematics, history);
+        let n = wall.normal;
+        let point_a = k.position - n * height;
+        let point_b = k.position - n * p.radius;
+        let point = nalgebra::center(&point_a, &point_b);
+        let relative_velocity = k.velocity_at(&point) - wall.velocity;
+        let response = law.respond(
+            depth,
+            &n,
+            &point,
+            &relative_velocity,
+            &point_a,
+            &k.position,
+            self.dt,
+            history,
+        );
         *out = PairOut {
             force_on_b: response.force_on_b,
             torque_on_a: response.torque_on_a,
             torque_on_b: response.torque_on_b,
             overlapping: true,
             damping_force: response.damping_force,
-            depth: g.depth,
-            overlap_ratio: g.depth / (2.0 * p.radius),
+            depth,
+            overlap_ratio: depth / (2.0 * p.radius),
         };
         Ok(())
     }

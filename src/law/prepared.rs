@@ -1,0 +1,137 @@
+//! A contact model with the constants of one contact formed: what [`ContactModel::evaluate`] computes
+//! from the model and the effective mass before it looks at the overlap (the viscous damping's
+//! ζ̂ √(m* k_n)), kept so that a caller that evaluates the same pair over many steps (the flat sphere
+//! path's neighbour list) forms them once per pair instead of once per step.
+//!
+//! [`ContactModel::evaluate`] is [`ContactModel::prepared`] followed by [`PreparedModel::respond`], so
+//! the two ways of calling the law are the same operations in the same order, and give the same bits.
+
+use super::damping::PreparedDamping;
+use super::model::{ContactModel, ContactResponse};
+use super::normal::NormalLaw;
+use super::tangential::{incremental_spring_damped, TangentialHistory, TangentialLaw};
+use crate::math::{Point, Real, Vector};
+
+/// A [`ContactModel`] with the constants of one contact (its effective mass) formed.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PreparedModel {
+    /// The normal slot (k_n as the caller scaled it for the contact's radii).
+    pub normal: NormalLaw,
+    pub damping: PreparedDamping,
+    pub tangential: TangentialLaw,
+    /// m* (kg): the tangential dashpot's √(m* k_t).
+    pub effective_mass: Real,
+}
+
+impl ContactModel {
+    /// The model with the constants of a contact of effective mass `effective_mass` (kg) formed.
+    #[inline(always)]
+    pub fn prepared(&self, effective_mass: Real) -> PreparedModel {
+        PreparedModel {
+            normal: self.normal,
+            damping: self.damping.prepared(self.normal.stiffness, effective_mass),
+            tangential: self.tangential,
+            effective_mass,
+        }
+    }
+}
+
+impl PreparedModel {
+    /// The law on an overlapping contact (overlap δ > 0, m; unit normal n from A to B; contact point c;
+    /// relative velocity v_B − v_A at c, m/s; centres of A and B; the tangential increment's time Δt, s),
+    /// updating the pair's spring `history`: [`ContactModel::evaluate`] past its test for an overlap.
+    #[allow(clippy::too_many_arguments)]
+    #[inline(always)]
+    pub fn respond(
+        &self,
+        overlap: Real,
+        n: &Vector,
+        point: &Point,
+        relative_velocity: &Vector,
+        center_a: &Point,
+        center_b: &Point,
+        dt: Real,
+        history: &mut TangentialHistory,
+    ) -> ContactResponse {
+        let n = *n;
+        let v = *relative_velocity;
+        let overlap_rate = -v.dot(&n);
+        let elastic = self.normal.force(overlap);
+        let mut damping = self
+            .damping
+            .force(self.normal.exponent, overlap, overlap_rate);
+        if self.normal.never_attractive && elastic + damping < 0.0 {
+            // The clamp removes the part of the damping force that would pull: what acts is −elastic.
+            damping = -elastic;
+        }
+        let normal_force = elastic + damping;
+
+        let (
+            tangential_force,
+            tangential_potential,
+            friction_dissipation,
+            sliding,
+            tangential_power,
+            dashpot_force,
+            tangential_stiffness_work,
+            previous_displacement,
+        ) = match self.tangential {
+            TangentialLaw::None => (
+                Vector::zeros(),
+                0.0,
+                0.0,
+                false,
+                0.0,
+                Vector::zeros(),
+                0.0,
+                None,
+            ),
+            law => {
+                let (stiffness, friction) = law.stiffness_and_friction(overlap);
+                let dashpot = match law {
+                    TangentialLaw::DampedMindlin { damping, .. } => {
+                        damping * (self.effective_mass * stiffness).sqrt()
+                    }
+                    _ => 0.0,
+                };
+                let v_t = v - n * v.dot(&n);
+                let r = incremental_spring_damped(
+                    stiffness,
+                    friction,
+                    dashpot,
+                    &n,
+                    normal_force,
+                    &v_t,
+                    dt,
+                    history,
+                );
+                (
+                    r.force,
+                    r.spring_energy,
+                    r.friction_dissipation,
+                    r.sliding,
+                    r.damping_power,
+                    r.damping_force,
+                    r.stiffness_work,
+                    Some(r.previous_displacement),
+                )
+            }
+        };
+        let force_on_b = n * normal_force + tangential_force;
+        ContactResponse {
+            force_on_b,
+            torque_on_a: (point - center_a).cross(&(-force_on_b)),
+            torque_on_b: (point - center_b).cross(&force_on_b),
+            normal_force,
+            tangential_force,
+            normal_potential: self.normal.potential(overlap),
+            tangential_potential,
+            damping_power: damping * overlap_rate + tangential_power,
+            damping_force: n * damping + dashpot_force,
+            friction_dissipation,
+            tangential_stiffness_work,
+            sliding,
+            previous_displacement,
+        }
+    }
+}
