@@ -154,12 +154,7 @@ fn packing_with_density_scale_ends_at_the_true_masses_with_the_ledger_closed_and
         report.ledger_balance_relative[1],
         report.ledger_balance_relative[2]
     );
-    let lowest = world
-        .bodies
-        .iter()
-        .map(|b| b.position.z)
-        .fold(Real::INFINITY, Real::min);
-    assert!(lowest > 0.0, "a rock centre below the floor: {lowest} m");
+    support::assert_rocks_above_floor(&world);
 }
 
 #[test]

@@ -182,10 +182,5 @@ fn packing_with_local_damping_and_a_drop_speed_settles_the_small_bed() {
         hold.abs() < 0.01,
         "hold: ledger balance change / initial potential {hold}, tol 0.01"
     );
-    let lowest = world
-        .bodies
-        .iter()
-        .map(|b| b.position.z)
-        .fold(Real::INFINITY, Real::min);
-    assert!(lowest > 0.0, "a rock centre below the floor: {lowest} m");
+    support::assert_rocks_above_floor(&world);
 }

@@ -1,6 +1,8 @@
 //! The small rockfill configuration shared by the rockfill tests (`tests/rockfill_*.rs`, included by path).
 
+use polydem::math::Real;
 use polydem::rockfill::config::ExperimentConfig;
+use polydem::world::World;
 
 /// The quick variant cut to a 1.2 m × 0.6 m × 0.6 m layer (about 25 rocks of 290 mm), short hold and
 /// deposition, so that a whole experiment runs in about a second.
@@ -15,4 +17,15 @@ pub fn small() -> ExperimentConfig {
     c.packing.compaction_pressure = 1.0e4;
     c.rock.seed = 3;
     c
+}
+
+/// Fails if a rock's centre lies below the floor (z = 0) after packing: a rock pushed through it.
+#[allow(dead_code)] // not every test file that includes this module packs a bed
+pub fn assert_rocks_above_floor(world: &World) {
+    let lowest = world
+        .bodies
+        .iter()
+        .map(|b| b.position.z)
+        .fold(Real::INFINITY, Real::min);
+    assert!(lowest > 0.0, "a rock centre below the floor: {lowest} m");
 }
