@@ -17,7 +17,7 @@
 use crate::contact::ContactTolerances;
 #[cfg(doc)]
 use crate::contact::{contact_plane_sphere, contact_sphere_sphere};
-use crate::law::{ContactModel, PreparedModel, RadiusScaling, TangentialHistory};
+use crate::law::{ContactModel, ContactResponse, PreparedModel, RadiusScaling, TangentialHistory};
 use crate::math::{Point, Real, Vector};
 
 use super::super::step::StepError;
@@ -101,6 +101,23 @@ pub(crate) struct PairOut {
     /// Overlap (m) and overlap / the smaller particle's diameter.
     pub(crate) depth: Real,
     pub(crate) overlap_ratio: Real,
+}
+
+impl PairOut {
+    /// The output of an overlapping pair: the law's `response` at overlap `depth` (m), with the overlap
+    /// over the smaller particle's diameter.
+    #[inline(always)]
+    fn overlapping(response: &ContactResponse, depth: Real, overlap_ratio: Real) -> Self {
+        PairOut {
+            force_on_b: response.force_on_b,
+            torque_on_a: response.torque_on_a,
+            torque_on_b: response.torque_on_b,
+            overlapping: true,
+            damping_force: response.damping_force,
+            depth,
+            overlap_ratio,
+        }
+    }
 }
 
 /// The inputs shared by every candidate of a step.
@@ -228,15 +245,7 @@ impl PairContext<'_> {
             self.dt,
             history,
         );
-        *out = PairOut {
-            force_on_b: response.force_on_b,
-            torque_on_a: response.torque_on_a,
-            torque_on_b: response.torque_on_b,
-            overlapping: true,
-            damping_force: response.damping_force,
-            depth,
-            overlap_ratio: depth / c.scale,
-        };
+        *out = PairOut::overlapping(&response, depth, depth / c.scale);
         Ok(())
     }
 
@@ -280,15 +289,7 @@ impl PairContext<'_> {
             self.dt,
             history,
         );
-        *out = PairOut {
-            force_on_b: response.force_on_b,
-            torque_on_a: response.torque_on_a,
-            torque_on_b: response.torque_on_b,
-            overlapping: true,
-            damping_force: response.damping_force,
-            depth,
-            overlap_ratio: depth / (2.0 * p.radius),
-        };
+        *out = PairOut::overlapping(&response, depth, depth / (2.0 * p.radius));
         Ok(())
     }
 }
