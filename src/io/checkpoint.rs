@@ -47,7 +47,7 @@ use crate::world::ContactKey;
 /// The first eight bytes of every checkpoint.
 pub const MAGIC: [u8; 8] = *b"PDEMCKPT";
 /// The format version this build writes and the only one it reads.
-pub const FORMAT_VERSION: u32 = 8;
+pub const FORMAT_VERSION: u32 = 9;
 /// Bytes before the payload.
 pub const HEADER_LEN: usize = 28;
 

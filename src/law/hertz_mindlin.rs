@@ -18,7 +18,7 @@
 
 use super::damping::DampingLaw;
 use super::normal::{NormalLaw, RadiusScaling};
-use super::tangential::TangentialLaw;
+use super::tangential::{SpringRotation, TangentialLaw};
 use super::{check_range, ContactModel, LawError};
 use crate::math::Real;
 use std::f64::consts::PI;
@@ -116,6 +116,7 @@ pub fn hertz_mindlin(pair: &SpherePair) -> Result<ContactModel, LawError> {
         tangential: TangentialLaw::Mindlin {
             coefficient: 8.0 * shear * radius.sqrt(),
             friction: pair.friction,
+            rotation: SpringRotation::Exact,
         },
     })
 }
@@ -176,11 +177,13 @@ pub fn material_hertz_mindlin(
             coefficient,
             friction,
             damping: 2.0 * (5.0_f64 / 6.0).sqrt() * zeta,
+            rotation: SpringRotation::Exact,
         }
     } else {
         TangentialLaw::Mindlin {
             coefficient,
             friction,
+            rotation: SpringRotation::Exact,
         }
     };
     Ok(ContactModel {
@@ -275,6 +278,7 @@ mod tests {
         let TangentialLaw::Mindlin {
             coefficient,
             friction,
+            ..
         } = model.tangential
         else {
             panic!(

@@ -29,7 +29,7 @@ pub use damping::DampingLaw;
 pub use model::{ContactKinematics, ContactModel, ContactResponse};
 pub use normal::{NormalLaw, RadiusScaling};
 pub use prepared::PreparedModel;
-pub use tangential::{TangentialHistory, TangentialLaw};
+pub use tangential::{SpringRotation, TangentialHistory, TangentialLaw};
 
 /// Invalid law parameters.
 #[derive(Debug, Clone, Copy, PartialEq, thiserror::Error)]

@@ -85,25 +85,31 @@ impl ContactModel {
             TangentialLaw::Spring {
                 stiffness,
                 friction,
+                rotation,
             } => TangentialLaw::Spring {
                 stiffness: stiffness * root_radius,
                 friction,
+                rotation,
             },
             TangentialLaw::Mindlin {
                 coefficient,
                 friction,
+                rotation,
             } => TangentialLaw::Mindlin {
                 coefficient: coefficient * root_radius,
                 friction,
+                rotation,
             },
             TangentialLaw::DampedMindlin {
                 coefficient,
                 friction,
                 damping,
+                rotation,
             } => TangentialLaw::DampedMindlin {
                 coefficient: coefficient * root_radius,
                 friction,
                 damping,
+                rotation,
             },
         };
         model

@@ -96,6 +96,7 @@ impl PreparedModel {
                 };
                 let v_t = v - n * v.dot(&n);
                 let r = incremental_spring_damped(
+                    law.rotation(),
                     stiffness,
                     friction,
                     dashpot,

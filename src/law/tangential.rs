@@ -3,8 +3,10 @@
 //! Per contact the caller stores a [`TangentialHistory`]: the accumulated tangential displacement u (m, of
 //! B relative to A, world frame, in the tangent plane) and the normal it was last expressed in. Each
 //! evaluation:
-//! 1. rotates u into the current tangent plane by the smallest rotation taking the stored normal to the
-//!    current one (Rodrigues), then removes any remaining normal component (round-off) keeping |u|;
+//! 1. carries u into the current tangent plane: by default ([`SpringRotation::Exact`]) by the smallest
+//!    rotation taking the stored normal to the current one (Rodrigues), then removes any remaining normal
+//!    component (round-off) keeping |u|; as an option ([`SpringRotation::Projection`], LIGGGHTS' rule)
+//!    by removing its component along the current normal only;
 //! 2. adds the tangential relative displacement of this step, u ← u + v_t Δt;
 //! 3. forms the trial force F_t = −k_t u (on B);
 //! 4. caps it: if |F_t| > μ F_n (F_n the compressive normal force, ≥ 0), F_t ← μ F_n F_t/|F_t| and
@@ -69,16 +71,48 @@ impl TangentialHistory {
     }
 }
 
-/// The tangential slot.
+/// How the stored spring is carried into the current tangent plane before this step's increment (the
+/// normal turns a little every step).
+///
+/// - `Exact` (the default: the engine's rule since the start, with which every recorded comparison was
+///   made): the smallest rotation taking the stored normal to the current one ([`rotate_into_tangent_plane`],
+///   Rodrigues, then the round-off normal part removed with |u| kept); a few square roots and divisions
+///   per contact and step.
+/// - `Projection`: the normal component of u along the current normal is removed, u ← u − n (u·n)
+///   ([`project_into_tangent_plane`]), |u| not restored: the rule of LIGGGHTS' `tangential history`
+///   model (it adds v_t Δt first and projects the sum; v_t is tangential, so the two orders differ only
+///   by round-off) and of LAMMPS' granular pair styles. Per step the spring shortens by the factor
+///   cos Δθ of the normal's turn Δθ (second order: Δθ ~ |v_t| Δt / R, 1 − cos Δθ ~ 1e-7 in the sphere-bed
+///   scenes); no square root, no division.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SpringRotation {
+    #[default]
+    Exact,
+    Projection,
+}
+
+/// The tangential slot. `rotation` (absent in a serialised law: [`SpringRotation::Exact`]) says how the
+/// spring follows the turning normal.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "snake_case", deny_unknown_fields)]
 pub enum TangentialLaw {
     /// Frictionless.
     None,
     /// Constant stiffness k_t (N/m) and friction coefficient μ.
-    Spring { stiffness: Real, friction: Real },
+    Spring {
+        stiffness: Real,
+        friction: Real,
+        #[serde(default)]
+        rotation: SpringRotation,
+    },
     /// Mindlin no-slip stiffness k_t = coefficient · δ^(1/2) (coefficient = 8 G* √R*, N/m^1.5), friction μ.
-    Mindlin { coefficient: Real, friction: Real },
+    Mindlin {
+        coefficient: Real,
+        friction: Real,
+        #[serde(default)]
+        rotation: SpringRotation,
+    },
     /// The Mindlin spring with a tangential dashpot while sticking, as LIGGGHTS' `model hertz tangential
     /// history` (`tangential_damping on`): F_t = −k_t u − c_t v_t with c_t = damping · √(m* k_t) (the
     /// dimensionless `damping` is 2√(5/6) β for LIGGGHTS, β = −ln e/√(π² + ln² e)); when |k_t u| exceeds
@@ -87,6 +121,8 @@ pub enum TangentialLaw {
         coefficient: Real,
         friction: Real,
         damping: Real,
+        #[serde(default)]
+        rotation: SpringRotation,
     },
 }
 
@@ -105,7 +141,30 @@ impl TangentialLaw {
         Ok(Self::Spring {
             stiffness,
             friction,
+            rotation: SpringRotation::Exact,
         })
+    }
+
+    /// How the spring follows the turning normal ([`SpringRotation::Exact`] without a spring).
+    #[inline(always)]
+    pub fn rotation(&self) -> SpringRotation {
+        match *self {
+            Self::None => SpringRotation::Exact,
+            Self::Spring { rotation, .. }
+            | Self::Mindlin { rotation, .. }
+            | Self::DampedMindlin { rotation, .. } => rotation,
+        }
+    }
+
+    /// The same law with the spring carried by `rotation` (no effect on [`TangentialLaw::None`]).
+    pub fn with_rotation(mut self, rotation: SpringRotation) -> Self {
+        match &mut self {
+            Self::None => {}
+            Self::Spring { rotation: r, .. }
+            | Self::Mindlin { rotation: r, .. }
+            | Self::DampedMindlin { rotation: r, .. } => *r = rotation,
+        }
+        self
     }
 
     /// The tangential stiffness (N/m) at overlap δ, and μ.
@@ -115,10 +174,12 @@ impl TangentialLaw {
             Self::Spring {
                 stiffness,
                 friction,
+                ..
             } => (stiffness, friction),
             Self::Mindlin {
                 coefficient,
                 friction,
+                ..
             }
             | Self::DampedMindlin {
                 coefficient,
@@ -182,6 +243,28 @@ pub fn rotate_into_tangent_plane(u: &Vector, old_normal: &Vector, new_normal: &V
     }
 }
 
+/// The displacement `u` with its component along `new_normal` removed, u − n (u·n): the
+/// [`SpringRotation::Projection`] rule (the length is not restored; see there).
+#[inline(always)]
+pub fn project_into_tangent_plane(u: &Vector, new_normal: &Vector) -> Vector {
+    u - new_normal * u.dot(new_normal)
+}
+
+/// The stored spring `u` (expressed against `old_normal`) carried into the plane perpendicular to
+/// `new_normal` by the rule `rotation`.
+#[inline(always)]
+pub fn carry_into_tangent_plane(
+    rotation: SpringRotation,
+    u: &Vector,
+    old_normal: &Vector,
+    new_normal: &Vector,
+) -> Vector {
+    match rotation {
+        SpringRotation::Exact => rotate_into_tangent_plane(u, old_normal, new_normal),
+        SpringRotation::Projection => project_into_tangent_plane(u, new_normal),
+    }
+}
+
 /// One incremental step of the spring with Coulomb cap (see the module docs). `normal_force` is the
 /// compressive normal force magnitude (negative values are treated as zero: no friction without
 /// compression). `history` is updated in place.
@@ -195,6 +278,7 @@ pub fn incremental_spring(
     history: &mut TangentialHistory,
 ) -> TangentialResponse {
     incremental_spring_damped(
+        SpringRotation::Exact,
         stiffness,
         friction,
         0.0,
@@ -206,13 +290,15 @@ pub fn incremental_spring(
     )
 }
 
-/// [`incremental_spring`] with a tangential dashpot c_t (N s/m) that acts while the contact sticks:
+/// [`incremental_spring`] with the spring carried by `rotation` ([`carry_into_tangent_plane`]) and a
+/// tangential dashpot c_t (N s/m) that acts while the contact sticks:
 /// F_t = −k_t u − c_t v_t when k_t |u| ≤ μ F_n; otherwise the spring force is capped as without the dashpot
 /// (the LIGGGHTS `tangential history` order). The dashpot's power c_t |v_t|² is reported in
 /// [`TangentialResponse::damping_power`].
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
 pub fn incremental_spring_damped(
+    rotation: SpringRotation,
     stiffness: Real,
     friction: Real,
     damping: Real,
@@ -222,7 +308,8 @@ pub fn incremental_spring_damped(
     dt: Real,
     history: &mut TangentialHistory,
 ) -> TangentialResponse {
-    let u_previous = rotate_into_tangent_plane(&history.displacement, &history.normal, normal);
+    let u_previous =
+        carry_into_tangent_plane(rotation, &history.displacement, &history.normal, normal);
     let mut u = u_previous + tangential_velocity * dt;
     let stiffness_work = 0.5 * (stiffness - history.stiffness) * u_previous.dot(&u);
     let mut force = -stiffness * u;
@@ -374,6 +461,53 @@ mod tests {
         let mut h = TangentialHistory::default();
         let r = incremental_spring(k, mu, &normal, -5.0, &v, dt, &mut h);
         assert_eq!(r.force, Vector::zeros());
+    }
+
+    #[test]
+    fn projection_removes_the_normal_part_and_shortens_by_the_cosine_of_the_turn() {
+        let n_old = Vector::new(0.0, 0.0, 1.0);
+        let u = Vector::new(2e-5, -1e-5, 0.0);
+        let turn = Rotation::from_scaled_axis(Vector::new(0.3, -0.2, 0.0));
+        let n_new = turn.transform_vector(&n_old);
+        let projected = project_into_tangent_plane(&u, &n_new);
+        assert!(
+            projected.dot(&n_new).abs() < 1e-16 * u.norm() * 10.0,
+            "projected spring {projected:?} not in the plane of {n_new:?}"
+        );
+        // |u − n(u·n)|² = |u|² − (u·n)²: the closed form of the projection's length.
+        let expected = (u.norm_squared() - u.dot(&n_new).powi(2)).sqrt();
+        assert!(
+            (projected.norm() - expected).abs() < 1e-14 * u.norm(),
+            "projected length {}, expected √(|u|² − (u·n)²) = {expected}",
+            projected.norm()
+        );
+        // Against the exact rotation: the same direction in the plane to first order in the turn θ
+        // (|θ| = 0.36 rad here), and never longer.
+        let exact = rotate_into_tangent_plane(&u, &n_old, &n_new);
+        let theta = 0.3_f64.hypot(0.2);
+        assert!(
+            projected.norm() <= exact.norm() * (1.0 + 1e-15),
+            "projection {} longer than the rotated spring {}",
+            projected.norm(),
+            exact.norm()
+        );
+        assert!(
+            (projected - exact).norm() <= (1.0 - theta.cos()) * u.norm() * (1.0 + 1e-9) + 1e-20,
+            "projection {projected:?} and rotation {exact:?} differ by more than (1 − cos θ)|u|, θ = {theta}"
+        );
+        // The law with either rule on a fixed normal: the same force (nothing to carry).
+        let normal = Vector::new(0.0, 0.0, 1.0);
+        let v = Vector::new(0.1, 0.05, 0.0);
+        let (mut h1, mut h2) = (TangentialHistory::default(), TangentialHistory::default());
+        for _ in 0..5 {
+            let a = incremental_spring_damped(
+                SpringRotation::Exact, 1e5, 0.3, 0.0, &normal, 10.0, &v, 1e-5, &mut h1,
+            );
+            let b = incremental_spring_damped(
+                SpringRotation::Projection, 1e5, 0.3, 0.0, &normal, 10.0, &v, 1e-5, &mut h2,
+            );
+            assert_eq!(a.force, b.force, "fixed normal: exact {a:?}, projection {b:?}");
+        }
     }
 
     #[test]

@@ -16,7 +16,9 @@ use crate::contact::wall_depth::WallDepth;
 use crate::dynamics::{Motion, PrincipalInertia, RigidBody, ViscousDamping};
 use crate::law::hertz_mindlin::{material_hertz_mindlin, ElasticMaterial, HertzMindlinOptions};
 use crate::law::pair::contact_radius;
-use crate::law::{ContactModel, DampingLaw, LawError, NormalLaw, RadiusScaling, TangentialLaw};
+use crate::law::{
+    ContactModel, DampingLaw, LawError, NormalLaw, RadiusScaling, SpringRotation, TangentialLaw,
+};
 use crate::math::{Point, Pose, Real, Rotation, Vector};
 use crate::shape::{ConvexPolyhedron, Plane, Shape, Sphere};
 use crate::world::{MaterialTable, StepParams, Wall, World};
@@ -385,6 +387,26 @@ fn build(ctx: &Ctx, file: &SceneFile) -> Result<Simulation, SceneError> {
                     "unknown law '{other}' (expected \"linear\", \"power\" or \"hertz_mindlin\")"
                 ),
                 ))
+            }
+        };
+        let model = match &it.spring_rotation {
+            None => model,
+            Some(r) => {
+                let rotation = match r.get_ref().as_str() {
+                    "exact" => SpringRotation::Exact,
+                    "projection" => SpringRotation::Projection,
+                    other => {
+                        return Err(ctx.invalid(
+                            r.span(),
+                            f("spring_rotation"),
+                            format!("unknown spring_rotation '{other}' (expected \"exact\" or \"projection\")"),
+                        ))
+                    }
+                };
+                ContactModel {
+                    tangential: model.tangential.with_rotation(rotation),
+                    ..model
+                }
             }
         };
         materials.set_model(ia, ib, model);

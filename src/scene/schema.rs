@@ -104,6 +104,10 @@ pub struct InteractionSection {
     pub tangential_damping: Option<Spanned<bool>>,
     /// The total normal force is never attractive; absent = false (LIGGGHTS' default).
     pub limit_force: Option<Spanned<bool>>,
+    /// How the tangential spring follows the turning normal: `"exact"` (rotation; absent = exact, the
+    /// engine's rule) or `"projection"` (its normal part removed, as LIGGGHTS; see
+    /// `polydem::law::SpringRotation`). No effect without a tangential spring.
+    pub spring_rotation: Option<Spanned<String>>,
 }
 
 /// `[[shape]]`.

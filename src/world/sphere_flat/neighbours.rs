@@ -351,20 +351,23 @@ impl NeighbourList {
             let (x_i, r_i) = (centres[i], props[i].radius);
             let c = grid.coord(&x_i);
             let range = |k: usize| c[k].saturating_sub(1)..=(c[k] + 1).min(grid.dims[k] - 1);
+            let (x_lo, x_hi) = (c[0].saturating_sub(1), (c[0] + 1).min(grid.dims[0] - 1));
             for z in range(2) {
                 for y in range(1) {
-                    for x in range(0) {
-                        let cell = grid.index([x, y, z]);
-                        let bodies =
-                            &grid.bodies[grid.start[cell] as usize..grid.start[cell + 1] as usize];
-                        // Neither i nor a body of the grid is large: the plain skin.
-                        out.extend(bodies.iter().copied().filter(|&j| {
-                            let j = j as usize;
-                            j > i && {
-                                let r = r_i + props[j].radius + skin;
-                                (centres[j] - x_i).norm_squared() < r * r
+                    // The cells x_lo..=x_hi of a row of the grid are consecutive: one run of bodies
+                    // (the row is sorted below, so the order of the runs does not matter).
+                    let (first, last) = (grid.index([x_lo, y, z]), grid.index([x_hi, y, z]));
+                    let bodies =
+                        &grid.bodies[grid.start[first] as usize..grid.start[last + 1] as usize];
+                    // Neither i nor a body of the grid is large: the plain skin.
+                    for &j in bodies {
+                        let ju = j as usize;
+                        if ju > i {
+                            let r = r_i + props[ju].radius + skin;
+                            if (centres[ju] - x_i).norm_squared() < r * r {
+                                out.push(j);
                             }
-                        }));
+                        }
                     }
                 }
             }
