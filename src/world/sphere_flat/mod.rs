@@ -40,13 +40,17 @@
 //!
 //! # Cost (callgrind instructions, one thread, 2026-11-22)
 //! The first 1000 steps of sphere beds a / b / c (`examples/sphere_bed_speed.rs`, run under
-//! `valgrind --tool=callgrind --toggle-collect='*run_flat*'`), per particle-step: 1757 / 2219 / 1444,
-//! from 2256 / 2745 / 1865 before the pair constants, the inlined geometry, the loads summed by the pair
-//! loop, the untracked orientations and the cheaper list search (−22 / −19 / −23 %; the same final
-//! bits); over 5000 steps of bed a, 1118 from 1510 (−26 %). What remains: the law of an overlapping pair (about 2.2 per sphere in those steps; the exact
-//! rotation of the spring into the new tangent plane is ~100 instructions of it), list rebuilds (bed b:
-//! ~100 in 1000 steps, ~20 % of its instructions), integration. The target (≤ ~900) is not
-//! reached.
+//! `valgrind --tool=callgrind --toggle-collect='*run_flat*'`), per particle-step: 1481 / 1774 / 1206,
+//! from 1750 / 2216 / 1438 (−15 / −20 / −16 %) with the scenes' LIGGGHTS projection of the spring
+//! ([`crate::law::SpringRotation::Projection`]: a 1750 → 1478, b 2152 → 1866 alone; other bits, the
+//! exact rotation stays the default), their 0.5 mm skin (LIGGGHTS' `neighbor`; same bits: bed b's
+//! rebuilds 109 → 71, a and c 18 → 11 per 1000 steps) and a list search that takes each grid row's
+//! cells as one run (same bits; b 2216 → 2152). Earlier: 2256 / 2745 / 1865 before the pair constants,
+//! the inlined geometry, the loads summed by the pair loop, the untracked orientations and the first
+//! cheaper search. What remains: the pair loop (~80 % of bed a: ~3.7 listed pairs and ~2.3 overlapping
+//! ones per sphere), list rebuilds (bed b: ~3800 instructions per sphere and build with the constants,
+//! ~16 % of its instructions at 71 builds; the fast bed spheres the projectile throws, not only the
+//! projectile (listed with four skins), use up the skin), integration. The target (≤ ~900) is not reached.
 //!
 //! # Validity of the owned state
 //! From [`SphereSim::from_world`] on, the simulation owns the state: the world it came from is stale
