@@ -43,15 +43,17 @@ fn packed_bed_stays_in_the_container_and_reloads_bit_for_bit() {
         "max overlap/size {}",
         report.max_overlap_ratio
     );
-    // The ledger of packing closes to 10 % of the rocks' initial potential energy (measured: 4 % on the
-    // 50-rock bed; the known first-order loss of flat wall contacts dominates it).
+    // The ledger of packing closes to 1 % of the rocks' initial potential energy (measured: 1.4e-3 to
+    // 1.7e-3 after every stage, seeds 3–5 of this bed in three rock orders; before the servo-driven top
+    // wall's work was booked with the velocity that moves it, compaction missed half of that work: 2e-2 to
+    // 1.8e-1 by seed and order).
     for (stage, b) in ["deposition", "compaction", "hold"]
         .iter()
         .zip(report.ledger_balance_relative)
     {
         assert!(
-            b.abs() < 0.1,
-            "{stage}: ledger balance / initial potential {b}, tol 0.1"
+            b.abs() < 1e-2,
+            "{stage}: ledger balance / initial potential {b}, tol 1e-2"
         );
     }
     let dir = std::env::temp_dir().join(format!("polydem_bed_{}", std::process::id()));

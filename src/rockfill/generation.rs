@@ -1,4 +1,5 @@
-//! Rock generation end to end (paper section 4.1): seeds by eq. 28 → Voronoi cells → eq. 29 shrinking → rocks.
+//! Rock generation end to end (paper section 4.1): seeds by eq. 28 → Voronoi cells → eq. 29 shrinking → rocks,
+//! numbered along a Z-order curve of their centres ([`super::spatial_order`]).
 
 use std::time::{Duration, Instant};
 
@@ -10,6 +11,7 @@ use super::grading::{
     DEFAULT_RANGE_FRACTION, DEFAULT_SIGMA_FRACTION,
 };
 use super::seeds::{random_seeds, seed_count, Region, SeedError};
+use super::spatial_order::order_rocks_spatially;
 use super::voronoi::{tessellate, VoronoiError};
 use crate::math::Real;
 
@@ -93,7 +95,9 @@ pub fn generate(params: &GenerationParams) -> Result<Sample, GenerationError> {
     let cells = tessellate(&params.region, &seeds)?;
     let tessellation_time = start.elapsed();
     let start = Instant::now();
-    let (rocks, grading) = grade_cells(&cells, &sizes, &mut rng)?;
+    let (mut rocks, grading) = grade_cells(&cells, &sizes, &mut rng)?;
+    // One grid cell per largest rock, so that the curve steps from a rock to a neighbour.
+    order_rocks_spatially(&mut rocks, &params.region.min, sizes.max_size());
     Ok(Sample {
         rocks,
         sizes,

@@ -5,7 +5,8 @@
 //! - [`seeds`]: the seed count of eq. 28 and uniform random seeds in a box;
 //! - [`voronoi`]: the 3D Voronoi cells of the seeds (voro++ through `voro_rs`);
 //! - [`grading`]: eq. 29's shrinking of each cell toward its seed to a graded rock;
-//! - [`generation`]: the three above end to end;
+//! - [`spatial_order`]: the rocks numbered along a Z-order curve of their centres (memory locality);
+//! - [`generation`]: the above end to end;
 //! - [`statistics`]: realised size distribution and shape statistics;
 //! - [`projectile`]: the ogive-nosed projectile with its internal cavity (mass properties solid − cavity);
 //! - [`config`]: the experiment's parameters as data (Table 1 and what the paper does not state), the laws;
@@ -30,6 +31,7 @@ pub mod penetration;
 pub mod projectile;
 pub mod section;
 pub mod seeds;
+pub mod spatial_order;
 pub mod statistics;
 pub mod study;
 pub mod voronoi;

@@ -13,7 +13,11 @@
 //! - `removed_by_sleeping`: the kinetic energy of bodies when they fell asleep (their velocities are then
 //!   set to zero, see [`super::sleeping`]); part of the balance, not a column of [`EnergyReport`];
 //! - `external_work`: the work done on the system by walls and non-dynamic bodies with a prescribed
-//!   velocity, trapezoidal over the step (P = −F_on_wall·v_wall).
+//!   velocity, trapezoidal over the step (P = −F_on_wall·v_wall, both ends with the velocity that moves
+//!   the wall in that step: a wall whose velocity is changed between steps, like the packing's servo-driven
+//!   top wall, books the work it does. Taking the start of the step with the velocity of the previous
+//!   evaluation booked ~2× the work of a bang-bang servo wall: the compaction ledgers missed 50–58 % of
+//!   the wall's work).
 //!
 //! The balance E(t) + dissipated − external − tangential stiffness work − E(0) is zero for exact dynamics.
 //!
@@ -67,13 +71,13 @@
 //! implicitly in the second, and their work differs from the trapezoid by (Δt²/8) c (v_n·a_n −
 //! v_(n+1)·a_(n+1)), which telescopes (measured: fitted order 1.93, same test).
 
-use crate::dynamics::ViscousDamping;
+use crate::dynamics::{Motion, RigidBody, ViscousDamping};
 use crate::law::tangential::{release_spring, rotate_into_tangent_plane};
 use crate::law::{ContactModel, ContactResponse, TangentialHistory};
 use crate::math::Real;
 use crate::math::Vector;
 
-use super::world::World;
+use super::world::{Loads, Wall, World};
 
 /// Work accumulated since the start of the run (J).
 #[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -275,6 +279,23 @@ pub(crate) fn viscous_power(world: &World, coefficient: impl Fn(Real) -> Real) -
         .sum()
 }
 
+/// Power (W) delivered to the system through contacts by the prescribed bodies among `bodies` and by
+/// `walls`, with the contact loads `loads` and the velocities they have now: P = −Σ F·v (− Σ M·ω).
+/// `bodies` may be empty when none is prescribed (the sum skips them anyway).
+pub(super) fn external_power(loads: &Loads, bodies: &[RigidBody], walls: &[Wall]) -> Real {
+    let mut power = 0.0;
+    for (i, body) in bodies.iter().enumerate() {
+        if let Motion::Prescribed { .. } = body.motion {
+            power -= loads.forces[i].dot(&body.velocity)
+                + loads.torques[i].dot(&body.angular_velocity());
+        }
+    }
+    for (w, wall) in walls.iter().enumerate() {
+        power -= loads.wall_forces[w].dot(&wall.velocity);
+    }
+    power
+}
+
 /// The powers stage 9 integrates over a step by the trapezoid rule, as they were at its start: the
 /// external power of the moving walls and the global viscous damping's power. Both step paths (the
 /// general one and [`super::sphere_step`]) take them at the start and close the step with them.
@@ -294,10 +315,13 @@ fn damping_power(damping: ViscousDamping, world: &World) -> Real {
 }
 
 impl StepPowers {
-    /// The powers at the start of a step.
+    /// The powers at the start of a step. The external power is taken with the velocities the walls and
+    /// prescribed bodies have now, i.e. those this step moves them with: a caller that changed a velocity
+    /// since the last evaluation (a servo-controlled wall) would otherwise book the work of the old one.
+    /// With unchanged velocities it is the evaluation's `external_power`, bit for bit.
     pub(super) fn at_start(damping: ViscousDamping, world: &World) -> Self {
         Self {
-            external: world.loads.external_power,
+            external: external_power(&world.loads, &world.bodies, &world.walls),
             viscous: damping_power(damping, world),
         }
     }

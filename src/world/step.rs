@@ -49,7 +49,7 @@ use crate::shape::Shape;
 use super::body_inputs;
 use super::contact_store::BodyAdjacency;
 use super::contact_store::{ContactKey, ContactState};
-use super::energy::{ContactWork, LastForces, StepPowers};
+use super::energy::{external_power, ContactWork, LastForces, StepPowers};
 use super::parallel::{
     for_each_chunked, for_each_item3_checked, for_each_item4, for_each_item_checked,
     for_each_item_pair, integration_work, Parallelism, Worker,
@@ -790,22 +790,12 @@ pub(super) fn evaluate_loads(
     }
     counters.contacts += report.contacts as u64;
     // Power delivered to the system by everything that moves without responding to forces.
-    let mut external_power = 0.0;
     let prescribed = if scratch.any_prescribed {
         world.bodies.as_slice()
     } else {
         &[]
     };
-    for (i, body) in prescribed.iter().enumerate() {
-        if let Motion::Prescribed { .. } = body.motion {
-            external_power -= loads.forces[i].dot(&body.velocity)
-                + loads.torques[i].dot(&body.angular_velocity());
-        }
-    }
-    for (w, wall) in world.walls.iter().enumerate() {
-        external_power -= loads.wall_forces[w].dot(&wall.velocity);
-    }
-    loads.external_power = external_power;
+    loads.external_power = external_power(loads, prescribed, &world.walls);
     loads.current = true;
     region_profile::serial_end(Section::SerialSums, profile_sums);
     let elapsed = t.elapsed();
