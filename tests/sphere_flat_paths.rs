@@ -149,7 +149,10 @@ fn other_rotation(file: &str) -> Simulation {
             }
         }
     }
-    assert!(flipped > 0, "{file}: no material pair with a tangential spring");
+    assert!(
+        flipped > 0,
+        "{file}: no material pair with a tangential spring"
+    );
     sim
 }
 

@@ -501,12 +501,31 @@ mod tests {
         let (mut h1, mut h2) = (TangentialHistory::default(), TangentialHistory::default());
         for _ in 0..5 {
             let a = incremental_spring_damped(
-                SpringRotation::Exact, 1e5, 0.3, 0.0, &normal, 10.0, &v, 1e-5, &mut h1,
+                SpringRotation::Exact,
+                1e5,
+                0.3,
+                0.0,
+                &normal,
+                10.0,
+                &v,
+                1e-5,
+                &mut h1,
             );
             let b = incremental_spring_damped(
-                SpringRotation::Projection, 1e5, 0.3, 0.0, &normal, 10.0, &v, 1e-5, &mut h2,
+                SpringRotation::Projection,
+                1e5,
+                0.3,
+                0.0,
+                &normal,
+                10.0,
+                &v,
+                1e-5,
+                &mut h2,
             );
-            assert_eq!(a.force, b.force, "fixed normal: exact {a:?}, projection {b:?}");
+            assert_eq!(
+                a.force, b.force,
+                "fixed normal: exact {a:?}, projection {b:?}"
+            );
         }
     }
 
