@@ -499,29 +499,12 @@ mod tests {
         let normal = Vector::new(0.0, 0.0, 1.0);
         let v = Vector::new(0.1, 0.05, 0.0);
         let (mut h1, mut h2) = (TangentialHistory::default(), TangentialHistory::default());
+        let spring = |rule, history: &mut TangentialHistory| {
+            incremental_spring_damped(rule, 1e5, 0.3, 0.0, &normal, 10.0, &v, 1e-5, history)
+        };
         for _ in 0..5 {
-            let a = incremental_spring_damped(
-                SpringRotation::Exact,
-                1e5,
-                0.3,
-                0.0,
-                &normal,
-                10.0,
-                &v,
-                1e-5,
-                &mut h1,
-            );
-            let b = incremental_spring_damped(
-                SpringRotation::Projection,
-                1e5,
-                0.3,
-                0.0,
-                &normal,
-                10.0,
-                &v,
-                1e-5,
-                &mut h2,
-            );
+            let a = spring(SpringRotation::Exact, &mut h1);
+            let b = spring(SpringRotation::Projection, &mut h2);
             assert_eq!(
                 a.force, b.force,
                 "fixed normal: exact {a:?}, projection {b:?}"
