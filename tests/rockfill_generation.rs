@@ -5,6 +5,7 @@ use polydem::contact::{sat_polyhedra, ContactKind};
 use polydem::math::Point;
 use polydem::rockfill::grading::{equivalent_diameter, grade_cells, SizeDistribution};
 use polydem::rockfill::seeds::{random_seeds, Region};
+use polydem::rockfill::spatial_order::morton_key;
 use polydem::rockfill::statistics::sample_statistics;
 use polydem::rockfill::voronoi::tessellate;
 use polydem::rockfill::{generate, GenerationParams};
@@ -176,4 +177,34 @@ fn realised_sizes_follow_the_requested_distribution() {
         sample.tessellation_time,
         sample.grading_time
     );
+}
+
+#[test]
+fn generated_rocks_are_numbered_along_the_z_order_curve() {
+    // generate() numbers the rocks along the Z-order curve of their centres on a grid of the largest rock
+    // size from the region's corner (src/rockfill/spatial_order.rs): the keys never decrease.
+    let region = region();
+    let params = GenerationParams::new(region, 0.1, 5);
+    let sample = generate(&params).unwrap();
+    let cell = sample.sizes.max_size();
+    let keys: Vec<u64> = sample
+        .rocks
+        .iter()
+        .map(|rock| {
+            let c = rock.pose.translation.vector;
+            let [i, j, k] =
+                [0, 1, 2].map(|a| ((c[a] - region.min[a]) / cell).floor().max(0.0) as u64);
+            morton_key(i, j, k)
+        })
+        .collect();
+    assert!(sample.rocks.len() > 100, "{} rocks", sample.rocks.len());
+    for (n, pair) in keys.windows(2).enumerate() {
+        assert!(
+            pair[0] <= pair[1],
+            "rocks {n} and {}: Z-order keys {} then {} (cell {cell} m)",
+            n + 1,
+            pair[0],
+            pair[1]
+        );
+    }
 }

@@ -319,6 +319,8 @@ impl StepPowers {
     /// prescribed bodies have now, i.e. those this step moves them with: a caller that changed a velocity
     /// since the last evaluation (a servo-controlled wall) would otherwise book the work of the old one.
     /// With unchanged velocities it is the evaluation's `external_power`, bit for bit.
+    /// It costs one pass over the bodies' motion tags per step (the prescribed ones may have been changed
+    /// too, and a step after a checkpoint load has no record of which bodies are prescribed).
     pub(super) fn at_start(damping: ViscousDamping, world: &World) -> Self {
         Self {
             external: external_power(&world.loads, &world.bodies, &world.walls),
