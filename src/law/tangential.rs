@@ -61,6 +61,17 @@ pub struct TangentialHistory {
 }
 
 impl TangentialHistory {
+    /// Whether every field holds the bits of [`TangentialHistory::default`] (+0.0: a spring with a −0.0
+    /// component is not cleared, so that skipping the store of a cleared spring never changes a bit).
+    #[inline(always)]
+    pub fn is_cleared(&self) -> bool {
+        let (u, n) = (&self.displacement, &self.normal);
+        (u.x.to_bits() | u.y.to_bits() | u.z.to_bits())
+            | (n.x.to_bits() | n.y.to_bits() | n.z.to_bits())
+            | self.stiffness.to_bits()
+            == 0
+    }
+
     /// The same history seen from the swapped pair (B, A).
     pub fn swapped(&self) -> Self {
         Self {

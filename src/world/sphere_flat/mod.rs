@@ -51,6 +51,12 @@
 //! ones per sphere), list rebuilds (bed b: ~3800 instructions per sphere and build with the constants,
 //! ~16 % of its instructions at 71 builds; the fast bed spheres the projectile throws, not only the
 //! projectile (listed with four skins), use up the skin), integration. The target (≤ ~900) is not reached.
+//! Since then (time, not instructions: `examples/sphere_bed_speed`, 5000 steps, one thread, quiet, same final
+//! checksums): a separated pair no longer stores its cleared spring and flag again ([`pair`]), and the kicks
+//! leave out the viscous-damping terms this path never has ([`step`]): bed a 1.31–1.51 s (five of six runs
+//! ≤ 1.37 s) against 1.49–1.54 s, b 2.19–2.35 against 2.34–2.49, c 1.08–1.17 against 1.31–1.42 (release
+//! build, six and three runs, 2026-11-22; `perf record` of bed a then
+//! puts ~73 % of the samples in the pair loop and ~17 % in the kicks and drift).
 //!
 //! # Validity of the owned state
 //! From [`SphereSim::from_world`] on, the simulation owns the state: the world it came from is stale

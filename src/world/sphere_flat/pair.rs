@@ -305,8 +305,17 @@ pub(crate) fn scaled(model: &ContactModel, root_radius: Real) -> ContactModel {
 }
 
 /// A candidate that does not overlap: the law resets its spring, and it contributes nothing.
+///
+/// A pair that stays apart already holds the cleared spring, and so does its output flag: both are only
+/// read then, not stored again. The stores dirtied the lists' cache lines of every separated pair on every
+/// step (bed a: ~1.4 of ~3.7 listed pairs per sphere; the history store took 17.5 % of the samples of
+/// `perf record`, 2026-11-22).
 #[inline(always)]
 fn separated(history: &mut TangentialHistory, out: &mut PairOut) {
-    *history = TangentialHistory::default();
-    out.overlapping = false;
+    if !history.is_cleared() {
+        *history = TangentialHistory::default();
+    }
+    if out.overlapping {
+        out.overlapping = false;
+    }
 }
