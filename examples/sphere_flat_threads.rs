@@ -6,8 +6,9 @@
 //! Each scene is warmed up on the flat path (so that the lattice is in contact), then the same stretch of
 //! steps is run from the warm state once per thread count, alternately, `--repeat` times back to back.
 //! Printed per run: wall time, process CPU time (all threads), particle-steps/s (wall), the load average,
-//! and whether the final state is bit-identical to the first thread count's; then the median and range of
-//! the speed-up.
+//! the wall time per step of each stage (the step's counters: kick and drift, lists, pair loop, walls and
+//! ledger) and whether the final state is bit-identical to the first thread count's; then the median and
+//! range of the speed-up.
 //!
 //! ```text
 //! cargo run --release --example sphere_flat_threads -- [--steps N] [--warm-up N] [--threads 1,2]
@@ -135,19 +136,34 @@ fn main() -> Result<(), String> {
                 let mut sim = warm.clone();
                 let load = load_average();
                 let (cpu0, t) = (cpu_time(), Instant::now());
+                let mut stages = [Duration::ZERO; 4];
+                let mut rebuilds = 0;
                 pool.install(|| -> Result<(), String> {
                     for _ in 0..o.steps {
-                        sim.step().map_err(|e| e.to_string())?;
+                        let c = sim.step().map_err(|e| e.to_string())?.counters;
+                        for (total, d) in
+                            stages
+                                .iter_mut()
+                                .zip([c.integrate, c.broad, c.narrow, c.accumulate])
+                        {
+                            *total += d;
+                        }
+                        rebuilds += c.broad_rebuilds;
                     }
                     Ok(())
                 })?;
                 let wall = t.elapsed().as_secs_f64();
+                let per_step = |d: Duration| d.as_secs_f64() * 1e6 / o.steps as f64;
                 let cpu = (cpu_time() - cpu0).as_secs_f64();
                 let bits = state_bits(&sim);
                 let same = first.as_ref().map(|(b, _)| *b == bits);
                 let rate = sim.len() as f64 * o.steps as f64 / wall;
                 println!(
-                    "  round {round}, {threads} thread(s): wall {wall:.3} s, CPU {cpu:.3} s, {rate:.3e} particle-steps/s, load {load}{}",
+                    "  round {round}, {threads} thread(s): wall {wall:.3} s, CPU {cpu:.3} s, {rate:.3e} particle-steps/s, load {load}; µs per step: kick+drift {:.1}, lists {:.1} ({rebuilds} builds), pairs {:.1}, walls {:.1}{}",
+                    per_step(stages[0]),
+                    per_step(stages[1]),
+                    per_step(stages[2]),
+                    per_step(stages[3]),
                     match same {
                         Some(true) => ", bit-identical to the first".to_owned(),
                         Some(false) => ", DIFFERS from the first".to_owned(),
