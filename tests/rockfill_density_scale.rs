@@ -158,7 +158,7 @@ fn packing_with_density_scale_ends_at_the_true_masses_with_the_ledger_closed_and
 }
 
 #[test]
-fn the_density_scaled_file_is_paper_toml_but_for_its_density_scaling_lines() {
+fn the_density_scaled_file_is_paper_toml_but_for_its_100_mm_lines() {
     let path = "scenes/rockfill/paper_density_scaled.toml";
     let scaled = ExperimentConfig::parse(
         include_str!("../scenes/rockfill/paper_density_scaled.toml"),
@@ -172,8 +172,12 @@ fn the_density_scaled_file_is_paper_toml_but_for_its_density_scaling_lines() {
     expected.packing.max_deposition_time = 2.0;
     expected.packing.packing_density_scale = Some(16.0);
     expected.packing.restore_time = Some(0.1);
+    expected.packing.generation_height_factor = 2.75;
+    expected.sleeping.penetration = true;
+    expected.sleeping.wake_contact_fraction = 0.03;
     assert_eq!(
         scaled, expected,
-        "{path} differs from paper.toml elsewhere than in mean_size, max_deposition_time and the density scaling"
+        "{path} differs from paper.toml elsewhere than in mean_size, max_deposition_time, the density scaling, \
+         the generation height factor and the penetration's sleeping"
     );
 }
