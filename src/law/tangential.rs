@@ -394,6 +394,29 @@ mod tests {
     use crate::math::Rotation;
 
     #[test]
+    fn only_the_bits_of_the_default_history_count_as_cleared() {
+        assert!(TangentialHistory::default().is_cleared());
+        let mut fields: Vec<(&str, TangentialHistory)> = Vec::new();
+        for (name, value) in [("a tiny displacement", 1e-300), ("a negative zero", -0.0)] {
+            let mut h = TangentialHistory::default();
+            h.displacement.y = value;
+            fields.push((name, h));
+            let mut h = TangentialHistory::default();
+            h.normal.z = value;
+            fields.push((name, h));
+            let mut h = TangentialHistory::default();
+            h.stiffness = value;
+            fields.push((name, h));
+        }
+        for (what, h) in fields {
+            assert!(
+                !h.is_cleared(),
+                "a history with {what} ({h:?}) reported as cleared: skipping its store would keep it"
+            );
+        }
+    }
+
+    #[test]
     fn spring_is_rotated_rigidly_with_the_normal() {
         let n_old = Vector::new(0.0, 0.0, 1.0);
         let u = Vector::new(2e-5, -1e-5, 0.0);
