@@ -404,8 +404,10 @@ mod tests {
             let mut h = TangentialHistory::default();
             h.normal.z = value;
             fields.push((name, h));
-            let mut h = TangentialHistory::default();
-            h.stiffness = value;
+            let h = TangentialHistory {
+                stiffness: value,
+                ..TangentialHistory::default()
+            };
             fields.push((name, h));
         }
         for (what, h) in fields {
