@@ -237,3 +237,62 @@ fn flat_path_is_the_same_on_one_two_and_four_threads() {
         );
     }
 }
+
+/// Every step reports the same overlap warnings on both paths, pairs between spheres then pairs with
+/// walls, on one thread (one block of the pair loop) and on two (four blocks). The warning fraction is 0,
+/// so every overlapping contact is a warning: the lists compared are the steps' whole contact lists.
+#[test]
+fn flat_path_reports_the_overlap_warnings_of_the_general_step() {
+    let mut sim = scene("scenes/sphere_bed_a_hertz_5ms.toml");
+    sim.params.overlap_warning_fraction = 0.0;
+    let steps = 60;
+    let mut world = sim.world.clone();
+    let mut scratch = StepScratch::default();
+    let reference: Vec<_> = (0..steps)
+        .map(|_| {
+            step(&sim.params, &mut world, &mut scratch)
+                .unwrap_or_else(|e| panic!("general step: {e}"))
+                .overlap_warnings
+        })
+        .collect();
+    for threads in [1, 2] {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .expect("pool");
+        let warnings: Vec<_> = pool.install(|| {
+            let mut flat = SphereSim::from_world(&sim.world, &sim.params)
+                .unwrap_or_else(|e| panic!("the sphere bed must take the flat path: {e}"));
+            (0..steps)
+                .map(|_| {
+                    flat.step()
+                        .unwrap_or_else(|e| panic!("flat step: {e}"))
+                        .overlap_warnings
+                })
+                .collect()
+        });
+        for (k, (flat, general)) in warnings.iter().zip(&reference).enumerate() {
+            let walls = |w: &[polydem::world::step::OverlapWarning]| {
+                w.iter()
+                    .filter(|w| matches!(w.key, ContactKey::Wall { .. }))
+                    .count()
+            };
+            assert!(
+                flat == general,
+                "step {k}, {threads} thread(s): {} flat warnings ({} with walls) against {} general \
+                 ({} with walls)",
+                flat.len(),
+                walls(flat),
+                general.len(),
+                walls(general)
+            );
+            assert!(
+                walls(general) > 100 && general.len() > walls(general) + 1000,
+                "step {k}: {} warnings, {} with walls: expected > 100 with walls and > 1000 between \
+                 spheres for a test that can fail",
+                general.len(),
+                walls(general)
+            );
+        }
+    }
+}

@@ -46,6 +46,17 @@ pub(super) struct Found {
 }
 
 impl Found {
+    /// The error to report (a body pair's before a wall pair's), else what was found, with the warnings
+    /// of body pairs then of wall pairs as one list (the general step's key order).
+    fn finish(mut self) -> Result<Found, StepError> {
+        if let Some(e) = self.error.take().or(self.wall_error.take()) {
+            return Err(e);
+        }
+        let wall_warnings = std::mem::take(&mut self.wall_warnings);
+        self.warnings.extend(wall_warnings);
+        Ok(self)
+    }
+
     fn merge(mut self, other: Found) -> Found {
         self.scattered |= other.scattered;
         self.contacts += other.contacts;
@@ -418,10 +429,9 @@ impl SphereSim {
                 }
             }
             self.outs_valid = true;
-            return match found.error {
-                Some(e) => Err(e),
-                None => Ok(found),
-            };
+            // Before 2026-11-22 (evening) this returned without joining the wall warnings to the list: a step on
+            // one block reported no overlap warning against a wall.
+            return found.finish();
         }
         // One block: bodies `first..first + force.len()`, their rows of pairs and their walls, in pair
         // order; the loads of every body of the block that no other block's pair reaches are summed here.
@@ -533,13 +543,7 @@ impl SphereSim {
                 .fold(Found::default(), Found::merge)
         };
         self.outs_valid = true;
-        let mut found = found;
-        if let Some(e) = found.error.take().or(found.wall_error.take()) {
-            return Err(e);
-        }
-        let wall_warnings = std::mem::take(&mut found.wall_warnings);
-        found.warnings.extend(wall_warnings);
-        Ok(found)
+        found.finish()
     }
 
     /// Stage 6 alone (the evaluation of an initial state): every sphere's sums (unless the pair loop
