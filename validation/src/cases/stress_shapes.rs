@@ -412,16 +412,40 @@ impl Case for StressShapes {
         let mass_run = run_scene("mass_ratio", sim, p.steps, p.oracle_every);
         ctx.progress().inc(1);
 
-        // Initial overlaps, released in free space: one run per level.
+        // Initial overlaps, released in free space: one run per level, the pair smoothing band by the
+        // rule of `polydem::contact::wall_depth` (h ≈ the scene's characteristic overlap: here the
+        // initial overlap, f × L). The band sweep below shows what the default band (1e-4 L) does.
         let mut overlap_runs = Vec::new();
         let mut reached = Vec::new();
+        let mut sweep = Vec::new();
         for (k, &f) in p.overlaps.iter().enumerate() {
             let mut level_rng = ChaCha8Rng::seed_from_u64(p.seed + 1 + k as u64);
             let (t, r) = overlap_scene(&p, &mut level_rng, &[f])?;
             reached.extend(r);
-            let sim = t.build(CASE, "overlaps")?;
+            let mut sim = t.build(CASE, "overlaps")?;
+            let default_band = sim.params.tolerances.pair_smoothing;
+            sim.params.tolerances.pair_smoothing = PairSmoothing::Smoothed { band: f };
             let steps = (p.release_contact_times * sim.time_step.contact_time / sim.params.dt)
                 .ceil() as u64;
+            for (band_name, band) in [
+                ("default", default_band),
+                ("rule", sim.params.tolerances.pair_smoothing),
+            ] {
+                for refine in [1u64, 2] {
+                    let mut s = sim.clone();
+                    s.params.tolerances.pair_smoothing = band;
+                    s.params.dt /= refine as Real;
+                    let run = run_monitored(&mut s, steps * refine, 1, |_| {});
+                    sweep.push((
+                        f,
+                        band_name,
+                        band,
+                        refine,
+                        run.energy_error_max,
+                        run.step_error,
+                    ));
+                }
+            }
             overlap_runs.push(run_scene(&format!("overlap_{f}"), sim, steps, 4));
         }
         ctx.progress().inc(1);
@@ -541,6 +565,48 @@ impl Case for StressShapes {
                 .collect::<Vec<_>>()
                 .join(", ")
         ));
+        ctx.section("Overlap releases: smoothing band and time step");
+        let rows: Vec<Vec<String>> = sweep
+            .chunks(2)
+            .map(|pair| {
+                let (f, name, band, _, e1, err1) = &pair[0];
+                let (_, _, _, _, e2, err2) = &pair[1];
+                let band = match band {
+                    PairSmoothing::Smoothed { band } => format!("{band:.1e} L ({name})"),
+                    PairSmoothing::Exact => format!("exact ({name})"),
+                };
+                let error = |e: &Real, err: &Option<String>| match err {
+                    Some(msg) => format!("step error: {msg}"),
+                    None => format!("{e:.3e}"),
+                };
+                vec![
+                    format!("{f}"),
+                    band,
+                    error(e1, err1),
+                    error(e2, err2),
+                    format!("{:.2}", (e1 / e2).log2()),
+                ]
+            })
+            .collect();
+        ctx.table(
+            Some("overlap_band_sweep"),
+            &[
+                "initial overlap / L",
+                "pair smoothing band h",
+                "max abs(balance)/E0 at Δt",
+                "at Δt/2",
+                "observed order",
+            ],
+            &rows,
+        )?;
+        ctx.text(
+            "The checked runs above use the rule band (h = the initial overlap). With the default band, \
+             1e-4 L, far below these overlaps, the switch of the deepest vertex below a face (a kink of \
+             kind (a) of `polydem::contact::pair_smoothing`) happens within one step: the force line jumps. \
+             At the 0.25 level the balance read at that one step is off by an amount proportional to Δt \
+             (the observed order about 1), while the steps before and after it stay an order of magnitude \
+             lower. The rule band smooths the switch over many steps: second order at every level.",
+        );
         ctx.plot(&Plot {
             name: "energy_error".into(),
             title: "Energy error of the extreme-shape runs".into(),
