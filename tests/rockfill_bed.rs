@@ -1,7 +1,8 @@
 //! The packed bed saved as an engine checkpoint (issue 6: "the packed bed saved as a checkpoint so each
 //! penetration run starts from it"): the penetration run from the saved bed is the run straight after
-//! packing, every monitor row bitwise equal; the study and convergence drivers write their tables; the ZY
-//! section of a cube is its square.
+//! packing, every monitor row bitwise equal, and takes the experiment file's contact laws (a changed rock
+//! density is refused); the study and convergence drivers write their tables; the ZY section of a cube is
+//! its square.
 
 use polydem::math::{Point, Pose};
 use polydem::rockfill::bed::{has_checkpoint, load_bed_info};
@@ -75,6 +76,40 @@ fn penetration_from_the_saved_bed_equals_penetration_straight_after_packing() {
             bits(rb),
             "monitor row {k} differs: straight {ra:?}, from the saved bed {rb:?}"
         );
+    }
+
+    // The experiment file's contact laws apply to a bed read from its checkpoint (not the laws stored in
+    // it), and say so; a changed rock density is refused.
+    let mut stiffer = config;
+    stiffer.contact.normal_stiffness *= 4.0;
+    let mut notes = Vec::new();
+    let mut record = |stage: &str, msg: String| notes.push(format!("{stage}: {msg}"));
+    let stiff =
+        run_experiment_with(&stiffer, BedSource::Load(&dir), &options, &mut record).unwrap();
+    assert!(
+        notes.iter().any(|n| n.contains("contact laws differ")),
+        "no note of the changed laws among {notes:?}"
+    );
+    let energy =
+        |r: &polydem::rockfill::experiment::ExperimentResult| r.penetration.projectile_energy_loss;
+    assert!(
+        energy(&stiff) != energy(&straight),
+        "k_n x 4 from the saved bed: the projectile lost {} J, as with the bed's own laws ({} J): \
+         the file's laws were not applied",
+        energy(&stiff),
+        energy(&straight)
+    );
+    let mut denser = config;
+    denser.rock.density *= 1.5;
+    match run_experiment_with(&denser, BedSource::Load(&dir), &options, &mut quiet) {
+        Err(e) => assert!(
+            e.to_string().contains("density"),
+            "a changed rock density: expected an error naming the density, got '{e}'"
+        ),
+        Ok(_) => panic!(
+            "a bed packed at {} kg/m³ ran with rock.density {} kg/m³",
+            config.rock.density, denser.rock.density
+        ),
     }
     std::fs::remove_dir_all(&dir).ok();
 }

@@ -9,7 +9,9 @@ use super::bed::{
 use super::collapse::{collapse, CollapseParams};
 use super::config::ExperimentConfig;
 use super::generation::{generate, GenerationError, GenerationParams, Sample};
-use super::packing::{load_bed, loose_world, pack, save_bed, PackingError, PackingReport};
+use super::packing::{
+    empty_world, load_bed, loose_world, pack, save_bed, PackingError, PackingReport,
+};
 use super::penetration::{
     add_projectile, penetrate_with, MonitorRow, PenetrationError, PenetrationOptions,
     PenetrationReport,
@@ -36,6 +38,16 @@ pub enum ExperimentError {
     Penetration(#[from] PenetrationError),
     #[error(transparent)]
     Bed(#[from] BedError),
+    #[error(
+        "bed {dir}: rock {rock} has density {bed} kg/m³ (mass over volume), the experiment file's rock.density \
+         is {config} kg/m³; pack a new bed, or set rock.density to the bed's"
+    )]
+    BedDensity {
+        dir: String,
+        rock: usize,
+        bed: Real,
+        config: Real,
+    },
 }
 
 /// Where the bed comes from.
@@ -100,6 +112,41 @@ pub fn generate_sample(config: &ExperimentConfig) -> Result<Sample, ExperimentEr
     Ok(generate(&params)?)
 }
 
+/// A bed read from its checkpoint keeps its rocks (shapes, masses, state) and takes the contact laws of
+/// the experiment file, as a bed read from its CSV files does: the checkpoint also stores the laws it was
+/// packed with, and a file changed since (a stiffness study from one bed) must not be silently overruled.
+/// A changed rock density cannot be applied to packed rocks (their weights set the bed): an error.
+fn apply_experiment_laws(
+    config: &ExperimentConfig,
+    dir: &Path,
+    world: &mut World,
+    progress: Progress,
+) -> Result<(), ExperimentError> {
+    for i in 0..world.bodies.len() {
+        if let crate::shape::Shape::Polyhedron(p) = world.shape(i) {
+            let bed = world.bodies[i].mass / p.mass_properties().volume;
+            if (bed - config.rock.density).abs() > 1e-9 * config.rock.density {
+                return Err(ExperimentError::BedDensity {
+                    dir: dir.display().to_string(),
+                    rock: i,
+                    bed,
+                    config: config.rock.density,
+                });
+            }
+        }
+    }
+    let laws = empty_world(config, world.broad_phase.skin())?.materials;
+    if world.materials != laws {
+        progress(
+            "bed",
+            "the experiment file's contact laws differ from those the bed was packed with: the run uses the file's"
+                .into(),
+        );
+        world.materials = laws;
+    }
+    Ok(())
+}
+
 /// Runs the experiment (see the module docs).
 pub fn run_experiment(
     config: &ExperimentConfig,
@@ -143,6 +190,10 @@ pub fn run_experiment_with(
             } else {
                 load_bed(config, dir)?
             };
+            let mut world = world;
+            if checkpoint {
+                apply_experiment_laws(config, dir, &mut world, &mut *progress)?;
+            }
             progress(
                 "bed",
                 format!(
