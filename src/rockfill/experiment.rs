@@ -167,7 +167,7 @@ pub fn run_experiment_with(
     let (mut world, generation, packing, bed_info, from_checkpoint) = match bed {
         BedSource::Load(dir) => {
             let mut checkpoint = has_checkpoint(dir);
-            let world = if checkpoint {
+            let mut world = if checkpoint {
                 match load_bed_checkpoint(dir) {
                     Ok(world) => world,
                     // A checkpoint of another format version (written by another build): the CSV files of
@@ -190,7 +190,6 @@ pub fn run_experiment_with(
             } else {
                 load_bed(config, dir)?
             };
-            let mut world = world;
             if checkpoint {
                 apply_experiment_laws(config, dir, &mut world, &mut *progress)?;
             }
