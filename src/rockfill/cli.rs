@@ -6,6 +6,8 @@
 //!                        [--section-sizes K] [--reuse-beds] --out DIR
 //! polydem rockfill convergence [--config FILE | --full] [--dt-divisors 1,2,4] [--sections 1.0,1.5,2.0]
 //!                        [--no-time-step] [--bed DIR] --out DIR
+//! polydem rockfill sensitivity [--config FILE | --full] [--size MM] [--seed N] --bed DIR
+//!                        --vary contact.friction=0,0.4 [--vary ...] --out DIR
 //! ```
 //! Without a subcommand it runs one experiment: the quick variant (`scenes/rockfill/quick.toml`, compiled in)
 //! or with `--full` the full-scale layer (`scenes/rockfill/paper.toml`). `--bed DIR` starts from a bed saved
@@ -16,7 +18,8 @@
 //! and `summary.txt` (also printed).
 //!
 //! `study` runs the size study ([`super::study`]); `convergence` the time-step and rock-count sequences
-//! ([`super::convergence`]).
+//! ([`super::convergence`]); `sensitivity` the one-at-a-time contact-parameter runs from one bed
+//! ([`super::sensitivity`]).
 
 use std::fmt::Write as _;
 use std::path::PathBuf;
@@ -27,6 +30,7 @@ use super::config::ExperimentConfig;
 use super::convergence::{run_convergence, ConvergenceParams};
 use super::experiment::ExperimentResult;
 use super::packing::STAGE_NAMES;
+use super::sensitivity::{run_sensitivity, sensitivity_table, SensitivityParams, Variation};
 use super::study::{run_one, run_study, StudyParams};
 
 /// Options of `polydem rockfill`.
@@ -99,6 +103,33 @@ pub enum RockfillCommand {
     Study(StudyArgs),
     /// Time-step and rock-count convergence with a work-precision plot (OUT/convergence.csv, .svg).
     Convergence(ConvergenceArgs),
+    /// Contact-parameter sensitivity from one saved bed, one parameter at a time (OUT/sensitivity.md, .csv).
+    Sensitivity(SensitivityArgs),
+}
+
+/// Options of `polydem rockfill sensitivity`.
+#[derive(clap::Args, Debug, Clone)]
+pub struct SensitivityArgs {
+    #[command(flatten)]
+    pub experiment: ExperimentArgs,
+    /// The bed's mean rock size (mm), when the file's is another (sets the time step and the disturbed
+    /// zone's unit).
+    #[arg(long)]
+    pub size: Option<f64>,
+    /// The bed's seed, when the file's is another (for the labels).
+    #[arg(long)]
+    pub seed: Option<u64>,
+    /// The saved bed every run starts from (directory with bed.pdck or bed_*.csv).
+    #[arg(long)]
+    pub bed: PathBuf,
+    /// A parameter and its values, KEY=V1,V2,... (repeatable). Keys: contact.stiffness_factor (k_n and
+    /// k_s together), contact.normal_stiffness, contact.tangential_stiffness, contact.friction,
+    /// contact.restitution_rocks, contact.restitution_projectile.
+    #[arg(long, required = true, value_parser = Variation::parse)]
+    pub vary: Vec<Variation>,
+    /// Output directory.
+    #[arg(long, default_value = "out/rockfill_sensitivity")]
+    pub out: PathBuf,
 }
 
 /// Options of `polydem rockfill study`.
@@ -150,19 +181,11 @@ pub fn run(args: &RockfillArgs) -> Result<()> {
     match &args.command {
         Some(RockfillCommand::Study(a)) => return study(a),
         Some(RockfillCommand::Convergence(a)) => return convergence(a),
+        Some(RockfillCommand::Sensitivity(a)) => return sensitivity(a),
         None => {}
     }
     let (mut config, _) = args.experiment.load()?;
-    if let Some(mm) = args.size {
-        anyhow::ensure!(
-            mm.is_finite() && mm > 0.0,
-            "--size {mm}: must be positive (mm)"
-        );
-        config.rock.mean_size = mm * 1e-3;
-    }
-    if let Some(seed) = args.seed {
-        config.rock.seed = seed;
-    }
+    override_sample(&mut config, args.size, args.seed)?;
     let mut progress = |stage: &str, text: String| eprintln!("[{stage}] {text}");
     let title = format!(
         "{} mm rocks, seed {}",
@@ -177,6 +200,44 @@ pub fn run(args: &RockfillArgs) -> Result<()> {
         &mut progress,
     )?;
     print!("{}", summary(&config, &result));
+    Ok(())
+}
+
+/// `--size MM` and `--seed N` applied to the file's sample.
+fn override_sample(
+    config: &mut ExperimentConfig,
+    size: Option<f64>,
+    seed: Option<u64>,
+) -> Result<()> {
+    if let Some(mm) = size {
+        anyhow::ensure!(
+            mm.is_finite() && mm > 0.0,
+            "--size {mm}: must be positive (mm)"
+        );
+        config.rock.mean_size = mm * 1e-3;
+    }
+    if let Some(seed) = seed {
+        config.rock.seed = seed;
+    }
+    Ok(())
+}
+
+fn sensitivity(a: &SensitivityArgs) -> Result<()> {
+    let (mut base, label) = a.experiment.load()?;
+    override_sample(&mut base, a.size, a.seed)?;
+    let params = SensitivityParams {
+        base,
+        bed: a.bed.clone(),
+        variations: a.vary.clone(),
+        out: a.out.clone(),
+        label,
+    };
+    let runs = run_sensitivity(&params, &mut |line| eprintln!("{line}"))?;
+    print!("{}", sensitivity_table(&params, &runs));
+    eprintln!(
+        "wrote {}/sensitivity.md and sensitivity.csv",
+        a.out.display()
+    );
     Ok(())
 }
 

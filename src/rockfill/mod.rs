@@ -31,6 +31,7 @@ pub mod penetration;
 pub mod projectile;
 pub mod section;
 pub mod seeds;
+pub mod sensitivity;
 pub mod spatial_order;
 pub mod statistics;
 pub mod study;

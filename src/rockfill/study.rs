@@ -52,6 +52,8 @@ pub enum StudyError {
     },
     #[error("study parameters: {0}")]
     Params(String),
+    #[error("sensitivity parameters: {0}")]
+    SensitivityParams(String),
 }
 
 /// What to run.
