@@ -81,7 +81,8 @@ impl Found {
 pub(super) const BLOCKS_PER_THREAD: usize = 2;
 
 /// The split of the pair loop into blocks of consecutive spheres, each with the pairs of its spheres'
-/// rows and their walls, of about equal numbers of pairs.
+/// rows and their walls, of about equal work: pairs weighted by whether they are in contact
+/// ([`CONTACT_WEIGHT`]; before 2026-11-22 (night), equal numbers of pairs).
 ///
 /// A block's pairs come in pair order, so a sphere all of whose pairs lie in its own block receives
 /// its loads in the order of the stage-6 gather (pairs (a, i) by increasing a, its row, its walls): the
@@ -99,14 +100,27 @@ pub(super) struct Blocks {
 impl Blocks {
     pub(super) fn new(list: &super::NeighbourList, wanted: usize) -> Self {
         let n = list.row_start.len().saturating_sub(1);
-        let total = list.a.len() + list.wall_of.len() + n;
+        // Per sphere: its row's pairs and its walls, a pair in contact counting CONTACT_WEIGHT, plus
+        // one for the sphere itself.
+        let cost = |histories: &[TangentialHistory]| -> usize {
+            histories
+                .iter()
+                .map(|h| if h.is_cleared() { 1 } else { CONTACT_WEIGHT })
+                .sum()
+        };
+        let weights: Vec<usize> = (0..n)
+            .map(|i| {
+                let (r0, r1) = (list.row_start[i] as usize, list.row_start[i + 1] as usize);
+                let (w0, w1) = (list.wall_start[i] as usize, list.wall_start[i + 1] as usize);
+                cost(&list.histories[r0..r1]) + cost(&list.wall_histories[w0..w1]) + 1
+            })
+            .collect();
+        let total: usize = weights.iter().sum();
         let target = total.div_ceil(wanted.max(1)).max(1);
         let mut bodies = Vec::with_capacity(wanted);
         let (mut first, mut weight) = (0, 0);
-        for i in 0..n {
-            weight += (list.row_start[i + 1] - list.row_start[i]) as usize
-                + (list.wall_start[i + 1] - list.wall_start[i]) as usize
-                + 1;
+        for (i, w) in weights.iter().enumerate() {
+            weight += w;
             if weight >= target && i + 1 < n {
                 bodies.push(first..i + 1);
                 (first, weight) = (i + 1, 0);
@@ -130,6 +144,16 @@ impl Blocks {
         }
     }
 }
+
+/// A listed pair's weight in the split into blocks when its spring holds a contact at the build (such a
+/// pair mostly stays in contact until the next build), against 1 for one that does not: the law costs
+/// several times the distance test, and the contacts crowd where the projectile strikes and at the
+/// floor, so blocks of equal pair counts are not blocks of equal work. 8 is the best of 1, 4, 6, 8, 12
+/// and 16 measured on the sphere beds a–c on two threads (`examples/sphere_flat_threads`, medians of 4–5
+/// runs, 2026-11-22: 1.43 / 1.67 / 1.43× over one thread with 1, 1.79 / 1.79 / 1.63× with 8); the
+/// 10^4-sphere settling scene is even within its noise. A frictionless law keeps no spring, so its
+/// pairs all weigh 1, as before.
+const CONTACT_WEIGHT: usize = 8;
 
 /// The slices of one block.
 struct BlockPart<'a> {
