@@ -41,18 +41,43 @@ pub struct RockfillArgs {
     pub command: Option<RockfillCommand>,
     #[command(flatten)]
     pub experiment: ExperimentArgs,
-    /// Override the mean rock size (mm).
-    #[arg(long)]
-    pub size: Option<f64>,
-    /// Override the random seed of the sample.
-    #[arg(long)]
-    pub seed: Option<u64>,
+    #[command(flatten)]
+    pub sample: SampleArgs,
     /// Start from a bed saved by an earlier run (directory with bed.pdck or bed_*.csv).
     #[arg(long)]
     pub bed: Option<PathBuf>,
     /// Output directory.
     #[arg(long, default_value = "out/rockfill")]
     pub out: PathBuf,
+}
+
+/// The sample: the file's mean rock size and seed, or these (for a run from a saved bed, the bed's: the
+/// size sets the time step and the disturbed zone's unit).
+#[derive(clap::Args, Debug, Clone)]
+pub struct SampleArgs {
+    /// Override the mean rock size (mm).
+    #[arg(long)]
+    pub size: Option<f64>,
+    /// Override the random seed of the sample.
+    #[arg(long)]
+    pub seed: Option<u64>,
+}
+
+impl SampleArgs {
+    /// `--size MM` and `--seed N` applied to the file's sample.
+    fn apply(&self, config: &mut ExperimentConfig) -> Result<()> {
+        if let Some(mm) = self.size {
+            anyhow::ensure!(
+                mm.is_finite() && mm > 0.0,
+                "--size {mm}: must be positive (mm)"
+            );
+            config.rock.mean_size = mm * 1e-3;
+        }
+        if let Some(seed) = self.seed {
+            config.rock.seed = seed;
+        }
+        Ok(())
+    }
 }
 
 /// The experiment file.
@@ -112,13 +137,9 @@ pub enum RockfillCommand {
 pub struct SensitivityArgs {
     #[command(flatten)]
     pub experiment: ExperimentArgs,
-    /// The bed's mean rock size (mm), when the file's is another (sets the time step and the disturbed
-    /// zone's unit).
-    #[arg(long)]
-    pub size: Option<f64>,
-    /// The bed's seed, when the file's is another (for the labels).
-    #[arg(long)]
-    pub seed: Option<u64>,
+    /// The bed's sample, when the file's is another.
+    #[command(flatten)]
+    pub sample: SampleArgs,
     /// The saved bed every run starts from (directory with bed.pdck or bed_*.csv).
     #[arg(long)]
     pub bed: PathBuf,
@@ -185,7 +206,7 @@ pub fn run(args: &RockfillArgs) -> Result<()> {
         None => {}
     }
     let (mut config, _) = args.experiment.load()?;
-    override_sample(&mut config, args.size, args.seed)?;
+    args.sample.apply(&mut config)?;
     let mut progress = |stage: &str, text: String| eprintln!("[{stage}] {text}");
     let title = format!(
         "{} mm rocks, seed {}",
@@ -203,28 +224,9 @@ pub fn run(args: &RockfillArgs) -> Result<()> {
     Ok(())
 }
 
-/// `--size MM` and `--seed N` applied to the file's sample.
-fn override_sample(
-    config: &mut ExperimentConfig,
-    size: Option<f64>,
-    seed: Option<u64>,
-) -> Result<()> {
-    if let Some(mm) = size {
-        anyhow::ensure!(
-            mm.is_finite() && mm > 0.0,
-            "--size {mm}: must be positive (mm)"
-        );
-        config.rock.mean_size = mm * 1e-3;
-    }
-    if let Some(seed) = seed {
-        config.rock.seed = seed;
-    }
-    Ok(())
-}
-
 fn sensitivity(a: &SensitivityArgs) -> Result<()> {
     let (mut base, label) = a.experiment.load()?;
-    override_sample(&mut base, a.size, a.seed)?;
+    a.sample.apply(&mut base)?;
     let params = SensitivityParams {
         base,
         bed: a.bed.clone(),

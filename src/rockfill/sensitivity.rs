@@ -20,7 +20,7 @@ use std::fmt::Write as _;
 use std::path::PathBuf;
 
 use super::config::ExperimentConfig;
-use super::study::{has_bed, run_one, StudyError, StudyRun};
+use super::study::{csv_text, has_bed, run_one, StudyError, StudyRun};
 use crate::math::Real;
 
 /// A contact parameter the driver can vary.
@@ -277,13 +277,10 @@ pub fn write_outputs(
         let path = params.out.join(name);
         std::fs::write(&path, text).map_err(|source| StudyError::Io { path, source })
     };
-    let mut csv = String::new();
-    csv.push_str(SensitivityRun::CSV_HEADER);
-    csv.push('\n');
-    for r in runs {
-        csv.push_str(&r.csv_row());
-        csv.push('\n');
-    }
+    let csv = csv_text(
+        SensitivityRun::CSV_HEADER,
+        runs.iter().map(SensitivityRun::csv_row),
+    );
     write("sensitivity.csv", csv)?;
     write("sensitivity.md", sensitivity_table(params, runs))
 }

@@ -365,15 +365,21 @@ pub fn run_study(
     Ok(runs)
 }
 
-/// Writes `runs.csv` and `study.md`.
-pub fn write_outputs(params: &StudyParams, runs: &[StudyRun]) -> Result<(), StudyError> {
+/// A CSV file's text: the header line, then one line per row.
+pub fn csv_text(header: &str, rows: impl IntoIterator<Item = String>) -> String {
     let mut csv = String::new();
-    csv.push_str(StudyRun::CSV_HEADER);
+    csv.push_str(header);
     csv.push('\n');
-    for r in runs {
-        csv.push_str(&r.csv_row());
+    for row in rows {
+        csv.push_str(&row);
         csv.push('\n');
     }
+    csv
+}
+
+/// Writes `runs.csv` and `study.md`.
+pub fn write_outputs(params: &StudyParams, runs: &[StudyRun]) -> Result<(), StudyError> {
+    let csv = csv_text(StudyRun::CSV_HEADER, runs.iter().map(StudyRun::csv_row));
     let path = params.out.join("runs.csv");
     std::fs::write(&path, csv).map_err(io_error(&path))?;
     let path = params.out.join("study.md");
