@@ -9,7 +9,7 @@ use std::path::Path;
 
 use polydem::math::Real;
 use polydem::scene::{load_scene, Simulation};
-use polydem::world::{step, SphereSim, StepError, StepScratch};
+use polydem::world::{step, SphereSim, StepError, StepScratch, World};
 
 fn scene(file: &str) -> Simulation {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join(file);
@@ -18,12 +18,16 @@ fn scene(file: &str) -> Simulation {
     sim
 }
 
+/// Bed c, and its world for the general step with its scratch, and the flat path made from it.
+fn bed_c() -> (Simulation, World, StepScratch, SphereSim) {
+    let sim = scene("scenes/sphere_bed_c_linear_5ms.toml");
+    let flat = SphereSim::from_world(&sim.world, &sim.params).expect("a sphere-only world");
+    (sim.clone(), sim.world, StepScratch::default(), flat)
+}
+
 #[test]
 fn accessors_show_every_step_end_as_the_general_step() {
-    let sim = scene("scenes/sphere_bed_c_linear_5ms.toml");
-    let mut world = sim.world.clone();
-    let mut scratch = StepScratch::default();
-    let mut flat = SphereSim::from_world(&sim.world, &sim.params).expect("a sphere-only world");
+    let (sim, mut world, mut scratch, mut flat) = bed_c();
     let n = world.bodies.len();
     // The projectile (last body), and a spread of bed spheres.
     let watched: Vec<usize> = (0..n).step_by(97).chain([n - 1]).collect();
@@ -58,10 +62,7 @@ fn accessors_show_every_step_end_as_the_general_step() {
 
 #[test]
 fn a_non_finite_state_is_the_general_steps_error() {
-    let sim = scene("scenes/sphere_bed_c_linear_5ms.toml");
-    let mut world = sim.world.clone();
-    let mut scratch = StepScratch::default();
-    let mut flat = SphereSim::from_world(&sim.world, &sim.params).expect("a sphere-only world");
+    let (sim, mut world, mut scratch, mut flat) = bed_c();
     for _ in 0..10 {
         step(&sim.params, &mut world, &mut scratch).unwrap();
         flat.step().unwrap();
