@@ -1,15 +1,14 @@
 //! One-at-a-time sensitivity of the penetration to the contact parameters of Table 1, from one saved bed.
 //!
-//! The paper (§4.2) reports that "the stiffnesses and the coefficient of friction have a minor influence
-//! on the penetration results, while the coefficient of restitution affects the final results
-//! significantly", without figures. This driver measures that claim for our model: it runs the
-//! penetration of one packed bed with the experiment file's parameters (the base), then once for each
-//! value of each varied parameter with every other parameter at the file's value. All runs start from the
+//! The paper (§4.2) states, without figures, that the two stiffnesses and the friction coefficient change
+//! the penetration little and the restitution coefficient changes it much. This driver measures that for
+//! our model: it runs the penetration of one packed bed with the experiment file's parameters (the base),
+//! then once for each value of each varied parameter with every other parameter at the file's value. All runs start from the
 //! same bed, so the packing does not change between them (a bed read from its checkpoint takes the file's
 //! contact laws, [`super::experiment`]); the rocks' density cannot vary (it set the bed's weights).
 //!
 //! Varied parameters ([`Parameter`]): the five entries of the file's `[contact]` section, and
-//! `contact.stiffness_factor`, a factor on both k_n and k_s (the paper names "the stiffnesses" together).
+//! `contact.stiffness_factor`, a factor on both k_n and k_s (the paper names the two stiffnesses together).
 //!
 //! Writes into OUT: one folder per run (`base`, `<parameter>_<value>`: `monitors.csv`, `summary.txt`,
 //! `section.svg`, as the study's runs), `sensitivity.csv` (one row per run, [`SensitivityRun::CSV_HEADER`])
@@ -71,19 +70,6 @@ impl Parameter {
                 keys.join(", ")
             )
         })
-    }
-
-    /// The file's value of the parameter (1 for the stiffness factor).
-    pub fn base_value(self, config: &ExperimentConfig) -> Real {
-        let c = &config.contact;
-        match self {
-            Parameter::StiffnessFactor => 1.0,
-            Parameter::NormalStiffness => c.normal_stiffness,
-            Parameter::TangentialStiffness => c.tangential_stiffness,
-            Parameter::Friction => c.friction,
-            Parameter::RestitutionRocks => c.restitution_rocks,
-            Parameter::RestitutionProjectile => c.restitution_projectile,
-        }
     }
 
     /// `base` with the parameter set to `value`, checked: the contact laws must accept it.
