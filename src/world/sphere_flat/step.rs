@@ -100,6 +100,14 @@ pub(super) struct Blocks {
 impl Blocks {
     pub(super) fn new(list: &super::NeighbourList, wanted: usize) -> Self {
         let n = list.row_start.len().saturating_sub(1);
+        if wanted <= 1 {
+            // One block of every sphere (the serial loop): no weights to form, no sphere gathered.
+            return Self {
+                built_for: (list.builds(), wanted),
+                bodies: std::iter::once(0..n).collect(),
+                gathered: vec![false; n],
+            };
+        }
         // Per sphere: its row's pairs and its walls, a pair in contact counting CONTACT_WEIGHT, plus
         // one for the sphere itself.
         let cost = |histories: &[TangentialHistory]| -> usize {
