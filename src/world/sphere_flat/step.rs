@@ -159,8 +159,8 @@ impl Blocks {
 /// floor, so blocks of equal pair counts are not blocks of equal work. 8 is the best of 1, 4, 6, 8, 12
 /// and 16 measured on the sphere beds a–c on two threads (`examples/sphere_flat_threads`, medians of 4–5
 /// runs, 2026-11-22: 1.43 / 1.67 / 1.43× over one thread with 1, 1.79 / 1.79 / 1.63× with 8); the
-/// 10^4-sphere settling scene is even within its noise. A frictionless law keeps no spring, so its
-/// pairs all weigh 1, as before.
+/// 10^4-sphere settling scene came out slightly slower (medians 1.39–1.51× against 1.51–1.57×, not
+/// understood). A frictionless law keeps no spring, so its pairs all weigh 1, as before.
 const CONTACT_WEIGHT: usize = 8;
 
 /// The slices of one block.
