@@ -67,6 +67,7 @@
 mod neighbours;
 mod pair;
 mod step;
+mod team;
 
 use crate::contact::{contact_plane_sphere, contact_sphere_sphere, QueryCounters};
 use crate::dynamics::rotation::{is_isotropic, SubRotation};
@@ -84,6 +85,7 @@ use super::step::{effective_model, StepError, StepParams};
 use super::world::{Wall, World};
 
 pub use neighbours::{NeighbourList, LARGE_RADIUS_FACTOR, MAX_CELLS_PER_BODY};
+use neighbours::{SpareVec, NOT_CARRIED};
 use pair::{Kinematic, PairConstants, PairOut, Props, WallConstants, WallPlane};
 
 /// Why a world cannot take the flat sphere path (see the module docs).
@@ -130,6 +132,9 @@ pub struct SphereSim {
     reach: Vec<Real>,
     pair_constants: Vec<PairConstants>,
     wall_constants: Vec<WallConstants>,
+    /// The vectors of the constants of the build before (refilled by the next build).
+    spare_reach: SpareVec<Real>,
+    spare_constants: SpareVec<PairConstants>,
     /// Whether the drift turns the orientations (see [`SphereSim::set_track_orientation`]).
     track_orientation: bool,
     /// The pair loop's blocks (made for the current lists and pool).
@@ -257,6 +262,8 @@ impl SphereSim {
             list: NeighbourList::new(world.broad_phase.skin()),
             reach: Vec::new(),
             pair_constants: Vec::new(),
+            spare_reach: SpareVec::default(),
+            spare_constants: SpareVec::default(),
             wall_constants: Vec::new(),
             track_orientation: true,
             blocks: step::Blocks::default(),
@@ -332,11 +339,35 @@ impl SphereSim {
             )
         };
         let n = list.a.len();
-        (self.reach, self.pair_constants) = if parallel && n >= MIN_PARALLEL_PAIRS {
-            (0..n).into_par_iter().map(body).unzip()
-        } else {
-            (0..n).map(body).unzip()
+        // A pair listed before keeps its constants (functions of its two bodies: the same bits).
+        let (old_reach, old_constants) = (
+            std::mem::take(&mut self.reach),
+            std::mem::take(&mut self.pair_constants),
+        );
+        let carried = |p: usize| {
+            let k = list.carried_from[p] as usize;
+            match (old_reach.get(k), old_constants.get(k)) {
+                (Some(&reach), Some(&c)) if list.carried_from[p] != NOT_CARRIED => (reach, c),
+                _ => body(p),
+            }
         };
+        let (mut reach, mut constants) = (
+            neighbours::recycled(&mut self.spare_reach.0),
+            neighbours::recycled(&mut self.spare_constants.0),
+        );
+        if parallel && n >= MIN_PARALLEL_PAIRS {
+            (0..n)
+                .into_par_iter()
+                .map(carried)
+                .unzip_into_vecs(&mut reach, &mut constants);
+        } else {
+            for (r, c) in (0..n).map(carried) {
+                reach.push(r);
+                constants.push(c);
+            }
+        }
+        (self.reach, self.pair_constants) = (reach, constants);
+        (self.spare_reach.0, self.spare_constants.0) = (old_reach, old_constants);
         self.wall_constants = list
             .wall_body
             .iter()

@@ -9,8 +9,10 @@
 //!  9.   wall forces and the walls' power (serial, pair order), ledger, time
 //! ```
 //! Every per-sphere and per-pair pass writes only its own items' slots, so it runs on rayon's current
-//! pool in chunks with the same bits for any number of threads. The pair loop runs in blocks of
-//! consecutive spheres ([`Blocks`]: one when serial, two per thread otherwise) and adds each overlapping
+//! pool with the same bits for any number of threads: each thread always takes the same part of each
+//! pass ([`super::team`]), so that a block's records stay in one core's cache from pass to pass. The pair
+//! loop runs in blocks of consecutive spheres ([`Blocks`]: one when serial, one per thread otherwise)
+//! and adds each overlapping
 //! pair's loads to its spheres as it goes, for every sphere that only its own block's pairs reach: in
 //! pair order such a sphere i receives its pairs (a, i) by increasing a (rows of a < i come first), then
 //! its own row (i, b) by increasing b, then its walls — the gather's order, so the same sums, bit for
@@ -18,16 +20,15 @@
 
 use std::time::Instant;
 
-use rayon::prelude::*;
-
 use crate::dynamics::rotation::drift_isotropic;
 use crate::law::TangentialHistory;
 use crate::math::{Point, Real, Vector};
 
 use super::super::step::{first_non_finite, OverlapWarning, StepError, StepReport};
 use super::super::ContactKey;
-use super::neighbours::{chunk_len, TopTwo};
+use super::neighbours::TopTwo;
 use super::pair::{Kinematic, PairContext, PairOut, WallPlane};
+use super::team::{for_each_part, split_at_ranges};
 use super::{SphereSim, Spin, MIN_PARALLEL_PAIRS};
 
 /// What the pair loop found, summed over its blocks in pair order.
@@ -73,16 +74,18 @@ impl Found {
     }
 }
 
-/// Blocks per thread of the parallel pair loop: few, because a sphere reached by a pair of another
-/// block has its loads gathered in stage 6 instead of summed by the pair loop (on the settled bed of
-/// the sphere-bed scenes, whose spheres are numbered by height, about 5 % of the spheres with 2 blocks
-/// of equal numbers of spheres, 15 % with 4, 35 % with 8 and 74 % with 16: counted once on its initial
-/// list, not measured in a run).
-pub(super) const BLOCKS_PER_THREAD: usize = 2;
-
-/// The split of the pair loop into blocks of consecutive spheres, each with the pairs of its spheres'
-/// rows and their walls, of about equal work: pairs weighted by whether they are in contact
-/// ([`CONTACT_WEIGHT`]; before 2026-11-22 (night), equal numbers of pairs).
+/// The split of the pair loop into blocks of consecutive spheres, one per thread, each with the pairs of
+/// its spheres' rows and their walls, of about equal work: pairs weighted by whether they are in contact
+/// ([`CONTACT_WEIGHT`]; before 2026-11-22 (night), equal numbers of pairs). With the split of the
+/// per-sphere passes ([`Blocks::kick`], [`Blocks::drift`]) it is what each thread of the team takes
+/// ([`super::team`]).
+///
+/// One block per thread, no more: a sphere reached by a pair of another block has its loads gathered
+/// in stage 6 instead of summed by the pair loop (on the settled bed of the sphere-bed scenes, whose
+/// spheres are numbered by height, about 5 % of the spheres with 2 blocks, 15 % with 4, 35 % with 8;
+/// counted on its initial list), and the team gives each thread its parts statically, so more blocks
+/// would not balance the threads (until 2026-11-22 (late) rayon shared two blocks per thread by work
+/// stealing).
 ///
 /// A block's pairs come in pair order, so a sphere all of whose pairs lie in its own block receives
 /// its loads in the order of the stage-6 gather (pairs (a, i) by increasing a, its row, its walls): the
@@ -95,6 +98,10 @@ pub(super) struct Blocks {
     pub(super) bodies: Vec<std::ops::Range<usize>>,
     /// Per sphere, whether a pair of another block reaches it.
     pub(super) gathered: Vec<bool>,
+    /// The spheres of each thread in the second half kick (balanced with the gathered spheres' sums)
+    /// and in the drift (equal numbers).
+    pub(super) kick: Vec<std::ops::Range<usize>>,
+    pub(super) drift: Vec<std::ops::Range<usize>>,
 }
 
 impl Blocks {
@@ -106,6 +113,8 @@ impl Blocks {
                 built_for: (list.builds(), wanted),
                 bodies: std::iter::once(0..n).collect(),
                 gathered: vec![false; n],
+                kick: std::iter::once(0..n).collect(),
+                drift: std::iter::once(0..n).collect(),
             };
         }
         // Per sphere: its row's pairs and its walls, a pair in contact counting CONTACT_WEIGHT, plus
@@ -123,18 +132,7 @@ impl Blocks {
                 cost(&list.histories[r0..r1]) + cost(&list.wall_histories[w0..w1]) + 1
             })
             .collect();
-        let total: usize = weights.iter().sum();
-        let target = total.div_ceil(wanted.max(1)).max(1);
-        let mut bodies = Vec::with_capacity(wanted);
-        let (mut first, mut weight) = (0, 0);
-        for (i, w) in weights.iter().enumerate() {
-            weight += w;
-            if weight >= target && i + 1 < n {
-                bodies.push(first..i + 1);
-                (first, weight) = (i + 1, 0);
-            }
-        }
-        bodies.push(first..n);
+        let bodies = ranges_of_equal_weight(&weights, wanted);
         let mut gathered = vec![false; n];
         if bodies.len() > 1 {
             for range in &bodies {
@@ -145,11 +143,45 @@ impl Blocks {
                 }
             }
         }
+        // The kick: a gathered sphere also sums its pairs, which took about two kicks' time (per-thread
+        // timestamps on bed c, 2026-11-22 (late): with the pair blocks' split the thread of the second
+        // block, ~1700 spheres of which ~160 gathered, kicked in ~21 µs against ~13 µs for ~1300).
+        let kick_weights: Vec<usize> = gathered.iter().map(|&g| 1 + 2 * usize::from(g)).collect();
+        let kick = ranges_of_equal_weight(&kick_weights, bodies.len());
+        let drift = ranges_of_equal_weight(&vec![1; n], bodies.len());
         Self {
             built_for: (list.builds(), wanted),
             bodies,
             gathered,
+            kick,
+            drift,
         }
+    }
+}
+
+/// Consecutive ranges of `weights`' indices, at most `wanted`, each of about the same total weight (the
+/// last takes the rest).
+fn ranges_of_equal_weight(weights: &[usize], wanted: usize) -> Vec<std::ops::Range<usize>> {
+    let n = weights.len();
+    let total: usize = weights.iter().sum();
+    let target = total.div_ceil(wanted.max(1)).max(1);
+    let mut ranges = Vec::with_capacity(wanted);
+    let (mut first, mut weight) = (0, 0);
+    for (i, w) in weights.iter().enumerate() {
+        weight += w;
+        if weight >= target && i + 1 < n {
+            ranges.push(first..i + 1);
+            (first, weight) = (i + 1, 0);
+        }
+    }
+    ranges.push(first..n);
+    ranges
+}
+
+impl Blocks {
+    /// Whether the per-sphere passes run on the team (several blocks).
+    pub(super) fn team(&self) -> bool {
+        self.bodies.len() > 1
     }
 }
 
@@ -186,6 +218,8 @@ impl SphereSim {
         let mut report = StepReport::default();
         let external_start = self.external_power;
         let parallel = self.parallel_bodies();
+        // The per-sphere passes run on the team when the pair loop does (its blocks of the last build).
+        let team = parallel && self.blocks.team();
 
         // 1–2. First half kick, drift, turn.
         let t = Instant::now();
@@ -229,18 +263,18 @@ impl SphereSim {
                 }
                 (top, large)
             };
-            let chunk = chunk_len(self.kin.len(), parallel);
-            if parallel {
-                self.kin
-                    .par_chunks_mut(chunk)
-                    .zip(spin.par_chunks_mut(chunk))
-                    .with_max_len(1)
-                    .enumerate()
-                    .map(|(c, (kin, spin))| drift(c * chunk, kin, spin))
-                    .reduce(
-                        || (TopTwo::default(), TopTwo::default()),
-                        |(a, b), (c, d)| (a.merge(c), b.merge(d)),
-                    )
+            if team {
+                // About the spheres of the thread that pairs and kicks them ([`super::team`]).
+                let ranges = &self.blocks.drift;
+                let parts: Vec<_> = split_at_ranges(&mut self.kin, ranges)
+                    .into_iter()
+                    .zip(split_at_ranges(spin, ranges))
+                    .collect();
+                for_each_part(parts, |k, (kin, spin)| drift(ranges[k].start, kin, spin))
+                    .into_iter()
+                    .fold((TopTwo::default(), TopTwo::default()), |(a, b), (c, d)| {
+                        (a.merge(c), b.merge(d))
+                    })
             } else {
                 drift(0, &mut self.kin, spin)
             }
@@ -282,6 +316,7 @@ impl SphereSim {
 
         // 6–8. Per-sphere sums, second half kick, checks.
         let t = Instant::now();
+        let team = parallel && self.blocks.team();
         let non_finite = {
             let (list, out, wall_out) = (&self.list, &self.out, &self.wall_out);
             let gathered = &self.blocks.gathered;
@@ -322,20 +357,20 @@ impl SphereSim {
                 }
                 None
             };
-            let chunk = chunk_len(kin.len(), parallel);
-            if parallel {
-                self.force
-                    .par_chunks_mut(chunk)
-                    .zip(self.torque.par_chunks_mut(chunk))
-                    .zip(kin.par_chunks_mut(chunk))
-                    .zip(spin.par_chunks_mut(chunk))
-                    .with_max_len(1)
-                    .enumerate()
-                    .map(|(c, (((f, t), kin), spin))| kick(c * chunk, f, t, kin, spin))
-                    .collect::<Vec<_>>()
+            if team {
+                let ranges = &self.blocks.kick;
+                let parts: Vec<_> = split_at_ranges(&mut self.force, ranges)
                     .into_iter()
-                    .flatten()
-                    .next()
+                    .zip(split_at_ranges(&mut self.torque, ranges))
+                    .zip(split_at_ranges(kin, ranges))
+                    .zip(split_at_ranges(spin, ranges))
+                    .collect();
+                for_each_part(parts, |k, (((f, t), kin), spin)| {
+                    kick(ranges[k].start, f, t, kin, spin)
+                })
+                .into_iter()
+                .flatten()
+                .next()
             } else {
                 kick(0, &mut self.force, &mut self.torque, kin, spin)
             }
@@ -368,7 +403,7 @@ impl SphereSim {
         let n_pairs = self.list.body_pairs() + self.list.wall_pairs();
         let parallel = rayon::current_num_threads() > 1 && n_pairs >= MIN_PARALLEL_PAIRS;
         let wanted = if parallel {
-            rayon::current_num_threads() * BLOCKS_PER_THREAD
+            rayon::current_num_threads()
         } else {
             1
         };
@@ -562,12 +597,9 @@ impl SphereSim {
             }
         }
         let found = if parallel && parts.len() > 1 {
-            let founds: Vec<Found> = parts
-                .into_par_iter()
-                .with_max_len(1)
-                .map(|(first, part)| block(first, part))
-                .collect();
-            founds.into_iter().fold(Found::default(), Found::merge)
+            for_each_part(parts, |_, (first, part)| block(first, part))
+                .into_iter()
+                .fold(Found::default(), Found::merge)
         } else {
             parts
                 .into_iter()
