@@ -21,9 +21,30 @@ pub fn relative_difference(a: Real, b: Real) -> Real {
     (a - b).abs() / (0.5 * (a.abs() + b.abs()))
 }
 
+/// The median of `values` (the mean of the middle two for an even count); `None` when empty.
+pub fn median(mut values: Vec<Real>) -> Option<Real> {
+    if values.is_empty() {
+        return None;
+    }
+    values.sort_by(Real::total_cmp);
+    let mid = values.len() / 2;
+    Some(if values.len() % 2 == 1 {
+        values[mid]
+    } else {
+        0.5 * (values[mid - 1] + values[mid])
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn median_of_odd_even_and_empty_lists() {
+        assert_eq!(median(vec![]), None);
+        assert_eq!(median(vec![3.0, 1.0, 2.0]), Some(2.0));
+        assert_eq!(median(vec![4.0, 1.0, 3.0, 2.0]), Some(2.5));
+    }
 
     #[test]
     fn slope_of_an_exact_power_law_is_its_exponent() {

@@ -12,6 +12,11 @@
 //! A thread that ends its part first spins until the others end theirs ([`spin_until_all`]) instead of
 //! returning to rayon, whose idle loop soon puts it to sleep: waking it for the next pass cost several µs
 //! per pass on the 2-core VM (per-thread timestamps, 2026-11-22 (late)).
+//!
+//! The spin holds a thread until every thread of the pool has run its part, so a pass needs all of the
+//! pool's threads: a caller that steps several flat simulations at once from jobs of one pool makes each
+//! wait until the others' threads come back to rayon (their next pass or join); nothing in polydem does
+//! (the suite steps one simulation at a time, on its own pool).
 
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Mutex;

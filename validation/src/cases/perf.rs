@@ -45,20 +45,6 @@ const HEADER: [&str; 8] = [
 /// How many recorded runs of a figure the regression baseline takes the median of.
 const BASELINE_RUNS: usize = 5;
 
-/// The median of `values` (the mean of the middle two for an even count); `None` when empty.
-fn median(mut values: Vec<f64>) -> Option<f64> {
-    if values.is_empty() {
-        return None;
-    }
-    values.sort_by(f64::total_cmp);
-    let mid = values.len() / 2;
-    Some(if values.len() % 2 == 1 {
-        values[mid]
-    } else {
-        0.5 * (values[mid - 1] + values[mid])
-    })
-}
-
 fn case_err(msg: impl Into<String>) -> SuiteError {
     SuiteError::case(NAME, msg)
 }
@@ -157,7 +143,7 @@ impl Case for Perf {
                 .filter_map(|r| r[7].parse::<f64>().ok())
                 .take(BASELINE_RUNS)
                 .collect();
-            median(recent)
+            crate::stats::median(recent)
         };
         let mut rows = Vec::new();
         let mut new_rows = Vec::new();
@@ -253,17 +239,5 @@ impl Case for Perf {
             })?;
         }
         Ok(())
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::median;
-
-    #[test]
-    fn median_of_odd_even_and_empty_lists() {
-        assert_eq!(median(vec![]), None);
-        assert_eq!(median(vec![3.0, 1.0, 2.0]), Some(2.0));
-        assert_eq!(median(vec![4.0, 1.0, 3.0, 2.0]), Some(2.5));
     }
 }
