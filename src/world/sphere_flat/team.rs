@@ -10,8 +10,8 @@
 //! thread computes a part, so the bits are the same as serial.
 //!
 //! A thread that ends its part first spins until the others end theirs ([`spin_until_all`]) instead of
-//! returning to rayon, whose idle loop soon puts it to sleep: waking it for the next pass cost several µs
-//! per pass on the 2-core VM (per-thread timestamps, 2026-11-22 (late)).
+//! returning to rayon, whose idle loop soon puts it to sleep: starting and joining the other thread cost
+//! ~3–8 µs per pass on the 2-core VM (per-thread timestamps, 2026-11-22 (late)).
 //!
 //! The spin holds a thread until every thread of the pool has run its part, so a pass needs all of the
 //! pool's threads: a caller that steps several flat simulations at once from jobs of one pool makes each
