@@ -106,31 +106,24 @@ pub struct NeighbourList {
 pub(crate) const NOT_CARRIED: u32 = u32::MAX;
 
 /// Vectors kept for reuse by the next build (see [`NeighbourList::rebuild`]); a clone holds none.
-#[derive(Debug, Default)]
+#[derive(Clone, Debug, Default)]
 struct Spare {
-    a: Vec<u32>,
-    b: Vec<u32>,
-    row_start: Vec<u32>,
-    as_b_start: Vec<u32>,
-    as_b: Vec<u32>,
-    root_radius: Vec<Real>,
-    effective_mass: Vec<Real>,
-    histories: Vec<TangentialHistory>,
-    since: Vec<u64>,
-    wall_start: Vec<u32>,
-    wall_of: Vec<u32>,
-    wall_body: Vec<u32>,
-    wall_histories: Vec<TangentialHistory>,
-    wall_since: Vec<u64>,
-    centres_at_build: Vec<Point>,
-    carried_from: Vec<u32>,
-}
-
-impl Clone for Spare {
-    /// Nothing: the spare vectors hold no state, only capacity.
-    fn clone(&self) -> Self {
-        Spare::default()
-    }
+    a: SpareVec<u32>,
+    b: SpareVec<u32>,
+    row_start: SpareVec<u32>,
+    as_b_start: SpareVec<u32>,
+    as_b: SpareVec<u32>,
+    root_radius: SpareVec<Real>,
+    effective_mass: SpareVec<Real>,
+    histories: SpareVec<TangentialHistory>,
+    since: SpareVec<u64>,
+    wall_start: SpareVec<u32>,
+    wall_of: SpareVec<u32>,
+    wall_body: SpareVec<u32>,
+    wall_histories: SpareVec<TangentialHistory>,
+    wall_since: SpareVec<u64>,
+    centres_at_build: SpareVec<Point>,
+    carried_from: SpareVec<u32>,
 }
 
 /// A vector kept only for its capacity (refilled by its owner's next use); a clone holds none.
@@ -487,12 +480,12 @@ impl NeighbourList {
         let mut spare = std::mem::take(&mut old.spare);
         self.skin = skin;
         self.builds = old.builds + 1;
-        self.a = recycled(&mut spare.a);
-        self.b = recycled(&mut spare.b);
-        self.row_start = recycled(&mut spare.row_start);
-        self.wall_start = recycled(&mut spare.wall_start);
-        self.wall_of = recycled(&mut spare.wall_of);
-        self.wall_body = recycled(&mut spare.wall_body);
+        self.a = recycled(&mut spare.a.0);
+        self.b = recycled(&mut spare.b.0);
+        self.row_start = recycled(&mut spare.row_start.0);
+        self.wall_start = recycled(&mut spare.wall_start.0);
+        self.wall_of = recycled(&mut spare.wall_of.0);
+        self.wall_body = recycled(&mut spare.wall_body.0);
         self.row_start.push(0);
         self.wall_start.push(0);
         let mut i = 0u32;
@@ -513,7 +506,7 @@ impl NeighbourList {
             self.wall_of.extend_from_slice(&wall_list);
         }
         // Side-B rows: pairs in key order appended to their second body's row (so increasing a).
-        self.as_b_start = recycled(&mut spare.as_b_start);
+        self.as_b_start = recycled(&mut spare.as_b_start.0);
         self.as_b_start.resize(n + 1, 0);
         for &b in &self.b {
             self.as_b_start[b as usize + 1] += 1;
@@ -521,7 +514,7 @@ impl NeighbourList {
         for k in 0..n {
             self.as_b_start[k + 1] += self.as_b_start[k];
         }
-        self.as_b = recycled(&mut spare.as_b);
+        self.as_b = recycled(&mut spare.as_b.0);
         self.as_b.resize(self.b.len(), 0);
         let mut fill = self.as_b_start.clone();
         for (p, &b) in self.b.iter().enumerate() {
@@ -531,7 +524,7 @@ impl NeighbourList {
 
         // Each new pair's slot in the old lists, if it was listed: a merge of the old and new rows of
         // its first body (both sorted by the second).
-        self.carried_from = recycled(&mut spare.carried_from);
+        self.carried_from = recycled(&mut spare.carried_from.0);
         for a in 0..n {
             let new_row = &self.b[self.row_start[a] as usize..self.row_start[a + 1] as usize];
             let (old_first, old_row) = match old.row_start.get(a..a + 2) {
@@ -553,10 +546,10 @@ impl NeighbourList {
         }
         // Springs and pair constants carried over (the constants are functions of the two bodies:
         // the same bits as forming them again), or imported, or new.
-        self.histories = recycled(&mut spare.histories);
-        self.since = recycled(&mut spare.since);
-        self.root_radius = recycled(&mut spare.root_radius);
-        self.effective_mass = recycled(&mut spare.effective_mass);
+        self.histories = recycled(&mut spare.histories.0);
+        self.since = recycled(&mut spare.since.0);
+        self.root_radius = recycled(&mut spare.root_radius.0);
+        self.effective_mass = recycled(&mut spare.effective_mass.0);
         for (p, &from) in self.carried_from.iter().enumerate() {
             let (a, b) = (self.a[p], self.b[p]);
             let k = from as usize;
@@ -589,8 +582,8 @@ impl NeighbourList {
                 .position(|&w| w == wall)
                 .map(|k| s + k)
         };
-        self.wall_histories = recycled(&mut spare.wall_histories);
-        self.wall_since = recycled(&mut spare.wall_since);
+        self.wall_histories = recycled(&mut spare.wall_histories.0);
+        self.wall_since = recycled(&mut spare.wall_since.0);
         for body in 0..n {
             for q in self.wall_start[body] as usize..self.wall_start[body + 1] as usize {
                 let wall = self.wall_of[q];
@@ -603,29 +596,29 @@ impl NeighbourList {
                 self.wall_since.push(s);
             }
         }
-        self.centres_at_build = recycled(&mut spare.centres_at_build);
+        self.centres_at_build = recycled(&mut spare.centres_at_build.0);
         self.centres_at_build.extend_from_slice(centres);
         self.large_flags = (0..n).map(|i| is_large(props[i].radius)).collect();
         self.layout = Some(layout);
         self.walls_at_build = walls.iter().map(|w| w.pose.translation.vector).collect();
         // The old lists' vectors are the next build's.
         self.spare = Spare {
-            a: old.a,
-            b: old.b,
-            row_start: old.row_start,
-            as_b_start: old.as_b_start,
-            as_b: old.as_b,
-            root_radius: old.root_radius,
-            effective_mass: old.effective_mass,
-            histories: old.histories,
-            since: old.since,
-            wall_start: old.wall_start,
-            wall_of: old.wall_of,
-            wall_body: old.wall_body,
-            wall_histories: old.wall_histories,
-            wall_since: old.wall_since,
-            centres_at_build: old.centres_at_build,
-            carried_from: old.carried_from,
+            a: SpareVec(old.a),
+            b: SpareVec(old.b),
+            row_start: SpareVec(old.row_start),
+            as_b_start: SpareVec(old.as_b_start),
+            as_b: SpareVec(old.as_b),
+            root_radius: SpareVec(old.root_radius),
+            effective_mass: SpareVec(old.effective_mass),
+            histories: SpareVec(old.histories),
+            since: SpareVec(old.since),
+            wall_start: SpareVec(old.wall_start),
+            wall_of: SpareVec(old.wall_of),
+            wall_body: SpareVec(old.wall_body),
+            wall_histories: SpareVec(old.wall_histories),
+            wall_since: SpareVec(old.wall_since),
+            centres_at_build: SpareVec(old.centres_at_build),
+            carried_from: SpareVec(old.carried_from),
         };
     }
 }
