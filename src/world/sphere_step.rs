@@ -34,8 +34,8 @@ use super::parallel::{
 };
 use super::region_profile::{self, Section};
 use super::step::{
-    evaluate_loads, non_finite_quantity, sum_body_loads, StepError, StepParams, StepReport,
-    StepScratch,
+    evaluate_loads, maybe_non_finite, non_finite_quantity, sum_body_loads, StepError, StepParams,
+    StepReport, StepScratch,
 };
 use super::world::World;
 
@@ -100,16 +100,18 @@ fn kick_and_check(
     let h = 0.5 * dt;
     second_half_kick(body, force, translation, h);
     body.angular_momentum += h * torque;
-    let sum = force.sum()
-        + torque.sum()
-        + body.position.coords.sum()
-        + body.velocity.sum()
-        + body.orientation.coords.sum()
-        + body.angular_momentum.sum();
-    if sum.is_finite() {
-        None
-    } else {
+    let maybe = maybe_non_finite(
+        force,
+        torque,
+        &body.position,
+        &body.velocity,
+        &body.orientation,
+        &body.angular_momentum,
+    );
+    if maybe {
         non_finite_quantity(body, force, torque)
+    } else {
+        None
     }
 }
 

@@ -460,7 +460,7 @@ impl SphereSim {
         };
         let mut sum = 0.0;
         for (p, o) in self.out.iter().enumerate() {
-            if o.overlapping {
+            if list.in_contact[p] {
                 let (a, b) = (list.a[p] as usize, list.b[p] as usize);
                 let m = pair::scaled(
                     model(self.props[a].material, self.props[b].material),
@@ -470,7 +470,7 @@ impl SphereSim {
             }
         }
         for (q, o) in self.wall_out.iter().enumerate() {
-            if o.overlapping {
+            if list.wall_in_contact[q] {
                 let (body, wall) = (list.wall_body[q] as usize, list.wall_of[q] as usize);
                 let m = model(self.planes[wall].material, self.props[body].material)
                     .for_contact_radii(None, Some(self.props[body].radius));
@@ -556,13 +556,19 @@ impl SphereSim {
         let mut counters = QueryCounters::default();
         let n_body = list.a.len();
         for (k, state) in store.states_mut().iter_mut().enumerate() {
-            let (history, since, out) = if k < n_body {
-                (list.histories[k], list.since[k], &self.out[k])
+            let (history, since, in_contact, out) = if k < n_body {
+                (
+                    list.histories[k],
+                    list.since[k],
+                    list.in_contact[k],
+                    &self.out[k],
+                )
             } else {
                 let q = k - n_body;
                 (
                     list.wall_histories[q],
                     list.wall_since[q],
+                    list.wall_in_contact[q],
                     &self.wall_out[q],
                 )
             };
@@ -608,7 +614,7 @@ impl SphereSim {
                     })
                 }
             };
-            let (force_on_b, damping_force) = if out.overlapping {
+            let (force_on_b, damping_force) = if in_contact {
                 (out.force_on_b, out.damping_force)
             } else {
                 (Vector::zeros(), Vector::zeros())

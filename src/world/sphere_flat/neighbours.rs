@@ -78,6 +78,11 @@ pub struct NeighbourList {
     /// The tangential spring of each body pair, and the step it entered the list.
     pub(crate) histories: Vec<TangentialHistory>,
     pub(crate) since: Vec<u64>,
+    /// Per body pair, whether the pair loop's last evaluation found it overlapping (its output then
+    /// holds its loads); false means its spring is cleared, so a pair that stays apart reads nothing
+    /// else ([`super::pair`]). A build sets it for the springs it holds (the outputs are formed by the
+    /// next evaluation).
+    pub(crate) in_contact: Vec<bool>,
     /// Body–wall pairs sorted by (body, wall): the walls of body i are
     /// `wall_of[wall_start[i]..wall_start[i + 1]]`.
     pub(crate) wall_start: Vec<u32>,
@@ -86,6 +91,7 @@ pub struct NeighbourList {
     pub(crate) wall_body: Vec<u32>,
     pub(crate) wall_histories: Vec<TangentialHistory>,
     pub(crate) wall_since: Vec<u64>,
+    pub(crate) wall_in_contact: Vec<bool>,
     /// Centres of the bodies and translations of the walls at the build.
     pub(crate) centres_at_build: Vec<Point>,
     pub(crate) walls_at_build: Vec<Vector>,
@@ -117,11 +123,13 @@ struct Spare {
     effective_mass: SpareVec<Real>,
     histories: SpareVec<TangentialHistory>,
     since: SpareVec<u64>,
+    in_contact: SpareVec<bool>,
     wall_start: SpareVec<u32>,
     wall_of: SpareVec<u32>,
     wall_body: SpareVec<u32>,
     wall_histories: SpareVec<TangentialHistory>,
     wall_since: SpareVec<u64>,
+    wall_in_contact: SpareVec<bool>,
     centres_at_build: SpareVec<Point>,
     carried_from: SpareVec<u32>,
 }
@@ -584,6 +592,7 @@ impl NeighbourList {
         };
         self.wall_histories = recycled(&mut spare.wall_histories.0);
         self.wall_since = recycled(&mut spare.wall_since.0);
+        self.wall_in_contact = recycled(&mut spare.wall_in_contact.0);
         for body in 0..n {
             for q in self.wall_start[body] as usize..self.wall_start[body + 1] as usize {
                 let wall = self.wall_of[q];
@@ -594,8 +603,13 @@ impl NeighbourList {
                 };
                 self.wall_histories.push(h);
                 self.wall_since.push(s);
+                self.wall_in_contact.push(!h.is_cleared());
             }
         }
+        // A held spring is a contact until the pair loop finds it apart (see `in_contact`).
+        self.in_contact = recycled(&mut spare.in_contact.0);
+        self.in_contact
+            .extend(self.histories.iter().map(|h| !h.is_cleared()));
         self.centres_at_build = recycled(&mut spare.centres_at_build.0);
         self.centres_at_build.extend_from_slice(centres);
         self.large_flags = (0..n).map(|i| is_large(props[i].radius)).collect();
@@ -612,11 +626,13 @@ impl NeighbourList {
             effective_mass: SpareVec(old.effective_mass),
             histories: SpareVec(old.histories),
             since: SpareVec(old.since),
+            in_contact: SpareVec(old.in_contact),
             wall_start: SpareVec(old.wall_start),
             wall_of: SpareVec(old.wall_of),
             wall_body: SpareVec(old.wall_body),
             wall_histories: SpareVec(old.wall_histories),
             wall_since: SpareVec(old.wall_since),
+            wall_in_contact: SpareVec(old.wall_in_contact),
             centres_at_build: SpareVec(old.centres_at_build),
             carried_from: SpareVec(old.carried_from),
         };

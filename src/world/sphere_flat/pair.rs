@@ -4,7 +4,7 @@
 //! A candidate first takes the cheap test that needs no square root: two spheres whose centres are at
 //! least r_A + r_B apart, or a sphere whose centre is at least r above a wall, cannot overlap by more than
 //! the touching band, so the pair is separated (its spring is released, as the law does for a pair that
-//! does not overlap). Any other candidate takes the operations of the general narrow phase's closed forms
+//! does not overlap; see [`separated`] for what a pair that stays apart costs). Any other candidate takes the operations of the general narrow phase's closed forms
 //! ([`contact_sphere_sphere`], [`contact_plane_sphere`]; the distance is the square root of the squared
 //! distance of the cheap test, as `norm` forms it) and the law of the pair's model scaled by its √R*
 //! ([`ContactModel::for_contact_radii`]) with the constants of the pair formed once per list build
@@ -86,36 +86,33 @@ impl WallPlane {
     }
 }
 
-/// The result of one candidate in one step: the loads the gather reads, then what only the write-back
-/// and the report read. Written in full for an overlapping pair; for a separated one only `overlapping`.
-/// The elastic potential is not kept: it is formed on request from the overlap and the spring
-/// ([`super::SphereSim::elastic_potential`]), with the law's own functions.
+/// The result of one overlapping candidate in one step: the loads the gather reads, then what only the
+/// write-back and the elastic potential read. Whether a pair overlaps is kept apart, in a dense flag per
+/// pair (the pair loop's `in_contact`): a separated pair writes nothing here, and the pair loop reads
+/// nothing here of a pair that stays apart. The elastic potential is not kept: it is formed on request
+/// from the overlap and the spring ([`super::SphereSim::elastic_potential`]), with the law's own
+/// functions.
 #[derive(Clone, Copy, Debug, Default)]
 pub(crate) struct PairOut {
     pub(crate) force_on_b: Vector,
     pub(crate) torque_on_a: Vector,
     pub(crate) torque_on_b: Vector,
-    pub(crate) overlapping: bool,
     /// The velocity-dependent part of the force (N), as the contact store keeps it.
     pub(crate) damping_force: Vector,
-    /// Overlap (m) and overlap / the smaller particle's diameter.
+    /// Overlap (m).
     pub(crate) depth: Real,
-    pub(crate) overlap_ratio: Real,
 }
 
 impl PairOut {
-    /// The output of an overlapping pair: the law's `response` at overlap `depth` (m), with the overlap
-    /// over the smaller particle's diameter.
+    /// The output of an overlapping pair: the law's `response` at overlap `depth` (m).
     #[inline(always)]
-    fn overlapping(response: &ContactResponse, depth: Real, overlap_ratio: Real) -> Self {
+    fn overlapping(response: &ContactResponse, depth: Real) -> Self {
         PairOut {
             force_on_b: response.force_on_b,
             torque_on_a: response.torque_on_a,
             torque_on_b: response.torque_on_b,
-            overlapping: true,
             damping_force: response.damping_force,
             depth,
-            overlap_ratio,
         }
     }
 }
@@ -196,8 +193,9 @@ impl PairContext<'_> {
         }
     }
 
-    /// The sphere pair (a, b), a < b (A = a): its output and updated spring. `reach` is r_a + r_b and
-    /// `c` the pair's constants.
+    /// The sphere pair (a, b), a < b (A = a): its output, flag and updated spring; `Some(overlap /
+    /// the smaller diameter)` when it overlaps. `reach` is r_a + r_b and `c` the pair's constants;
+    /// `in_contact` says whether it overlapped at the last evaluation (false: its spring is cleared).
     ///
     /// The geometry is [`contact_sphere_sphere`]'s, by its operations (the distance's square root taken
     /// from the squared distance of the cheap test, as `norm` forms it), and the law is the model's
@@ -211,22 +209,23 @@ impl PairContext<'_> {
         reach: Real,
         c: &PairConstants,
         history: &mut TangentialHistory,
+        in_contact: &mut bool,
         out: &mut PairOut,
-    ) -> Result<(), StepError> {
+    ) -> Result<Option<Real>, StepError> {
         let (ka, kb) = (&self.kin[a], &self.kin[b]);
         let d_vec = kb.position - ka.position;
         let d_squared = d_vec.norm_squared();
         if d_squared >= reach * reach {
             // d ≥ r_A + r_B: no overlap beyond the touching band.
-            separated(history, out);
-            return Ok(());
+            separated(history, in_contact);
+            return Ok(None);
         }
         let d = d_squared.sqrt();
         let normal = if d > 0.0 { d_vec / d } else { Vector::x() };
         let depth = reach - d;
         if !(depth > c.touch && depth > 0.0) {
-            separated(history, out);
-            return Ok(());
+            separated(history, in_contact);
+            return Ok(None);
         }
         let Some(law) = &c.law else {
             return Err(self.missing_law(self.props[a].material, self.props[b].material));
@@ -245,12 +244,14 @@ impl PairContext<'_> {
             self.dt,
             history,
         );
-        *out = PairOut::overlapping(&response, depth, depth / c.scale);
-        Ok(())
+        *out = PairOut::overlapping(&response, depth);
+        *in_contact = true;
+        Ok(Some(depth / c.scale))
     }
 
     /// The wall–sphere pair (A = wall `w`, B = sphere `i`) with its constants `c`: the geometry of
-    /// [`contact_plane_sphere`] by its operations, then the model.
+    /// [`contact_plane_sphere`] by its operations, then the model (returns and flags as
+    /// [`PairContext::body_pair`], the ratio over the sphere's diameter).
     #[inline(always)]
     pub(crate) fn wall_pair(
         &self,
@@ -258,18 +259,19 @@ impl PairContext<'_> {
         i: usize,
         c: &WallConstants,
         history: &mut TangentialHistory,
+        in_contact: &mut bool,
         out: &mut PairOut,
-    ) -> Result<(), StepError> {
+    ) -> Result<Option<Real>, StepError> {
         let (k, p, wall) = (&self.kin[i], &self.props[i], &self.walls[w]);
         let height = wall.height(&k.position);
         if height >= p.radius {
-            separated(history, out);
-            return Ok(());
+            separated(history, in_contact);
+            return Ok(None);
         }
         let depth = p.radius - height;
         if !(depth > c.touch && depth > 0.0) {
-            separated(history, out);
-            return Ok(());
+            separated(history, in_contact);
+            return Ok(None);
         }
         let Some(law) = &c.law else {
             return Err(self.missing_law(wall.material, p.material));
@@ -289,8 +291,9 @@ impl PairContext<'_> {
             self.dt,
             history,
         );
-        *out = PairOut::overlapping(&response, depth, depth / (2.0 * p.radius));
-        Ok(())
+        *out = PairOut::overlapping(&response, depth);
+        *in_contact = true;
+        Ok(Some(depth / (2.0 * p.radius)))
     }
 }
 
@@ -306,16 +309,18 @@ pub(crate) fn scaled(model: &ContactModel, root_radius: Real) -> ContactModel {
 
 /// A candidate that does not overlap: the law resets its spring, and it contributes nothing.
 ///
-/// A pair that stays apart already holds the cleared spring, and so does its output flag: both are only
-/// read then, not stored again. The stores dirtied the lists' cache lines of every separated pair on every
-/// step (bed a: ~1.4 of ~3.7 listed pairs per sphere; the history store took 17.5 % of the samples of
-/// `perf record`, 2026-11-22).
+/// A pair that was apart at the last evaluation already holds the cleared spring (`in_contact` false
+/// says so), so it reads and writes nothing but its flag: neither its spring nor its output, whose
+/// records are ~15 times the flag's size. Until 2026-11-23 the flag was a field of the output, and every
+/// separated pair read a cache line of its output and one of its spring on every step (bed c: ~82 % of
+/// ~11 000 listed pairs apart; before 2026-11-22 it also stored both, 17.5 % of `perf record`'s samples
+/// on bed a).
 #[inline(always)]
-fn separated(history: &mut TangentialHistory, out: &mut PairOut) {
-    if !history.is_cleared() {
-        *history = TangentialHistory::default();
-    }
-    if out.overlapping {
-        out.overlapping = false;
+fn separated(history: &mut TangentialHistory, in_contact: &mut bool) {
+    if *in_contact {
+        if !history.is_cleared() {
+            *history = TangentialHistory::default();
+        }
+        *in_contact = false;
     }
 }

@@ -24,7 +24,9 @@ use crate::dynamics::rotation::drift_isotropic;
 use crate::law::TangentialHistory;
 use crate::math::{Point, Real, Vector};
 
-use super::super::step::{first_non_finite, OverlapWarning, StepError, StepReport};
+use super::super::step::{
+    first_non_finite, maybe_non_finite, OverlapWarning, StepError, StepReport,
+};
 use super::super::ContactKey;
 use super::neighbours::TopTwo;
 use super::pair::{Kinematic, PairContext, PairOut, WallPlane};
@@ -199,8 +201,10 @@ const CONTACT_WEIGHT: usize = 8;
 /// The slices of one block.
 struct BlockPart<'a> {
     histories: &'a mut [TangentialHistory],
+    in_contact: &'a mut [bool],
     outs: &'a mut [PairOut],
     wall_histories: &'a mut [TangentialHistory],
+    wall_in_contact: &'a mut [bool],
     wall_outs: &'a mut [PairOut],
     force: &'a mut [Vector],
     torque: &'a mut [Vector],
@@ -344,13 +348,15 @@ impl SphereSim {
                     let (kin, spin) = (&mut kin[k], &mut spin[k]);
                     kin.velocity += h * (f / p.mass + gravity);
                     spin.angular_momentum += h * t;
-                    let sum = f.sum()
-                        + t.sum()
-                        + kin.position.coords.sum()
-                        + kin.velocity.sum()
-                        + spin.orientation.coords.sum()
-                        + spin.angular_momentum.sum();
-                    if !sum.is_finite() {
+                    let maybe = maybe_non_finite(
+                        &f,
+                        &t,
+                        &kin.position,
+                        &kin.velocity,
+                        &spin.orientation,
+                        &spin.angular_momentum,
+                    );
+                    if maybe {
                         if let Some(q) = non_finite_quantity(&f, &t, kin, spin) {
                             return Some((i, q));
                         }
@@ -430,14 +436,14 @@ impl SphereSim {
         let (a, b) = (&list.a, &list.b);
         let (row_start, wall_start) = (&list.row_start, &list.wall_start);
         let (wall_body, wall_of) = (&list.wall_body, &list.wall_of);
-        let note = |found: &mut Found, o: &PairOut, key: ContactKey, wall: bool| {
+        let note = |found: &mut Found, o: &PairOut, ratio: Real, key: ContactKey, wall: bool| {
             found.contacts += 1;
-            found.max_overlap_ratio = found.max_overlap_ratio.max(o.overlap_ratio);
-            if o.overlap_ratio > fraction {
+            found.max_overlap_ratio = found.max_overlap_ratio.max(ratio);
+            if ratio > fraction {
                 let warning = OverlapWarning {
                     key,
                     depth: o.depth,
-                    ratio: o.overlap_ratio,
+                    ratio,
                 };
                 if wall {
                     found.wall_warnings.push(warning);
@@ -455,44 +461,45 @@ impl SphereSim {
                 scattered: true,
                 ..Found::default()
             };
-            for (p, (history, out)) in list.histories.iter_mut().zip(&mut self.out).enumerate() {
+            let pairs = list.histories.iter_mut().zip(&mut list.in_contact);
+            for (p, ((history, in_contact), out)) in pairs.zip(&mut self.out).enumerate() {
                 let (i, j) = (a[p] as usize, b[p] as usize);
-                if let Err(e) = ctx.body_pair(i, j, reach[p], &constants[p], history, out) {
-                    found.error = Some(e);
-                    break;
-                }
-                if out.overlapping {
-                    force[i] -= out.force_on_b;
-                    torque[i] += out.torque_on_a;
-                    force[j] += out.force_on_b;
-                    torque[j] += out.torque_on_b;
-                    note(
-                        &mut found,
-                        out,
-                        ContactKey::Body { a: a[p], b: b[p] },
-                        false,
-                    );
-                }
-            }
-            if found.error.is_none() {
-                for (q, (history, out)) in list
-                    .wall_histories
-                    .iter_mut()
-                    .zip(&mut self.wall_out)
-                    .enumerate()
-                {
-                    let (body, wall) = (wall_body[q], wall_of[q]);
-                    let i = body as usize;
-                    if let Err(e) =
-                        ctx.wall_pair(wall as usize, i, &wall_constants[q], history, out)
-                    {
+                match ctx.body_pair(i, j, reach[p], &constants[p], history, in_contact, out) {
+                    Ok(None) => {}
+                    Ok(Some(ratio)) => {
+                        force[i] -= out.force_on_b;
+                        torque[i] += out.torque_on_a;
+                        force[j] += out.force_on_b;
+                        torque[j] += out.torque_on_b;
+                        let key = ContactKey::Body { a: a[p], b: b[p] };
+                        note(&mut found, out, ratio, key, false);
+                    }
+                    Err(e) => {
                         found.error = Some(e);
                         break;
                     }
-                    if out.overlapping {
-                        force[i] += out.force_on_b;
-                        torque[i] += out.torque_on_b;
-                        note(&mut found, out, ContactKey::Wall { body, wall }, true);
+                }
+            }
+            if found.error.is_none() {
+                let pairs = list
+                    .wall_histories
+                    .iter_mut()
+                    .zip(&mut list.wall_in_contact);
+                for (q, ((history, in_contact), out)) in pairs.zip(&mut self.wall_out).enumerate() {
+                    let (body, wall) = (wall_body[q], wall_of[q]);
+                    let (i, c) = (body as usize, &wall_constants[q]);
+                    match ctx.wall_pair(wall as usize, i, c, history, in_contact, out) {
+                        Ok(None) => {}
+                        Ok(Some(ratio)) => {
+                            force[i] += out.force_on_b;
+                            torque[i] += out.torque_on_b;
+                            let key = ContactKey::Wall { body, wall };
+                            note(&mut found, out, ratio, key, true);
+                        }
+                        Err(e) => {
+                            found.error = Some(e);
+                            break;
+                        }
                     }
                 }
             }
@@ -506,8 +513,10 @@ impl SphereSim {
         let block = |first: usize, part: BlockPart<'_>| -> Found {
             let BlockPart {
                 histories,
+                in_contact,
                 outs,
                 wall_histories,
+                wall_in_contact,
                 wall_outs,
                 force,
                 torque,
@@ -521,48 +530,49 @@ impl SphereSim {
             force.fill(Vector::zeros());
             torque.fill(Vector::zeros());
             let own = |j: usize| j < end && !gathered.get(j).copied().unwrap_or(false);
-            for (k, (history, out)) in histories.iter_mut().zip(outs.iter_mut()).enumerate() {
+            let pairs = histories.iter_mut().zip(in_contact.iter_mut());
+            for (k, ((history, in_contact), out)) in pairs.zip(outs.iter_mut()).enumerate() {
                 let p = p0 + k;
                 let (i, j) = (a[p] as usize, b[p] as usize);
-                if let Err(e) = ctx.body_pair(i, j, reach[p], &constants[p], history, out) {
-                    found.error = Some(e);
-                    return found;
-                }
-                if out.overlapping {
-                    if own(i) {
-                        force[i - first] -= out.force_on_b;
-                        torque[i - first] += out.torque_on_a;
+                match ctx.body_pair(i, j, reach[p], &constants[p], history, in_contact, out) {
+                    Ok(None) => {}
+                    Ok(Some(ratio)) => {
+                        if own(i) {
+                            force[i - first] -= out.force_on_b;
+                            torque[i - first] += out.torque_on_a;
+                        }
+                        if own(j) {
+                            force[j - first] += out.force_on_b;
+                            torque[j - first] += out.torque_on_b;
+                        }
+                        let key = ContactKey::Body { a: a[p], b: b[p] };
+                        note(&mut found, out, ratio, key, false);
                     }
-                    if own(j) {
-                        force[j - first] += out.force_on_b;
-                        torque[j - first] += out.torque_on_b;
+                    Err(e) => {
+                        found.error = Some(e);
+                        return found;
                     }
-                    note(
-                        &mut found,
-                        out,
-                        ContactKey::Body { a: a[p], b: b[p] },
-                        false,
-                    );
                 }
             }
-            for (k, (history, out)) in wall_histories
-                .iter_mut()
-                .zip(wall_outs.iter_mut())
-                .enumerate()
-            {
+            let pairs = wall_histories.iter_mut().zip(wall_in_contact.iter_mut());
+            for (k, ((history, in_contact), out)) in pairs.zip(wall_outs.iter_mut()).enumerate() {
                 let q = q0 + k;
                 let (body, wall) = (wall_body[q], wall_of[q]);
-                let i = body as usize;
-                if let Err(e) = ctx.wall_pair(wall as usize, i, &wall_constants[q], history, out) {
-                    found.wall_error = Some(e);
-                    return found;
-                }
-                if out.overlapping {
-                    if own(i) {
-                        force[i - first] += out.force_on_b;
-                        torque[i - first] += out.torque_on_b;
+                let (i, c) = (body as usize, &wall_constants[q]);
+                match ctx.wall_pair(wall as usize, i, c, history, in_contact, out) {
+                    Ok(None) => {}
+                    Ok(Some(ratio)) => {
+                        if own(i) {
+                            force[i - first] += out.force_on_b;
+                            torque[i - first] += out.torque_on_b;
+                        }
+                        let key = ContactKey::Wall { body, wall };
+                        note(&mut found, out, ratio, key, true);
                     }
-                    note(&mut found, out, ContactKey::Wall { body, wall }, true);
+                    Err(e) => {
+                        found.wall_error = Some(e);
+                        return found;
+                    }
                 }
             }
             found
@@ -570,26 +580,38 @@ impl SphereSim {
         // Split every array at the blocks' boundaries.
         let mut parts = Vec::with_capacity(blocks.bodies.len());
         {
-            let (mut h, mut o) = (&mut list.histories[..], &mut self.out[..]);
-            let (mut wh, mut wo) = (&mut list.wall_histories[..], &mut self.wall_out[..]);
+            let (mut h, mut c, mut o) = (
+                &mut list.histories[..],
+                &mut list.in_contact[..],
+                &mut self.out[..],
+            );
+            let (mut wh, mut wc, mut wo) = (
+                &mut list.wall_histories[..],
+                &mut list.wall_in_contact[..],
+                &mut self.wall_out[..],
+            );
             let (mut f, mut t) = (&mut self.force[..], &mut self.torque[..]);
             for range in &blocks.bodies {
                 let (first, last) = (range.start, range.end);
                 let pairs = (row_start[last] - row_start[first]) as usize;
                 let walls = (wall_start[last] - wall_start[first]) as usize;
                 let (h1, h2) = std::mem::take(&mut h).split_at_mut(pairs);
+                let (c1, c2) = std::mem::take(&mut c).split_at_mut(pairs);
                 let (o1, o2) = std::mem::take(&mut o).split_at_mut(pairs);
                 let (wh1, wh2) = std::mem::take(&mut wh).split_at_mut(walls);
+                let (wc1, wc2) = std::mem::take(&mut wc).split_at_mut(walls);
                 let (wo1, wo2) = std::mem::take(&mut wo).split_at_mut(walls);
                 let (f1, f2) = std::mem::take(&mut f).split_at_mut(last - first);
                 let (t1, t2) = std::mem::take(&mut t).split_at_mut(last - first);
-                (h, o, wh, wo, f, t) = (h2, o2, wh2, wo2, f2, t2);
+                (h, c, o, wh, wc, wo, f, t) = (h2, c2, o2, wh2, wc2, wo2, f2, t2);
                 parts.push((
                     first,
                     BlockPart {
                         histories: h1,
+                        in_contact: c1,
                         outs: o1,
                         wall_histories: wh1,
+                        wall_in_contact: wc1,
                         wall_outs: wo1,
                         force: f1,
                         torque: t1,
@@ -631,9 +653,10 @@ impl SphereSim {
         for f in &mut self.wall_forces {
             *f = Vector::zeros();
         }
+        let list = &self.list;
         for (q, o) in self.wall_out.iter().enumerate() {
-            if o.overlapping {
-                self.wall_forces[self.list.wall_of[q] as usize] -= o.force_on_b;
+            if list.wall_in_contact[q] {
+                self.wall_forces[list.wall_of[q] as usize] -= o.force_on_b;
             }
         }
         let mut external_power = 0.0;
@@ -655,22 +678,22 @@ fn sum_body(
 ) -> (Vector, Vector) {
     let (mut f, mut t) = (Vector::zeros(), Vector::zeros());
     for &p in &list.as_b[list.as_b_start[i] as usize..list.as_b_start[i + 1] as usize] {
-        let o = &out[p as usize];
-        if o.overlapping {
+        if list.in_contact[p as usize] {
+            let o = &out[p as usize];
             f += o.force_on_b;
             t += o.torque_on_b;
         }
     }
-    for o in &out[list.row_start[i] as usize..list.row_start[i + 1] as usize] {
-        if o.overlapping {
-            f -= o.force_on_b;
-            t += o.torque_on_a;
+    for p in list.row_start[i] as usize..list.row_start[i + 1] as usize {
+        if list.in_contact[p] {
+            f -= out[p].force_on_b;
+            t += out[p].torque_on_a;
         }
     }
-    for o in &wall_out[list.wall_start[i] as usize..list.wall_start[i + 1] as usize] {
-        if o.overlapping {
-            f += o.force_on_b;
-            t += o.torque_on_b;
+    for q in list.wall_start[i] as usize..list.wall_start[i + 1] as usize {
+        if list.wall_in_contact[q] {
+            f += wall_out[q].force_on_b;
+            t += wall_out[q].torque_on_b;
         }
     }
     (f, t)
