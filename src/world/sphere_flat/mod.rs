@@ -64,8 +64,10 @@
 //! its lists on its next step), and its contact store then holds the flat list's pairs, with the geometry
 //! the general step would have stored for them at the current positions.
 
+mod fused;
 mod neighbours;
 mod pair;
+mod passes;
 mod step;
 mod team;
 
@@ -315,6 +317,9 @@ impl SphereSim {
                 sim.ledger.initial_total = Some(at_start.energy().mechanical());
             }
         }
+        // The pair loop's blocks for the pool this is made on (so that its first step can already run
+        // as one job of the team: `fused`).
+        sim.ready_blocks();
         Ok(sim)
     }
 

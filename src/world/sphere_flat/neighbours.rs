@@ -196,6 +196,32 @@ impl Layout {
 pub(crate) type ImportHistory<'a> =
     dyn Fn(Option<(u32, u32)>, Option<(u32, u32)>) -> Option<(TangentialHistory, u64)> + Sync + 'a;
 
+/// [`NeighbourList::is_stale`] with the walls' moves formed: what decides from the bodies' displacements
+/// alone whether the lists hold (each thread of the team decides it for itself: `super::fused`).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct StaleTest {
+    /// The lists must be built whatever the displacements (never built, or other walls).
+    always: bool,
+    /// The largest squared move of a wall since the build (m²).
+    walls_moved: Real,
+    skin: Real,
+}
+
+impl StaleTest {
+    /// Whether a pair left out may overlap, with `top` and `large` the two largest squared displacements
+    /// since the build of the small and of the large bodies.
+    pub(crate) fn is_stale(&self, top: TopTwo, large: TopTwo) -> bool {
+        if self.always {
+            return true;
+        }
+        let w1 = self.walls_moved;
+        let margin = 1.0 - 1e-9;
+        top.first.sqrt() + top.second.max(w1).sqrt() >= self.skin * margin
+            || large.first.sqrt() + large.second.max(top.first).max(w1).sqrt()
+                >= self.skin * LARGE_SKIN_FACTOR * margin
+    }
+}
+
 /// The two largest of a set of squared displacements (order-free: the same for any split of the set).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub(crate) struct TopTwo {
@@ -343,18 +369,22 @@ impl NeighbourList {
     /// the build, `top` (squared, bodies) and the walls' moves, sum to the skin.
     /// `large` holds the two largest of the large bodies.
     pub(crate) fn is_stale(&self, top: TopTwo, large: TopTwo, walls: &[WallPlane]) -> bool {
-        if self.builds == 0 || walls.len() != self.walls_at_build.len() {
-            return true;
-        }
-        let w1 = walls
+        self.stale_test(walls).is_stale(top, large)
+    }
+
+    /// The test of [`NeighbourList::is_stale`] for the walls at `walls` (their part of it formed).
+    pub(crate) fn stale_test(&self, walls: &[WallPlane]) -> StaleTest {
+        let always = self.builds == 0 || walls.len() != self.walls_at_build.len();
+        let walls_moved = walls
             .iter()
             .zip(&self.walls_at_build)
             .map(|(w, then)| (w.pose.translation.vector - then).norm_squared())
             .fold(0.0, Real::max);
-        let margin = 1.0 - 1e-9;
-        top.first.sqrt() + top.second.max(w1).sqrt() >= self.skin * margin
-            || large.first.sqrt() + large.second.max(top.first).max(w1).sqrt()
-                >= self.skin * LARGE_SKIN_FACTOR * margin
+        StaleTest {
+            always,
+            walls_moved,
+            skin: self.skin,
+        }
     }
 
     /// Whether body `i` is a large body (listed with the wider skin; see the module docs).

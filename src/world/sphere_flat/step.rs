@@ -1,8 +1,8 @@
 //! One step of the flat sphere path, stage by stage (the stages of `super::super::sphere_step`):
 //!
 //! ```text
-//!  1–2. first half kick, drift, turn; ω = L/J and the displacement since the build   (per sphere)
 //!       walls moved by Δt times their velocity
+//!  1–2. first half kick, drift, turn; ω = L/J and the displacement since the build   (per sphere)
 //!  3.   lists rebuilt if the two largest displacements sum to the skin                (rows per sphere)
 //!  4–5. pair loop: geometry and law of every listed pair and body–wall pair            (per pair)
 //!  6–8. per-sphere sums in key order, second half kick, finiteness check               (per sphere)
@@ -10,71 +10,29 @@
 //! ```
 //! Every per-sphere and per-pair pass writes only its own items' slots, so it runs on rayon's current
 //! pool with the same bits for any number of threads: each thread always takes the same part of each
-//! pass ([`super::team`]), so that a block's records stay in one core's cache from pass to pass. The pair
+//! pass ([`super::team`]), so that a block's records stay in one core's cache from pass to pass; when
+//! the lists hold, the three passes run as one job of the team ([`super::fused`]). The pair
 //! loop runs in blocks of consecutive spheres ([`Blocks`]: one when serial, one per thread otherwise)
 //! and adds each overlapping
 //! pair's loads to its spheres as it goes, for every sphere that only its own block's pairs reach: in
 //! pair order such a sphere i receives its pairs (a, i) by increasing a (rows of a < i come first), then
 //! its own row (i, b) by increasing b, then its walls — the gather's order, so the same sums, bit for
 //! bit. Stage 6 gathers the loads of the other spheres (reached by a pair of an earlier block).
+//! The passes themselves are in [`super::passes`].
 
 use std::time::Instant;
 
-use crate::dynamics::rotation::drift_isotropic;
 use crate::law::TangentialHistory;
 use crate::math::{Point, Real, Vector};
 
-use super::super::step::{
-    first_non_finite, maybe_non_finite, OverlapWarning, StepError, StepReport,
-};
+use super::super::step::{StepError, StepReport};
 use super::super::ContactKey;
+use super::fused::Fused;
 use super::neighbours::TopTwo;
-use super::pair::{Kinematic, PairContext, PairOut, WallPlane};
+use super::pair::{PairContext, PairOut, WallPlane};
+use super::passes::{BlockPart, Drift, Found, Kick, PairBlocks, Rows};
 use super::team::{for_each_part, split_at_ranges};
-use super::{SphereSim, Spin, MIN_PARALLEL_PAIRS};
-
-/// What the pair loop found, summed over its blocks in pair order.
-#[derive(Default)]
-pub(super) struct Found {
-    /// Whether the pair loop summed the loads of the spheres it could (see [`Blocks`]).
-    pub(super) scattered: bool,
-    contacts: usize,
-    max_overlap_ratio: Real,
-    /// Warnings of body pairs, then of wall pairs (each in pair order).
-    warnings: Vec<OverlapWarning>,
-    wall_warnings: Vec<OverlapWarning>,
-    /// The first error of a body pair, and of a wall pair.
-    error: Option<StepError>,
-    wall_error: Option<StepError>,
-}
-
-impl Found {
-    /// The error to report (a body pair's before a wall pair's), else what was found, with the warnings
-    /// of body pairs then of wall pairs as one list (the general step's key order).
-    fn finish(mut self) -> Result<Found, StepError> {
-        if let Some(e) = self.error.take().or(self.wall_error.take()) {
-            return Err(e);
-        }
-        let wall_warnings = std::mem::take(&mut self.wall_warnings);
-        self.warnings.extend(wall_warnings);
-        Ok(self)
-    }
-
-    fn merge(mut self, other: Found) -> Found {
-        self.scattered |= other.scattered;
-        self.contacts += other.contacts;
-        self.max_overlap_ratio = self.max_overlap_ratio.max(other.max_overlap_ratio);
-        self.warnings.extend(other.warnings);
-        self.wall_warnings.extend(other.wall_warnings);
-        if self.error.is_none() {
-            self.error = other.error;
-        }
-        if self.wall_error.is_none() {
-            self.wall_error = other.wall_error;
-        }
-        self
-    }
-}
+use super::{SphereSim, MIN_PARALLEL_PAIRS};
 
 /// The split of the pair loop into blocks of consecutive spheres, one per thread, each with the pairs of
 /// its spheres' rows and their walls, of about equal work: pairs weighted by whether they are in contact
@@ -198,18 +156,6 @@ fn ranges_of_equal_weight(weights: &[usize], wanted: usize) -> Vec<std::ops::Ran
 /// understood). A frictionless law keeps no spring, so its pairs all weigh 1, as before.
 const CONTACT_WEIGHT: usize = 8;
 
-/// The slices of one block.
-struct BlockPart<'a> {
-    histories: &'a mut [TangentialHistory],
-    in_contact: &'a mut [bool],
-    outs: &'a mut [PairOut],
-    wall_histories: &'a mut [TangentialHistory],
-    wall_in_contact: &'a mut [bool],
-    wall_outs: &'a mut [PairOut],
-    force: &'a mut [Vector],
-    torque: &'a mut [Vector],
-}
-
 impl SphereSim {
     /// Advances the simulation by one step (see the module docs).
     pub fn step(&mut self) -> Result<StepReport, StepError> {
@@ -222,167 +168,45 @@ impl SphereSim {
         }
         let mut report = StepReport::default();
         let external_start = self.external_power;
-        let parallel = self.parallel_bodies();
-        // The per-sphere passes run on the team when the pair loop does (its blocks of the last build).
-        let team = parallel && self.blocks.team();
-
-        // 1–2. First half kick, drift, turn.
-        let t = Instant::now();
-        let h = 0.5 * dt;
-        let (props, force, torque) = (&self.props, &self.force, &self.torque);
         // No global viscous damping on this path (`SphereSim::from_world` refuses it), so the kicks leave
         // out the general step's damping terms: with c = 0 they are exact no-ops here (x − (0/m)·v = x
         // because a force summed from +0.0 is never −0.0, and x / (1 + h·0/m) = x), and they cost five of
         // the fourteen divisions per sphere and step.
         debug_assert_eq!(self.params.damping, crate::dynamics::ViscousDamping::None);
-        let (gravity, form) = (self.gravity, self.form);
-        let track_orientation = self.track_orientation;
-        let at_build = &self.list.centres_at_build;
-        let large_flags = &self.list.large_flags;
-        let (top, large) = {
-            let spin = &mut self.spin;
-            let drift = |start: usize, kin: &mut [Kinematic], spin: &mut [Spin]| {
-                let (mut top, mut large) = (TopTwo::default(), TopTwo::default());
-                for (k, (kin, spin)) in kin.iter_mut().zip(spin.iter_mut()).enumerate() {
-                    let i = start + k;
-                    let p = &props[i];
-                    kin.velocity += h * (force[i] / p.mass + gravity);
-                    spin.angular_momentum += h * torque[i];
-                    kin.position += dt * kin.velocity;
-                    if track_orientation && spin.angular_momentum != Vector::zeros() {
-                        drift_isotropic(
-                            form,
-                            &mut spin.orientation,
-                            &spin.angular_momentum,
-                            p.moment,
-                            dt,
-                        );
-                    }
-                    kin.omega = spin.angular_momentum / p.moment;
-                    let moved = (kin.position - at_build[i]).norm_squared();
-                    if large_flags[i] {
-                        large.push(moved);
-                    } else {
-                        top.push(moved);
-                    }
-                }
-                (top, large)
-            };
-            if team {
-                // About the spheres of the thread that pairs and kicks them ([`super::team`]).
-                let ranges = &self.blocks.drift;
-                let parts: Vec<_> = split_at_ranges(&mut self.kin, ranges)
-                    .into_iter()
-                    .zip(split_at_ranges(spin, ranges))
-                    .collect();
-                for_each_part(parts, |k, (kin, spin)| drift(ranges[k].start, kin, spin))
-                    .into_iter()
-                    .fold((TopTwo::default(), TopTwo::default()), |(a, b), (c, d)| {
-                        (a.merge(c), b.merge(d))
-                    })
-            } else {
-                drift(0, &mut self.kin, spin)
-            }
-        };
+
+        // The walls move first: their moves do not depend on the spheres (the drift is the same either
+        // way; until 2026-11-23 they moved after it).
+        let t = Instant::now();
         for (wall, plane) in self.walls.iter_mut().zip(&mut self.planes) {
             wall.pose.translation.vector += dt * wall.velocity;
             *plane = WallPlane::of(wall);
         }
         report.counters.integrate += t.elapsed();
 
-        // 3. Lists.
-        let t = Instant::now();
-        if self.list.is_stale(top, large, &self.planes) {
-            let centres: Vec<Point> = self.kin.iter().map(|k| k.position).collect();
-            self.list.rebuild(
-                &centres,
-                &self.props,
-                &self.planes,
-                parallel,
-                self.step_index,
-                &|_, _| None,
-            );
-            self.prepare_pairs(parallel);
-            report.counters.broad_rebuilds += 1;
-        }
+        // 1–8 as one job of the team while the lists hold, else pass by pass.
+        let (found, non_finite) = match self.fused_step(dt, &mut report) {
+            Some(Fused::Stepped { found, non_finite }) => (found.finish()?, non_finite),
+            stale => {
+                let moved = match stale {
+                    Some(Fused::Stale { top, large }) => (top, large),
+                    _ => self.drift(dt, &mut report),
+                };
+                self.lists(moved, &mut report);
+                let t = Instant::now();
+                let found = self.evaluate(dt)?;
+                report.counters.narrow += t.elapsed();
+                let t = Instant::now();
+                let non_finite = self.kick(dt, found.scattered);
+                report.counters.integrate += t.elapsed();
+                (found, non_finite)
+            }
+        };
         report.counters.body_pairs_tested += self.list.body_pairs() as u64;
         report.counters.wall_pairs_tested += self.list.wall_pairs() as u64;
-        report.counters.broad += t.elapsed();
-
-        // 4–5. Pair loop.
-        let t = Instant::now();
-        let found = self.evaluate(dt)?;
-        let scattered = found.scattered;
         report.contacts = found.contacts;
         report.max_overlap_ratio = found.max_overlap_ratio;
         report.overlap_warnings = found.warnings;
         report.counters.contacts += found.contacts as u64;
-        report.counters.narrow += t.elapsed();
-
-        // 6–8. Per-sphere sums, second half kick, checks.
-        let t = Instant::now();
-        let team = parallel && self.blocks.team();
-        let non_finite = {
-            let (list, out, wall_out) = (&self.list, &self.out, &self.wall_out);
-            let gathered = &self.blocks.gathered;
-            let props = &self.props;
-            let kin = &mut self.kin;
-            let spin = &mut self.spin;
-            let kick = |start: usize,
-                        force: &mut [Vector],
-                        torque: &mut [Vector],
-                        kin: &mut [Kinematic],
-                        spin: &mut [Spin]|
-             -> Option<(usize, &'static str)> {
-                for k in 0..force.len() {
-                    let i = start + k;
-                    let (f, t) = if scattered && !gathered.get(i).copied().unwrap_or(false) {
-                        (force[k], torque[k])
-                    } else {
-                        let (f, t) = sum_body(list, out, wall_out, i);
-                        force[k] = f;
-                        torque[k] = t;
-                        (f, t)
-                    };
-                    let p = &props[i];
-                    let (kin, spin) = (&mut kin[k], &mut spin[k]);
-                    kin.velocity += h * (f / p.mass + gravity);
-                    spin.angular_momentum += h * t;
-                    let maybe = maybe_non_finite(
-                        &f,
-                        &t,
-                        &kin.position,
-                        &kin.velocity,
-                        &spin.orientation,
-                        &spin.angular_momentum,
-                    );
-                    if maybe {
-                        if let Some(q) = non_finite_quantity(&f, &t, kin, spin) {
-                            return Some((i, q));
-                        }
-                    }
-                }
-                None
-            };
-            if team {
-                let ranges = &self.blocks.kick;
-                let parts: Vec<_> = split_at_ranges(&mut self.force, ranges)
-                    .into_iter()
-                    .zip(split_at_ranges(&mut self.torque, ranges))
-                    .zip(split_at_ranges(kin, ranges))
-                    .zip(split_at_ranges(spin, ranges))
-                    .collect();
-                for_each_part(parts, |k, (((f, t), kin), spin)| {
-                    kick(ranges[k].start, f, t, kin, spin)
-                })
-                .into_iter()
-                .flatten()
-                .next()
-            } else {
-                kick(0, &mut self.force, &mut self.torque, kin, spin)
-            }
-        };
-        report.counters.integrate += t.elapsed();
         if let Some((body, quantity)) = non_finite {
             return Err(StepError::NonFinite {
                 step: self.step_index + 1,
@@ -403,10 +227,131 @@ impl SphereSim {
         Ok(report)
     }
 
-    /// Stages 4–5 at the current positions with the tangential increment's time `dt`: every listed pair's
-    /// output and spring, and the loads of every sphere the pair loop can sum itself (see
-    /// [`Blocks`]): the others' are gathered by stage 6.
-    pub(super) fn evaluate(&mut self, dt: Real) -> Result<Found, StepError> {
+    /// What the drift reads.
+    pub(super) fn drift_inputs(&self, dt: Real) -> Drift<'_> {
+        Drift {
+            props: &self.props,
+            force: &self.force,
+            torque: &self.torque,
+            at_build: &self.list.centres_at_build,
+            large_flags: &self.list.large_flags,
+            gravity: self.gravity,
+            form: self.form,
+            dt,
+            track_orientation: self.track_orientation,
+        }
+    }
+
+    /// Stages 1–2 (on the team when the pair loop runs on it, in its blocks of the last build): the
+    /// two largest squared displacements since the build, of the small and of the large spheres.
+    fn drift(&mut self, dt: Real, report: &mut StepReport) -> (TopTwo, TopTwo) {
+        let t = Instant::now();
+        let team = self.parallel_bodies() && self.blocks.team();
+        let mut kin = std::mem::take(&mut self.kin);
+        let mut spin = std::mem::take(&mut self.spin);
+        let drift = self.drift_inputs(dt);
+        let moved = if team {
+            // About the spheres of the thread that pairs and kicks them ([`super::team`]).
+            let ranges = &self.blocks.drift;
+            let parts: Vec<_> = split_at_ranges(&mut kin, ranges)
+                .into_iter()
+                .zip(split_at_ranges(&mut spin, ranges))
+                .collect();
+            for_each_part(parts, |k, (kin, spin)| {
+                drift.run(ranges[k].start, kin, spin)
+            })
+            .into_iter()
+            .fold((TopTwo::default(), TopTwo::default()), |(a, b), (c, d)| {
+                (a.merge(c), b.merge(d))
+            })
+        } else {
+            drift.run(0, &mut kin, &mut spin)
+        };
+        (self.kin, self.spin) = (kin, spin);
+        report.counters.integrate += t.elapsed();
+        moved
+    }
+
+    /// Stage 3: the lists rebuilt if the displacements `moved` since the build may have let a pair in.
+    pub(super) fn lists(&mut self, moved: (TopTwo, TopTwo), report: &mut StepReport) {
+        let t = Instant::now();
+        if self.list.is_stale(moved.0, moved.1, &self.planes) {
+            let parallel = self.parallel_bodies();
+            let centres: Vec<Point> = self.kin.iter().map(|k| k.position).collect();
+            self.list.rebuild(
+                &centres,
+                &self.props,
+                &self.planes,
+                parallel,
+                self.step_index,
+                &|_, _| None,
+            );
+            self.prepare_pairs(parallel);
+            report.counters.broad_rebuilds += 1;
+        }
+        report.counters.broad += t.elapsed();
+    }
+
+    /// What the stage-6 sums read of the lists.
+    pub(super) fn rows(&self) -> Rows<'_> {
+        let list = &self.list;
+        Rows {
+            row_start: &list.row_start,
+            as_b_start: &list.as_b_start,
+            as_b: &list.as_b,
+            wall_start: &list.wall_start,
+            in_contact: &list.in_contact,
+            wall_in_contact: &list.wall_in_contact,
+        }
+    }
+
+    /// Stages 6–8 (on the team when the pair loop ran on it): every sphere's loads not summed by the
+    /// pair loop (all of them unless `scattered`), second half kick, checks; the first non-finite
+    /// quantity, if any.
+    fn kick(&mut self, dt: Real, scattered: bool) -> Option<(usize, &'static str)> {
+        let team = self.parallel_bodies() && self.blocks.team();
+        let (mut force, mut torque) = (
+            std::mem::take(&mut self.force),
+            std::mem::take(&mut self.torque),
+        );
+        let (mut kin, mut spin) = (
+            std::mem::take(&mut self.kin),
+            std::mem::take(&mut self.spin),
+        );
+        let kick = Kick {
+            rows: self.rows(),
+            out: &self.out,
+            wall_out: &self.wall_out,
+            gathered: &self.blocks.gathered,
+            scattered,
+            props: &self.props,
+            gravity: self.gravity,
+            dt,
+        };
+        let non_finite = if team {
+            let ranges = &self.blocks.kick;
+            let parts: Vec<_> = split_at_ranges(&mut force, ranges)
+                .into_iter()
+                .zip(split_at_ranges(&mut torque, ranges))
+                .zip(split_at_ranges(&mut kin, ranges))
+                .zip(split_at_ranges(&mut spin, ranges))
+                .collect();
+            for_each_part(parts, |k, (((f, t), kin), spin)| {
+                kick.run(ranges[k].start, f, t, kin, spin)
+            })
+            .into_iter()
+            .flatten()
+            .next()
+        } else {
+            kick.run(0, &mut force, &mut torque, &mut kin, &mut spin)
+        };
+        (self.force, self.torque, self.kin, self.spin) = (force, torque, kin, spin);
+        non_finite
+    }
+
+    /// The blocks of the pair loop for the current lists and pool (made anew after a build of the lists
+    /// or a change of the pool), and the outputs sized for the lists.
+    pub(super) fn ready_blocks(&mut self) {
         let n_pairs = self.list.body_pairs() + self.list.wall_pairs();
         let parallel = rayon::current_num_threads() > 1 && n_pairs >= MIN_PARALLEL_PAIRS;
         let wanted = if parallel {
@@ -420,6 +365,14 @@ impl SphereSim {
         self.out.resize(self.list.body_pairs(), PairOut::default());
         self.wall_out
             .resize(self.list.wall_pairs(), PairOut::default());
+    }
+
+    /// Stages 4–5 at the current positions with the tangential increment's time `dt`: every listed pair's
+    /// output and spring, and the loads of every sphere the pair loop can sum itself (see
+    /// [`Blocks`]): the others' are gathered by stage 6.
+    pub(super) fn evaluate(&mut self, dt: Real) -> Result<Found, StepError> {
+        self.ready_blocks();
+        let fraction = self.params.overlap_warning_fraction;
         let ctx = PairContext {
             kin: &self.kin,
             props: &self.props,
@@ -427,40 +380,16 @@ impl SphereSim {
             dt,
             step_index: self.step_index,
         };
-        let (reach, constants, wall_constants) =
-            (&self.reach, &self.pair_constants, &self.wall_constants);
-        let fraction = self.params.overlap_warning_fraction;
+        let (reach, constants) = (&self.reach, &self.pair_constants);
         let blocks = &self.blocks;
-        let gathered = &blocks.gathered;
         let list = &mut self.list;
         let (a, b) = (&list.a, &list.b);
-        let (row_start, wall_start) = (&list.row_start, &list.wall_start);
-        let (wall_body, wall_of) = (&list.wall_body, &list.wall_of);
-        let note = |found: &mut Found, o: &PairOut, ratio: Real, key: ContactKey, wall: bool| {
-            found.contacts += 1;
-            found.max_overlap_ratio = found.max_overlap_ratio.max(ratio);
-            if ratio > fraction {
-                let warning = OverlapWarning {
-                    key,
-                    depth: o.depth,
-                    ratio,
-                };
-                if wall {
-                    found.wall_warnings.push(warning);
-                } else {
-                    found.warnings.push(warning);
-                }
-            }
-        };
         if blocks.bodies.len() == 1 {
             // One block of every sphere: the same pass without the test of which spheres it sums.
             let (force, torque) = (&mut self.force, &mut self.torque);
             force.fill(Vector::zeros());
             torque.fill(Vector::zeros());
-            let mut found = Found {
-                scattered: true,
-                ..Found::default()
-            };
+            let mut found = Found::scattered();
             let pairs = list.histories.iter_mut().zip(&mut list.in_contact);
             for (p, ((history, in_contact), out)) in pairs.zip(&mut self.out).enumerate() {
                 let (i, j) = (a[p] as usize, b[p] as usize);
@@ -472,7 +401,7 @@ impl SphereSim {
                         force[j] += out.force_on_b;
                         torque[j] += out.torque_on_b;
                         let key = ContactKey::Body { a: a[p], b: b[p] };
-                        note(&mut found, out, ratio, key, false);
+                        found.note(out.depth, ratio, key, fraction);
                     }
                     Err(e) => {
                         found.error = Some(e);
@@ -481,20 +410,21 @@ impl SphereSim {
                 }
             }
             if found.error.is_none() {
+                let (wall_body, wall_of) = (&list.wall_body, &list.wall_of);
                 let pairs = list
                     .wall_histories
                     .iter_mut()
                     .zip(&mut list.wall_in_contact);
                 for (q, ((history, in_contact), out)) in pairs.zip(&mut self.wall_out).enumerate() {
                     let (body, wall) = (wall_body[q], wall_of[q]);
-                    let (i, c) = (body as usize, &wall_constants[q]);
+                    let (i, c) = (body as usize, &self.wall_constants[q]);
                     match ctx.wall_pair(wall as usize, i, c, history, in_contact, out) {
                         Ok(None) => {}
                         Ok(Some(ratio)) => {
                             force[i] += out.force_on_b;
                             torque[i] += out.torque_on_b;
                             let key = ContactKey::Wall { body, wall };
-                            note(&mut found, out, ratio, key, true);
+                            found.note(out.depth, ratio, key, fraction);
                         }
                         Err(e) => {
                             found.error = Some(e);
@@ -508,74 +438,19 @@ impl SphereSim {
             // one block reported no overlap warning against a wall.
             return found.finish();
         }
-        // One block: bodies `first..first + force.len()`, their rows of pairs and their walls, in pair
-        // order; the loads of every body of the block that no other block's pair reaches are summed here.
-        let block = |first: usize, part: BlockPart<'_>| -> Found {
-            let BlockPart {
-                histories,
-                in_contact,
-                outs,
-                wall_histories,
-                wall_in_contact,
-                wall_outs,
-                force,
-                torque,
-            } = part;
-            let end = first + force.len();
-            let (p0, q0) = (row_start[first] as usize, wall_start[first] as usize);
-            let mut found = Found {
-                scattered: true,
-                ..Found::default()
-            };
-            force.fill(Vector::zeros());
-            torque.fill(Vector::zeros());
-            let own = |j: usize| j < end && !gathered.get(j).copied().unwrap_or(false);
-            let pairs = histories.iter_mut().zip(in_contact.iter_mut());
-            for (k, ((history, in_contact), out)) in pairs.zip(outs.iter_mut()).enumerate() {
-                let p = p0 + k;
-                let (i, j) = (a[p] as usize, b[p] as usize);
-                match ctx.body_pair(i, j, reach[p], &constants[p], history, in_contact, out) {
-                    Ok(None) => {}
-                    Ok(Some(ratio)) => {
-                        if own(i) {
-                            force[i - first] -= out.force_on_b;
-                            torque[i - first] += out.torque_on_a;
-                        }
-                        if own(j) {
-                            force[j - first] += out.force_on_b;
-                            torque[j - first] += out.torque_on_b;
-                        }
-                        let key = ContactKey::Body { a: a[p], b: b[p] };
-                        note(&mut found, out, ratio, key, false);
-                    }
-                    Err(e) => {
-                        found.error = Some(e);
-                        return found;
-                    }
-                }
-            }
-            let pairs = wall_histories.iter_mut().zip(wall_in_contact.iter_mut());
-            for (k, ((history, in_contact), out)) in pairs.zip(wall_outs.iter_mut()).enumerate() {
-                let q = q0 + k;
-                let (body, wall) = (wall_body[q], wall_of[q]);
-                let (i, c) = (body as usize, &wall_constants[q]);
-                match ctx.wall_pair(wall as usize, i, c, history, in_contact, out) {
-                    Ok(None) => {}
-                    Ok(Some(ratio)) => {
-                        if own(i) {
-                            force[i - first] += out.force_on_b;
-                            torque[i - first] += out.torque_on_b;
-                        }
-                        let key = ContactKey::Wall { body, wall };
-                        note(&mut found, out, ratio, key, true);
-                    }
-                    Err(e) => {
-                        found.wall_error = Some(e);
-                        return found;
-                    }
-                }
-            }
-            found
+        let pass = PairBlocks {
+            ctx,
+            a,
+            b,
+            row_start: &list.row_start,
+            wall_start: &list.wall_start,
+            wall_body: &list.wall_body,
+            wall_of: &list.wall_of,
+            reach,
+            constants,
+            wall_constants: &self.wall_constants,
+            gathered: &blocks.gathered,
+            fraction,
         };
         // Split every array at the blocks' boundaries.
         let mut parts = Vec::with_capacity(blocks.bodies.len());
@@ -593,8 +468,8 @@ impl SphereSim {
             let (mut f, mut t) = (&mut self.force[..], &mut self.torque[..]);
             for range in &blocks.bodies {
                 let (first, last) = (range.start, range.end);
-                let pairs = (row_start[last] - row_start[first]) as usize;
-                let walls = (wall_start[last] - wall_start[first]) as usize;
+                let pairs = (pass.row_start[last] - pass.row_start[first]) as usize;
+                let walls = (pass.wall_start[last] - pass.wall_start[first]) as usize;
                 let (h1, h2) = std::mem::take(&mut h).split_at_mut(pairs);
                 let (c1, c2) = std::mem::take(&mut c).split_at_mut(pairs);
                 let (o1, o2) = std::mem::take(&mut o).split_at_mut(pairs);
@@ -619,14 +494,14 @@ impl SphereSim {
                 ));
             }
         }
-        let found = if parallel && parts.len() > 1 {
-            for_each_part(parts, |_, (first, part)| block(first, part))
+        let found = if parts.len() > 1 && rayon::current_num_threads() > 1 {
+            for_each_part(parts, |_, (first, part)| pass.run(first, part))
                 .into_iter()
                 .fold(Found::default(), Found::merge)
         } else {
             parts
                 .into_iter()
-                .map(|(first, part)| block(first, part))
+                .map(|(first, part)| pass.run(first, part))
                 .fold(Found::default(), Found::merge)
         };
         self.outs_valid = true;
@@ -636,10 +511,9 @@ impl SphereSim {
     /// Stage 6 alone (the evaluation of an initial state): every sphere's sums (unless the pair loop
     /// `scattered` them), the walls'.
     pub(super) fn gather_only(&mut self, scattered: bool) {
-        let (list, out, wall_out) = (&self.list, &self.out, &self.wall_out);
         for i in 0..self.kin.len() {
             if !scattered || self.blocks.gathered.get(i).copied().unwrap_or(false) {
-                let (f, t) = sum_body(list, out, wall_out, i);
+                let (f, t) = self.rows().sum_body(&self.out, &self.wall_out, i);
                 self.force[i] = f;
                 self.torque[i] = t;
             }
@@ -665,53 +539,4 @@ impl SphereSim {
         }
         self.external_power = external_power;
     }
-}
-
-/// Stage 6 for sphere `i`: its force and torque summed over its overlapping pairs in key order (pairs
-/// (a, i) by increasing a, (i, b) by increasing b, then its walls), as the general step sums them.
-#[inline(always)]
-fn sum_body(
-    list: &super::NeighbourList,
-    out: &[PairOut],
-    wall_out: &[PairOut],
-    i: usize,
-) -> (Vector, Vector) {
-    let (mut f, mut t) = (Vector::zeros(), Vector::zeros());
-    for &p in &list.as_b[list.as_b_start[i] as usize..list.as_b_start[i + 1] as usize] {
-        if list.in_contact[p as usize] {
-            let o = &out[p as usize];
-            f += o.force_on_b;
-            t += o.torque_on_b;
-        }
-    }
-    for p in list.row_start[i] as usize..list.row_start[i + 1] as usize {
-        if list.in_contact[p] {
-            f -= out[p].force_on_b;
-            t += out[p].torque_on_a;
-        }
-    }
-    for q in list.wall_start[i] as usize..list.wall_start[i + 1] as usize {
-        if list.wall_in_contact[q] {
-            f += wall_out[q].force_on_b;
-            t += wall_out[q].torque_on_b;
-        }
-    }
-    (f, t)
-}
-
-/// The first non-finite quantity of a sphere's loads and state (the general step's order).
-fn non_finite_quantity(
-    force: &Vector,
-    torque: &Vector,
-    kin: &Kinematic,
-    spin: &Spin,
-) -> Option<&'static str> {
-    first_non_finite(
-        force,
-        torque,
-        &kin.position,
-        &kin.velocity,
-        &spin.orientation,
-        &spin.angular_momentum,
-    )
 }

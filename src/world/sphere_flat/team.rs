@@ -11,7 +11,9 @@
 //!
 //! A thread that ends its part first spins until the others end theirs ([`spin_until_all`]) instead of
 //! returning to rayon, whose idle loop soon puts it to sleep: starting and joining the other thread cost
-//! ~3–8 µs per pass on the 2-core VM (per-thread timestamps, 2026-11-22 (late)).
+//! ~3–8 µs per pass on the 2-core VM (per-thread timestamps, 2026-11-22 (late)). Since 2026-11-23 a step
+//! whose lists hold runs its three passes as one job, with a [`Barrier`] between them and the arrays
+//! shared as [`PhaseSlice`]s (`super::fused`); [`for_each_part`] runs the passes of the other steps.
 //!
 //! The spin holds a thread until every thread of the pool has run its part, so a pass needs all of the
 //! pool's threads: a caller that steps several flat simulations at once from jobs of one pool makes each
@@ -78,6 +80,80 @@ fn spin_until_all(arrived: &AtomicUsize, all: usize) {
     }
 }
 
+/// The barriers between the phases of one job that every thread of the team runs (`super::fused`):
+/// the k-th [`Barrier::wait`] of each thread returns once all `threads` have made their k-th call.
+/// What a thread wrote before a wait is visible to every thread after it (the count is released and
+/// acquired).
+pub(super) struct Barrier {
+    arrived: AtomicUsize,
+    threads: usize,
+}
+
+impl Barrier {
+    pub(super) fn new(threads: usize) -> Self {
+        Self {
+            arrived: AtomicUsize::new(0),
+            threads,
+        }
+    }
+
+    /// Waits for the `round`-th time (1, 2, …: each thread counts its own calls).
+    pub(super) fn wait(&self, round: usize) {
+        spin_until_all(&self.arrived, round * self.threads);
+    }
+}
+
+/// A slice that the threads of one team job write in disjoint parts in one phase and read whole in
+/// another, the phases separated by a [`Barrier`]: what the borrow checker cannot see across the
+/// phases of one job, the caller promises (see [`PhaseSlice::part`], [`PhaseSlice::whole`]).
+pub(super) struct PhaseSlice<'a, T> {
+    ptr: *mut T,
+    len: usize,
+    _borrow: std::marker::PhantomData<&'a mut [T]>,
+}
+
+// SAFETY: a PhaseSlice is a `&mut [T]` handed to several threads; the callers of `part` and `whole`
+// keep the accesses of different threads disjoint or read-only within each phase.
+unsafe impl<T: Send> Send for PhaseSlice<'_, T> {}
+unsafe impl<T: Send + Sync> Sync for PhaseSlice<'_, T> {}
+
+impl<'a, T> PhaseSlice<'a, T> {
+    pub(super) fn new(slice: &'a mut [T]) -> Self {
+        Self {
+            ptr: slice.as_mut_ptr(),
+            len: slice.len(),
+            _borrow: std::marker::PhantomData,
+        }
+    }
+
+    /// The items of `range`, to write.
+    ///
+    /// # Safety
+    /// Until the reference is dropped, which must happen before the phase ends, no other reference to
+    /// an item of `range` exists: no other thread's part overlaps it and no thread holds the slice
+    /// [`whole`](Self::whole) in this phase.
+    #[allow(clippy::mut_from_ref)]
+    pub(super) unsafe fn part(&self, range: std::ops::Range<usize>) -> &mut [T] {
+        assert!(
+            range.start <= range.end && range.end <= self.len,
+            "part {range:?} of a slice of {}",
+            self.len
+        );
+        // SAFETY: in bounds (asserted); exclusive by the caller's promise.
+        unsafe { std::slice::from_raw_parts_mut(self.ptr.add(range.start), range.len()) }
+    }
+
+    /// The whole slice, to read.
+    ///
+    /// # Safety
+    /// Until the reference is dropped, which must happen before the phase ends, no thread holds a
+    /// [`part`](Self::part) of the slice.
+    pub(super) unsafe fn whole(&self) -> &[T] {
+        // SAFETY: the slice this was made from, read-only by the caller's promise.
+        unsafe { std::slice::from_raw_parts(self.ptr, self.len) }
+    }
+}
+
 /// `slice` cut into the consecutive pieces of `ranges` (which must tile `0..slice.len()` in order).
 pub(super) fn split_at_ranges<'a, T>(
     mut slice: &'a mut [T],
@@ -121,6 +197,39 @@ mod tests {
         let got =
             pool.install(|| for_each_part(vec![(); 4], |_, ()| rayon::current_thread_index()));
         assert_eq!(got, vec![Some(0), Some(1), Some(0), Some(1)]);
+    }
+
+    #[test]
+    fn barrier_orders_the_phases_of_a_job() {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(2)
+            .build()
+            .unwrap();
+        let mut v = vec![0u64; 8];
+        let shared = PhaseSlice::new(&mut v);
+        let barrier = Barrier::new(2);
+        let sums = pool.install(|| {
+            rayon::broadcast(|ctx| {
+                let k = ctx.index();
+                for round in 1..=3u64 {
+                    // SAFETY: thread k writes items 4k..4k+4 only, then both read after the barrier.
+                    let part = unsafe { shared.part(4 * k..4 * k + 4) };
+                    part.iter_mut().for_each(|x| *x += round);
+                    barrier.wait(2 * round as usize - 1);
+                    // SAFETY: nobody writes between the two barriers of the round.
+                    let sum: u64 = unsafe { shared.whole() }.iter().sum();
+                    barrier.wait(2 * round as usize);
+                    assert_eq!(
+                        sum,
+                        8 * round * (round + 1) / 2,
+                        "thread {k}, round {round}"
+                    );
+                }
+                k
+            })
+        });
+        assert_eq!(sums, vec![0, 1]);
+        assert_eq!(v, vec![6; 8]);
     }
 
     #[test]
