@@ -8,8 +8,7 @@
 //!
 //! How: part k of each pass runs on thread k, as in the pass-by-pass step ([`super::step`]), with the
 //! same functions ([`super::passes`]), so the bits are the same. After the drift, every thread reads
-//! every thread's displacements and decides for itself whether the lists hold
-//! ([`StaleTest`](super::neighbours::StaleTest): the same
+//! every thread's displacements and decides for itself whether the lists hold ([`StaleTest`]: the same
 //! inputs, so the same answer). If they do not, the job ends there and the step goes on pass by pass
 //! (the lists are rebuilt serially); otherwise the pair loop and the kick follow in the same job. A
 //! block that fails (a pair without a law) makes every thread skip the kick, as the pass-by-pass step
@@ -25,18 +24,24 @@
 //!  springs, flags, outputs  -      write P_k                            read all
 //! ```
 
+use std::ops::Range;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Mutex;
 use std::time::Instant;
 
-use crate::math::Real;
+use crate::dynamics::rotation::SubRotation;
+use crate::law::TangentialHistory;
+use crate::math::{Point, Real, Vector};
 
 use super::super::step::StepReport;
-use super::neighbours::TopTwo;
-use super::pair::PairContext;
+use super::neighbours::{StaleTest, TopTwo};
+use super::pair::{
+    Kinematic, PairConstants, PairContext, PairOut, Props, WallConstants, WallPlane,
+};
 use super::passes::{BlockPart, Drift, Found, Kick, PairBlocks, Rows};
+use super::step::Blocks;
 use super::team::{Barrier, PhaseSlice};
-use super::SphereSim;
+use super::{SphereSim, Spin};
 
 /// How a fused step ended.
 pub(super) enum Fused {
@@ -85,180 +90,57 @@ impl SphereSim {
         let threads = rayon::current_num_threads();
         let start = Instant::now();
         let stale_test = self.list.stale_test(&self.planes);
-        let fraction = self.params.overlap_warning_fraction;
-        let step_index = self.step_index;
-        let (gravity, form, track_orientation) = (self.gravity, self.form, self.track_orientation);
         let list = &mut self.list;
         let blocks = &self.blocks;
-        // Per block, its range of body pairs and of wall pairs.
-        let pair_ranges: Vec<_> = blocks
-            .bodies
-            .iter()
-            .map(|r| list.row_start[r.start] as usize..list.row_start[r.end] as usize)
-            .collect();
-        let wall_ranges: Vec<_> = blocks
-            .bodies
-            .iter()
-            .map(|r| list.wall_start[r.start] as usize..list.wall_start[r.end] as usize)
-            .collect();
-        let kin = PhaseSlice::new(&mut self.kin);
-        let spin = PhaseSlice::new(&mut self.spin);
-        let force = PhaseSlice::new(&mut self.force);
-        let torque = PhaseSlice::new(&mut self.torque);
-        let histories = PhaseSlice::new(&mut list.histories);
-        let in_contact = PhaseSlice::new(&mut list.in_contact);
-        let out = PhaseSlice::new(&mut self.out);
-        let wall_histories = PhaseSlice::new(&mut list.wall_histories);
-        let wall_in_contact = PhaseSlice::new(&mut list.wall_in_contact);
-        let wall_out = PhaseSlice::new(&mut self.wall_out);
-        let (props, planes) = (&self.props, &self.planes);
-        let (a, b, row_start, wall_start) = (&list.a, &list.b, &list.row_start, &list.wall_start);
-        let (wall_body, wall_of) = (&list.wall_body, &list.wall_of);
-        let (as_b_start, as_b) = (&list.as_b_start, &list.as_b);
-        let (at_build, large_flags) = (&list.centres_at_build, &list.large_flags);
-        let (reach, constants, wall_constants) =
-            (&self.reach, &self.pair_constants, &self.wall_constants);
-        let moved: Vec<Mutex<(TopTwo, TopTwo)>> = (0..threads).map(|_| Mutex::default()).collect();
-        let failed = AtomicBool::new(false);
-        let barrier = Barrier::new(threads);
-
-        let ends: Vec<ThreadEnd> = rayon::broadcast(|ctx| {
-            let k = ctx.index();
-            // Drift.
-            {
-                let range = blocks.drift[k].clone();
-                // SAFETY: the drift ranges tile the spheres, one per thread; nobody reads kin or spin
-                // whole, or writes force or torque, in this phase.
-                let (kin, spin) = unsafe { (kin.part(range.clone()), spin.part(range.clone())) };
-                let drift = Drift {
-                    props,
-                    // SAFETY: as above.
-                    force: unsafe { force.whole() },
-                    torque: unsafe { torque.whole() },
-                    at_build,
-                    large_flags,
-                    gravity,
-                    form,
-                    dt,
-                    track_orientation,
-                };
-                let m = drift.run(range.start, kin, spin);
-                *moved[k].lock().unwrap_or_else(|e| e.into_inner()) = m;
-            }
-            barrier.wait(1);
-            let drift_end = Instant::now();
-            let (top, large) = moved
+        let job = Job {
+            pair_ranges: blocks
+                .bodies
                 .iter()
-                .map(|m| *m.lock().unwrap_or_else(|e| e.into_inner()))
-                .fold((TopTwo::default(), TopTwo::default()), |(a, b), (c, d)| {
-                    (a.merge(c), b.merge(d))
-                });
-            if stale_test.is_stale(top, large) {
-                return ThreadEnd {
-                    stepped: None,
-                    drift_end,
-                    pairs_end: drift_end,
-                };
-            }
-            // Pair loop.
-            let found = {
-                let (body_range, pairs, walls) = (
-                    blocks.bodies[k].clone(),
-                    pair_ranges[k].clone(),
-                    wall_ranges[k].clone(),
-                );
-                // SAFETY: blocks, their pairs and their walls are disjoint between threads; in this
-                // phase kin is only read, and the pair outputs, springs and flags only in parts.
-                let (part, kin) = unsafe {
-                    (
-                        BlockPart {
-                            histories: histories.part(pairs.clone()),
-                            in_contact: in_contact.part(pairs.clone()),
-                            outs: out.part(pairs),
-                            wall_histories: wall_histories.part(walls.clone()),
-                            wall_in_contact: wall_in_contact.part(walls.clone()),
-                            wall_outs: wall_out.part(walls),
-                            force: force.part(body_range.clone()),
-                            torque: torque.part(body_range.clone()),
-                        },
-                        kin.whole(),
-                    )
-                };
-                let pass = PairBlocks {
-                    ctx: PairContext {
-                        kin,
-                        props,
-                        walls: planes,
-                        dt,
-                        step_index,
-                    },
-                    a,
-                    b,
-                    row_start,
-                    wall_start,
-                    wall_body,
-                    wall_of,
-                    reach,
-                    constants,
-                    wall_constants,
-                    gathered: &blocks.gathered,
-                    fraction,
-                };
-                pass.run(body_range.start, part)
-            };
-            if found.failed() {
-                failed.store(true, Ordering::Release);
-            }
-            barrier.wait(2);
-            let pairs_end = Instant::now();
-            if failed.load(Ordering::Acquire) {
-                return ThreadEnd {
-                    stepped: Some((found, None)),
-                    drift_end,
-                    pairs_end,
-                };
-            }
-            // Kick.
-            let non_finite = {
-                let range = blocks.kick[k].clone();
-                // SAFETY: the kick ranges tile the spheres, one per thread; the outputs, springs and
-                // flags are only read in this phase.
-                let (f, t, kin, spin, rows, out, wall_out) = unsafe {
-                    (
-                        force.part(range.clone()),
-                        torque.part(range.clone()),
-                        kin.part(range.clone()),
-                        spin.part(range.clone()),
-                        Rows {
-                            row_start,
-                            as_b_start,
-                            as_b,
-                            wall_start,
-                            in_contact: in_contact.whole(),
-                            wall_in_contact: wall_in_contact.whole(),
-                        },
-                        out.whole(),
-                        wall_out.whole(),
-                    )
-                };
-                let kick = Kick {
-                    rows,
-                    out,
-                    wall_out,
-                    gathered: &blocks.gathered,
-                    scattered: true,
-                    props,
-                    gravity,
-                    dt,
-                };
-                kick.run(range.start, f, t, kin, spin)
-            };
-            ThreadEnd {
-                stepped: Some((found, non_finite)),
-                drift_end,
-                pairs_end,
-            }
-        });
+                .map(|r| list.row_start[r.start] as usize..list.row_start[r.end] as usize)
+                .collect(),
+            wall_ranges: blocks
+                .bodies
+                .iter()
+                .map(|r| list.wall_start[r.start] as usize..list.wall_start[r.end] as usize)
+                .collect(),
+            blocks,
+            kin: PhaseSlice::new(&mut self.kin),
+            spin: PhaseSlice::new(&mut self.spin),
+            force: PhaseSlice::new(&mut self.force),
+            torque: PhaseSlice::new(&mut self.torque),
+            histories: PhaseSlice::new(&mut list.histories),
+            in_contact: PhaseSlice::new(&mut list.in_contact),
+            out: PhaseSlice::new(&mut self.out),
+            wall_histories: PhaseSlice::new(&mut list.wall_histories),
+            wall_in_contact: PhaseSlice::new(&mut list.wall_in_contact),
+            wall_out: PhaseSlice::new(&mut self.wall_out),
+            props: &self.props,
+            planes: &self.planes,
+            a: &list.a,
+            b: &list.b,
+            row_start: &list.row_start,
+            wall_start: &list.wall_start,
+            wall_body: &list.wall_body,
+            wall_of: &list.wall_of,
+            as_b_start: &list.as_b_start,
+            as_b: &list.as_b,
+            at_build: &list.centres_at_build,
+            large_flags: &list.large_flags,
+            reach: &self.reach,
+            constants: &self.pair_constants,
+            wall_constants: &self.wall_constants,
+            gravity: self.gravity,
+            form: self.form,
+            track_orientation: self.track_orientation,
+            fraction: self.params.overlap_warning_fraction,
+            step_index: self.step_index,
+            dt,
+            stale_test,
+            moved: (0..threads).map(|_| Mutex::default()).collect(),
+            failed: AtomicBool::new(false),
+            barrier: Barrier::new(threads),
+        };
+        let ends: Vec<ThreadEnd> = rayon::broadcast(|ctx| job.run(ctx.index()));
 
         // Stage timers as thread 0 saw the phases end.
         let end = Instant::now();
@@ -272,16 +154,12 @@ impl SphereSim {
             match e.stepped {
                 Some(s) => stepped.push(s),
                 None => {
-                    let (top, large) = moved
-                        .into_iter()
-                        .map(|m| m.into_inner().unwrap_or_else(|e| e.into_inner()))
-                        .fold((TopTwo::default(), TopTwo::default()), |(a, b), (c, d)| {
-                            (a.merge(c), b.merge(d))
-                        });
+                    let (top, large) = job.moved();
                     return Some(Fused::Stale { top, large });
                 }
             }
         }
+        drop(job);
         self.outs_valid = true;
         let mut non_finite = None;
         let mut found = Found::default();
@@ -290,6 +168,220 @@ impl SphereSim {
             non_finite = non_finite.or(nf);
         }
         Some(Fused::Stepped { found, non_finite })
+    }
+}
+
+/// One fused job: the arrays its phases share (see the module docs' table), the inputs they read, and
+/// what the threads exchange (the drift's displacements, a failed block, the barrier).
+struct Job<'a> {
+    blocks: &'a Blocks,
+    /// Per block, its range of body pairs and of body–wall pairs.
+    pair_ranges: Vec<Range<usize>>,
+    wall_ranges: Vec<Range<usize>>,
+    kin: PhaseSlice<'a, Kinematic>,
+    spin: PhaseSlice<'a, Spin>,
+    force: PhaseSlice<'a, Vector>,
+    torque: PhaseSlice<'a, Vector>,
+    histories: PhaseSlice<'a, TangentialHistory>,
+    in_contact: PhaseSlice<'a, bool>,
+    out: PhaseSlice<'a, PairOut>,
+    wall_histories: PhaseSlice<'a, TangentialHistory>,
+    wall_in_contact: PhaseSlice<'a, bool>,
+    wall_out: PhaseSlice<'a, PairOut>,
+    props: &'a [Props],
+    planes: &'a [WallPlane],
+    a: &'a [u32],
+    b: &'a [u32],
+    row_start: &'a [u32],
+    wall_start: &'a [u32],
+    wall_body: &'a [u32],
+    wall_of: &'a [u32],
+    as_b_start: &'a [u32],
+    as_b: &'a [u32],
+    at_build: &'a [Point],
+    large_flags: &'a [bool],
+    reach: &'a [Real],
+    constants: &'a [PairConstants],
+    wall_constants: &'a [WallConstants],
+    gravity: Vector,
+    form: SubRotation,
+    track_orientation: bool,
+    fraction: Real,
+    step_index: u64,
+    dt: Real,
+    stale_test: StaleTest,
+    /// Each thread's two largest squared displacements since the build (small spheres, large ones).
+    moved: Vec<Mutex<(TopTwo, TopTwo)>>,
+    /// Whether a block of the pair loop failed (then no thread kicks).
+    failed: AtomicBool,
+    barrier: Barrier,
+}
+
+impl Job<'_> {
+    /// The phases on thread `k` of the team: drift, the decision whether the lists hold, pair loop,
+    /// kick, with a barrier after the drift and after the pair loop.
+    fn run(&self, k: usize) -> ThreadEnd {
+        // SAFETY (of the three phases' calls): every thread of the team runs `run` once with its own
+        // index k, and the barriers keep the phases apart.
+        let moved = unsafe { self.drift(k) };
+        *self.moved[k].lock().unwrap_or_else(|e| e.into_inner()) = moved;
+        self.barrier.wait(1);
+        let drift_end = Instant::now();
+        let (top, large) = self.moved();
+        if self.stale_test.is_stale(top, large) {
+            return ThreadEnd {
+                stepped: None,
+                drift_end,
+                pairs_end: drift_end,
+            };
+        }
+        let found = unsafe { self.pairs(k) };
+        if found.failed() {
+            self.failed.store(true, Ordering::Release);
+        }
+        self.barrier.wait(2);
+        let pairs_end = Instant::now();
+        let non_finite = if self.failed.load(Ordering::Acquire) {
+            None
+        } else {
+            unsafe { self.kick(k) }
+        };
+        ThreadEnd {
+            stepped: Some((found, non_finite)),
+            drift_end,
+            pairs_end,
+        }
+    }
+
+    /// The displacements of all threads' drifts, merged.
+    fn moved(&self) -> (TopTwo, TopTwo) {
+        self.moved
+            .iter()
+            .map(|m| *m.lock().unwrap_or_else(|e| e.into_inner()))
+            .fold((TopTwo::default(), TopTwo::default()), |(a, b), (c, d)| {
+                (a.merge(c), b.merge(d))
+            })
+    }
+
+    /// Thread `k`'s part of the drift.
+    ///
+    /// # Safety
+    /// Called once per thread index in the drift phase: the drift ranges tile the spheres, kin and spin
+    /// are written only in these parts, and force and torque only read.
+    unsafe fn drift(&self, k: usize) -> (TopTwo, TopTwo) {
+        let range = self.blocks.drift[k].clone();
+        // SAFETY: the caller's promise.
+        let (kin, spin, force, torque) = unsafe {
+            (
+                self.kin.part(range.clone()),
+                self.spin.part(range.clone()),
+                self.force.whole(),
+                self.torque.whole(),
+            )
+        };
+        let drift = Drift {
+            props: self.props,
+            force,
+            torque,
+            at_build: self.at_build,
+            large_flags: self.large_flags,
+            gravity: self.gravity,
+            form: self.form,
+            dt: self.dt,
+            track_orientation: self.track_orientation,
+        };
+        drift.run(range.start, kin, spin)
+    }
+
+    /// Thread `k`'s block of the pair loop.
+    ///
+    /// # Safety
+    /// Called once per thread index in the pair phase: blocks, their pairs and their walls are disjoint
+    /// between threads, the springs, flags, outputs and loads are written only in these parts, and kin
+    /// only read.
+    unsafe fn pairs(&self, k: usize) -> Found {
+        let (bodies, pairs, walls) = (
+            self.blocks.bodies[k].clone(),
+            self.pair_ranges[k].clone(),
+            self.wall_ranges[k].clone(),
+        );
+        // SAFETY: the caller's promise.
+        let (part, kin) = unsafe {
+            (
+                BlockPart {
+                    histories: self.histories.part(pairs.clone()),
+                    in_contact: self.in_contact.part(pairs.clone()),
+                    outs: self.out.part(pairs),
+                    wall_histories: self.wall_histories.part(walls.clone()),
+                    wall_in_contact: self.wall_in_contact.part(walls.clone()),
+                    wall_outs: self.wall_out.part(walls),
+                    force: self.force.part(bodies.clone()),
+                    torque: self.torque.part(bodies.clone()),
+                },
+                self.kin.whole(),
+            )
+        };
+        let pass = PairBlocks {
+            ctx: PairContext {
+                kin,
+                props: self.props,
+                walls: self.planes,
+                dt: self.dt,
+                step_index: self.step_index,
+            },
+            a: self.a,
+            b: self.b,
+            row_start: self.row_start,
+            wall_start: self.wall_start,
+            wall_body: self.wall_body,
+            wall_of: self.wall_of,
+            reach: self.reach,
+            constants: self.constants,
+            wall_constants: self.wall_constants,
+            gathered: &self.blocks.gathered,
+            fraction: self.fraction,
+        };
+        pass.run(bodies.start, part)
+    }
+
+    /// Thread `k`'s part of the kick.
+    ///
+    /// # Safety
+    /// Called once per thread index in the kick phase: the kick ranges tile the spheres, the loads, kin
+    /// and spin are written only in these parts, and the springs' flags and the outputs only read.
+    unsafe fn kick(&self, k: usize) -> Option<(usize, &'static str)> {
+        let range = self.blocks.kick[k].clone();
+        // SAFETY: the caller's promise.
+        let (force, torque, kin, spin, in_contact, wall_in_contact, out, wall_out) = unsafe {
+            (
+                self.force.part(range.clone()),
+                self.torque.part(range.clone()),
+                self.kin.part(range.clone()),
+                self.spin.part(range.clone()),
+                self.in_contact.whole(),
+                self.wall_in_contact.whole(),
+                self.out.whole(),
+                self.wall_out.whole(),
+            )
+        };
+        let kick = Kick {
+            rows: Rows {
+                row_start: self.row_start,
+                as_b_start: self.as_b_start,
+                as_b: self.as_b,
+                wall_start: self.wall_start,
+                in_contact,
+                wall_in_contact,
+            },
+            out,
+            wall_out,
+            gathered: &self.blocks.gathered,
+            scattered: true,
+            props: self.props,
+            gravity: self.gravity,
+            dt: self.dt,
+        };
+        kick.run(range.start, force, torque, kin, spin)
     }
 }
 
