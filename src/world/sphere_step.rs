@@ -9,10 +9,9 @@
 //! those answers are known for the whole world from one pass over it, and each body goes straight to:
 //! - 1–2: v ← v + ½Δt (F/m + g − (c/m) v), L ← L + ½Δt p, x ← x + Δt v, the orientation turned about L
 //!   ([`drift_isotropic`], or not at all for L = 0: the general path's `still_rotation` branch);
-//! - 7–8: the second half kick, then the finiteness check of its loads and state, taken as one sum of
-//!   the 22 values (finite only if every term is; inf − inf and NaN propagate to a non-finite sum), with
-//!   the general per-quantity check ([`super::step`]'s `non_finite_quantity`) run only when the sum is not
-//!   finite, to name the quantity (or to clear a sum that overflowed from finite terms).
+//! - 7–8: the second half kick, then the finiteness check of its loads and state (the general step's
+//!   `non_finite_quantity` of [`super::step`]: one sum of the 22 values first, the quantities one by one
+//!   only when it is not finite).
 //!
 //! Stages 3–6 are the general ones (with the sphere kernel of [`super::sphere_kernel`]), and so are the
 //! ledger and counters of stage 9. Every value is computed by the same functions in the same order, so
@@ -34,8 +33,8 @@ use super::parallel::{
 };
 use super::region_profile::{self, Section};
 use super::step::{
-    evaluate_loads, maybe_non_finite, non_finite_quantity, sum_body_loads, StepError, StepParams,
-    StepReport, StepScratch,
+    evaluate_loads, non_finite_quantity, sum_body_loads, StepError, StepParams, StepReport,
+    StepScratch,
 };
 use super::world::World;
 
@@ -100,19 +99,7 @@ fn kick_and_check(
     let h = 0.5 * dt;
     second_half_kick(body, force, translation, h);
     body.angular_momentum += h * torque;
-    let maybe = maybe_non_finite(
-        force,
-        torque,
-        &body.position,
-        &body.velocity,
-        &body.orientation,
-        &body.angular_momentum,
-    );
-    if maybe {
-        non_finite_quantity(body, force, torque)
-    } else {
-        None
-    }
+    non_finite_quantity(body, force, torque)
 }
 
 /// One step of a world of free spheres (call only when [`applies`] holds; the step's input checks and the

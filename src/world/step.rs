@@ -1252,28 +1252,42 @@ pub(super) fn non_finite_quantity(
     )
 }
 
-/// Whether a body's loads and state may hold a non-finite value: one sum of them all (not finite if any
-/// term is not, or if the sum overflows: then [`first_non_finite`] finds nothing), formed as a tree of
-/// vector sums. The cheap test the sphere paths run on every sphere of every step before the exact
-/// one; as a chain of 18 scalar additions it took ~5 % of a step of the flat sphere path (`perf
-/// record`, bed c, 2026-11-23).
+/// The first non-finite quantity among a body's loads and state, in the order the step's error names
+/// them; shared by the general step and the sphere paths so all report the same quantity.
+///
+/// First one sum of them all, formed as a tree of vector sums: finite only if every term is (inf − inf
+/// and NaN propagate), so a finite sum answers `None` at once; otherwise the quantities are tested one
+/// by one (which also clears a sum that overflowed from finite terms). Every body of every step takes
+/// the test: as a chain of 18 scalar additions the sum took ~5 % of a step of the flat sphere path
+/// (`perf record`, bed c, 2026-11-23), and before that the general step tested the quantities one by
+/// one.
 #[inline(always)]
-pub(super) fn maybe_non_finite(
+pub(super) fn first_non_finite(
     force: &Vector,
     torque: &Vector,
     position: &Point,
     velocity: &Vector,
     orientation: &crate::math::Rotation,
     angular_momentum: &Vector,
-) -> bool {
+) -> Option<&'static str> {
     let sum = ((force + torque) + (position.coords + velocity) + angular_momentum).sum()
         + orientation.coords.sum();
-    !sum.is_finite()
+    if sum.is_finite() {
+        return None;
+    }
+    first_non_finite_one_by_one(
+        force,
+        torque,
+        position,
+        velocity,
+        orientation,
+        angular_momentum,
+    )
 }
 
-/// The first non-finite quantity among a body's loads and state, in the order the step's error names
-/// them; shared by the general step and the flat sphere path so both report the same quantity.
-pub(super) fn first_non_finite(
+#[cold]
+#[inline(never)]
+fn first_non_finite_one_by_one(
     force: &Vector,
     torque: &Vector,
     position: &Point,

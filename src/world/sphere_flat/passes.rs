@@ -7,7 +7,7 @@ use crate::dynamics::rotation::{drift_isotropic, SubRotation};
 use crate::law::TangentialHistory;
 use crate::math::{Point, Real, Vector};
 
-use super::super::step::{first_non_finite, maybe_non_finite, OverlapWarning, StepError};
+use super::super::step::{first_non_finite, OverlapWarning, StepError};
 use super::super::ContactKey;
 use super::neighbours::TopTwo;
 use super::pair::{Kinematic, PairConstants, PairContext, PairOut, Props, WallConstants};
@@ -225,7 +225,7 @@ impl Kick<'_> {
             let (kin, spin) = (&mut kin[k], &mut spin[k]);
             kin.velocity += h * (f / p.mass + self.gravity);
             spin.angular_momentum += h * t;
-            let maybe = maybe_non_finite(
+            let quantity = first_non_finite(
                 &f,
                 &t,
                 &kin.position,
@@ -233,18 +233,8 @@ impl Kick<'_> {
                 &spin.orientation,
                 &spin.angular_momentum,
             );
-            if maybe {
-                let quantity = first_non_finite(
-                    &f,
-                    &t,
-                    &kin.position,
-                    &kin.velocity,
-                    &spin.orientation,
-                    &spin.angular_momentum,
-                );
-                if let Some(q) = quantity {
-                    return Some((i, q));
-                }
+            if let Some(q) = quantity {
+                return Some((i, q));
             }
         }
         None
