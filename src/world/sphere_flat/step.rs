@@ -186,8 +186,9 @@ impl SphereSim {
         // 1–8 as one job of the team while the lists hold, else pass by pass.
         let (found, non_finite) = match self.fused_step(dt, &mut report) {
             Some(Fused::Stepped { found, non_finite }) => (found.finish()?, non_finite),
-            stale => {
-                let moved = match stale {
+            drifted_or_not_run => {
+                // The fused job drifted and found the lists stale, or it did not run: pass by pass.
+                let moved = match drifted_or_not_run {
                     Some(Fused::Stale { top, large }) => (top, large),
                     _ => self.drift(dt, &mut report),
                 };
