@@ -19,8 +19,12 @@ pub struct PreparedModel {
     pub normal: NormalLaw,
     pub damping: PreparedDamping,
     pub tangential: TangentialLaw,
-    /// m* (kg): the tangential dashpot's √(m* k_t).
-    pub effective_mass: Real,
+    /// The tangential dashpot's c_t over δ^¼: damping · √(m* k̂_t) for [`TangentialLaw::DampedMindlin`]
+    /// with k_t = k̂_t √δ (N s/m^(5/4)), zero for the other laws. Formed once per contact, so that an
+    /// evaluation takes c_t from the δ^¼ the viscous normal damping also forms instead of a square root
+    /// of m* k_t of its own (until 2026-11-23: c_t = damping · √(m* k_t) per evaluation; the two agree to
+    /// rounding).
+    pub tangential_dashpot: Real,
 }
 
 impl ContactModel {
@@ -31,7 +35,14 @@ impl ContactModel {
             normal: self.normal,
             damping: self.damping.prepared(self.normal.stiffness, effective_mass),
             tangential: self.tangential,
-            effective_mass,
+            tangential_dashpot: match self.tangential {
+                TangentialLaw::DampedMindlin {
+                    coefficient,
+                    damping,
+                    ..
+                } => damping * (effective_mass * coefficient).sqrt(),
+                _ => 0.0,
+            },
         }
     }
 }
@@ -89,8 +100,8 @@ impl PreparedModel {
             law => {
                 let (stiffness, friction) = law.stiffness_and_friction(overlap);
                 let dashpot = match law {
-                    TangentialLaw::DampedMindlin { damping, .. } => {
-                        damping * (self.effective_mass * stiffness).sqrt()
+                    TangentialLaw::DampedMindlin { .. } => {
+                        self.tangential_dashpot * overlap.max(0.0).sqrt().sqrt()
                     }
                     _ => 0.0,
                 };

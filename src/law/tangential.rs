@@ -325,10 +325,10 @@ pub fn incremental_spring_damped(
     let stiffness_work = 0.5 * (stiffness - history.stiffness) * u_previous.dot(&u);
     let mut force = -stiffness * u;
     let cap = friction * normal_force.max(0.0);
-    let magnitude = force.norm();
     let mut sliding = false;
     let mut friction_dissipation = 0.0;
-    if magnitude > cap {
+    if exceeds(force.norm_squared(), cap) {
+        let magnitude = force.norm();
         sliding = true;
         force *= if magnitude > 0.0 {
             cap / magnitude
@@ -363,6 +363,29 @@ pub fn incremental_spring_damped(
         stiffness_work,
         previous_displacement: u_previous,
     }
+}
+
+/// Whether √`norm_squared` > `cap` (the Coulomb test of [`incremental_spring_damped`]), with the answer
+/// of forming the root: decided on the squares where they differ by more than 1e-12 (relative), by the
+/// root itself within that band and where cap² would leave the normal range. A sticking contact then
+/// waits for no square root (the root's latency sat on this branch for every contact: the hottest
+/// instruction of the flat sphere path's pair loop in `perf annotate`, 2026-11-23).
+///
+/// Exactness: x > cap²(1 + 1e-12), rounded, gives √x > cap (1 + 4e-13), far beyond the root's rounding,
+/// so the rounded root exceeds cap too; likewise below the band.
+#[inline(always)]
+pub(crate) fn exceeds(norm_squared: Real, cap: Real) -> bool {
+    const BAND: Real = 1e-12;
+    if cap > 1e-150 && cap < 1e150 {
+        let cap_squared = cap * cap;
+        if norm_squared > cap_squared * (1.0 + BAND) {
+            return true;
+        }
+        if norm_squared < cap_squared * (1.0 - BAND) {
+            return false;
+        }
+    }
+    norm_squared.sqrt() > cap
 }
 
 /// The step in which a contact opens: the spring of `history` (force −k_t,prev u on B for the first half
