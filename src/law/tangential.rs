@@ -416,6 +416,55 @@ mod tests {
     use super::*;
     use crate::math::Rotation;
 
+    /// `exceeds` answers as the root does: on random magnitudes over 600 decades, on squares placed
+    /// within a few ulps of cap² (where the band hands the decision to the root), and on the edges
+    /// (zero, subnormal, huge, infinite and NaN values).
+    #[test]
+    fn coulomb_test_on_squares_answers_as_the_root() {
+        use rand::{Rng, SeedableRng};
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(23);
+        let check = |x: Real, cap: Real| {
+            assert_eq!(
+                exceeds(x, cap),
+                x.sqrt() > cap,
+                "norm² {x:e}, cap {cap:e}: root {:e}",
+                x.sqrt()
+            );
+        };
+        for _ in 0..200_000 {
+            let cap = 10f64.powf(rng.random_range(-300.0..300.0));
+            let x = 10f64.powf(rng.random_range(-300.0..300.0));
+            check(x, cap);
+            // Near the boundary: cap² moved by a few ulps either way.
+            let c2 = cap * cap;
+            let ulps: i64 = rng.random_range(-8..=8);
+            let near = Real::from_bits((c2.to_bits() as i64 + ulps).max(0) as u64);
+            check(near, cap);
+            check(c2, cap);
+            // A root landing on the cap exactly.
+            let root = cap * (1.0 + rng.random_range(-1e-15..1e-15));
+            check(root * root, cap);
+        }
+        let edges = [
+            0.0,
+            Real::MIN_POSITIVE,
+            5e-324,
+            1e-160,
+            1e-150,
+            1.0,
+            1e150,
+            1e160,
+            Real::MAX,
+            Real::INFINITY,
+            Real::NAN,
+        ];
+        for &x in &edges {
+            for &cap in &edges {
+                check(x, cap);
+            }
+        }
+    }
+
     #[test]
     fn only_the_bits_of_the_default_history_count_as_cleared() {
         assert!(TangentialHistory::default().is_cleared());
