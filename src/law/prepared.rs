@@ -1,7 +1,8 @@
 //! A contact model with the constants of one contact formed: what [`ContactModel::evaluate`] computes
 //! from the model and the effective mass before it looks at the overlap (the viscous damping's
-//! ζ̂ √(m* k_n), the tangential dashpot's damping · √(m* k̂_t)), kept so that a caller that evaluates the same pair over many steps (the flat sphere
-//! path's neighbour list) forms them once per pair instead of once per step.
+//! ζ̂ √(m* k_n), the tangential dashpot's damping · √(m* k̂_t)), kept so that a caller that evaluates
+//! the same pair over many steps (the flat sphere path's neighbour list) forms them once per pair
+//! instead of once per step.
 //!
 //! [`ContactModel::evaluate`] is [`ContactModel::prepared`] followed by [`PreparedModel::respond`], so
 //! the two ways of calling the law are the same operations in the same order, and give the same bits.
