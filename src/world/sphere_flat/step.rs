@@ -26,7 +26,6 @@ use crate::law::TangentialHistory;
 use crate::math::{Point, Real, Vector};
 
 use super::super::step::{StepError, StepReport};
-use super::super::ContactKey;
 use super::fused::Fused;
 use super::neighbours::TopTwo;
 use super::pair::{PairContext, PairOut, WallPlane};
@@ -381,78 +380,39 @@ impl SphereSim {
             dt,
             step_index: self.step_index,
         };
-        let (reach, constants) = (&self.reach, &self.pair_constants);
         let blocks = &self.blocks;
         let list = &mut self.list;
-        let (a, b) = (&list.a, &list.b);
-        if blocks.bodies.len() == 1 {
-            // One block of every sphere: the same pass without the test of which spheres it sums.
-            let (force, torque) = (&mut self.force, &mut self.torque);
-            force.fill(Vector::zeros());
-            torque.fill(Vector::zeros());
-            let mut found = Found::scattered();
-            let pairs = list.histories.iter_mut().zip(&mut list.in_contact);
-            for (p, ((history, in_contact), out)) in pairs.zip(&mut self.out).enumerate() {
-                let (i, j) = (a[p] as usize, b[p] as usize);
-                match ctx.body_pair(i, j, reach[p], &constants[p], history, in_contact, out) {
-                    Ok(None) => {}
-                    Ok(Some(ratio)) => {
-                        force[i] -= out.force_on_b;
-                        torque[i] += out.torque_on_a;
-                        force[j] += out.force_on_b;
-                        torque[j] += out.torque_on_b;
-                        let key = ContactKey::Body { a: a[p], b: b[p] };
-                        found.note(out.depth, ratio, key, fraction);
-                    }
-                    Err(e) => {
-                        found.error = Some(e);
-                        break;
-                    }
-                }
-            }
-            if found.error.is_none() {
-                let (wall_body, wall_of) = (&list.wall_body, &list.wall_of);
-                let pairs = list
-                    .wall_histories
-                    .iter_mut()
-                    .zip(&mut list.wall_in_contact);
-                for (q, ((history, in_contact), out)) in pairs.zip(&mut self.wall_out).enumerate() {
-                    let (body, wall) = (wall_body[q], wall_of[q]);
-                    let (i, c) = (body as usize, &self.wall_constants[q]);
-                    match ctx.wall_pair(wall as usize, i, c, history, in_contact, out) {
-                        Ok(None) => {}
-                        Ok(Some(ratio)) => {
-                            force[i] += out.force_on_b;
-                            torque[i] += out.torque_on_b;
-                            let key = ContactKey::Wall { body, wall };
-                            found.note(out.depth, ratio, key, fraction);
-                        }
-                        Err(e) => {
-                            found.error = Some(e);
-                            break;
-                        }
-                    }
-                }
-            }
-            self.outs_valid = true;
-            // Before 2026-11-22 (evening) this returned without joining the wall warnings to the list: a step on
-            // one block reported no overlap warning against a wall.
-            return found.finish();
-        }
         let pass = PairBlocks {
             ctx,
-            a,
-            b,
+            a: &list.a,
+            b: &list.b,
             row_start: &list.row_start,
             wall_start: &list.wall_start,
             wall_body: &list.wall_body,
             wall_of: &list.wall_of,
-            reach,
-            constants,
+            reach: &self.reach,
+            constants: &self.pair_constants,
             wall_constants: &self.wall_constants,
             gathered: &blocks.gathered,
             fraction,
         };
+        if blocks.bodies.len() == 1 {
+            // One block of every sphere: the same pass without the test of which spheres it sums.
+            let found = pass.run_all(BlockPart {
+                histories: &mut list.histories,
+                in_contact: &mut list.in_contact,
+                outs: &mut self.out,
+                wall_histories: &mut list.wall_histories,
+                wall_in_contact: &mut list.wall_in_contact,
+                wall_outs: &mut self.wall_out,
+                force: &mut self.force,
+                torque: &mut self.torque,
+            });
+            self.outs_valid = true;
+            // Before 2026-11-22 (evening) this returned without joining the wall warnings to the list:
+            // a step on one block reported no overlap warning against a wall.
+            return found.finish();
+        }
         // Split every array at the blocks' boundaries.
         let mut parts = Vec::with_capacity(blocks.bodies.len());
         {
