@@ -325,30 +325,25 @@ pub fn incremental_spring_damped(
     let stiffness_work = 0.5 * (stiffness - history.stiffness) * u_previous.dot(&u);
     let mut force = -stiffness * u;
     let cap = friction * normal_force.max(0.0);
-    let mut sliding = false;
-    let mut friction_dissipation = 0.0;
-    if exceeds(force.norm_squared(), cap) {
-        let magnitude = force.norm();
-        sliding = true;
-        force *= if magnitude > 0.0 {
-            cap / magnitude
-        } else {
-            0.0
-        };
-        let u_capped = if stiffness > 0.0 {
-            -force / stiffness
-        } else {
-            Vector::zeros()
-        };
-        friction_dissipation = 0.5 * stiffness * (u_previous + u_capped).dot(&(u - u_capped));
-        u = u_capped;
-    }
+    // The Coulomb cap without a branch on whether the contact slides (that branch was mispredicted for
+    // ~4 contacts in 10 on the sphere beds): force and spring scaled by min(1, cap / |F|), 1 exactly
+    // for a sticking contact (and for |F| = 0, where the quotient is ∞ or NaN), so a sticking contact
+    // keeps its bits.
+    let magnitude = force.norm();
+    let sliding = magnitude > cap;
+    let scale = (cap / magnitude).min(1.0);
+    force *= scale;
+    let u_capped = u * scale;
+    let friction_dissipation = 0.5 * stiffness * (u_previous + u_capped).dot(&(u - u_capped));
+    u = u_capped;
     let mut damping_power = 0.0;
     let mut damping_force = Vector::zeros();
-    if !sliding && damping > 0.0 {
-        damping_force = -damping * tangential_velocity;
+    if damping > 0.0 {
+        // The dashpot acts while the contact sticks: its coefficient times 1 or 0.
+        let dashpot = damping * Real::from(u8::from(!sliding));
+        damping_force = -dashpot * tangential_velocity;
         force += damping_force;
-        damping_power = damping * tangential_velocity.norm_squared();
+        damping_power = dashpot * tangential_velocity.norm_squared();
     }
     history.displacement = u;
     history.normal = *normal;
@@ -363,29 +358,6 @@ pub fn incremental_spring_damped(
         stiffness_work,
         previous_displacement: u_previous,
     }
-}
-
-/// Whether √`norm_squared` > `cap` (the Coulomb test of [`incremental_spring_damped`]), with the answer
-/// of forming the root: decided on the squares where they differ by more than 1e-12 (relative), by the
-/// root itself within that band and where cap² would leave the normal range. A sticking contact then
-/// waits for no square root (the root's latency sat on this branch for every contact: the hottest
-/// instruction of the flat sphere path's pair loop in `perf annotate`, 2026-11-23).
-///
-/// Exactness: x > cap²(1 + 1e-12), rounded, gives √x > cap (1 + 4e-13), far beyond the root's rounding,
-/// so the rounded root exceeds cap too; likewise below the band.
-#[inline(always)]
-pub(crate) fn exceeds(norm_squared: Real, cap: Real) -> bool {
-    const BAND: Real = 1e-12;
-    if cap > 1e-150 && cap < 1e150 {
-        let cap_squared = cap * cap;
-        if norm_squared > cap_squared * (1.0 + BAND) {
-            return true;
-        }
-        if norm_squared < cap_squared * (1.0 - BAND) {
-            return false;
-        }
-    }
-    norm_squared.sqrt() > cap
 }
 
 /// The step in which a contact opens: the spring of `history` (force −k_t,prev u on B for the first half
@@ -416,53 +388,110 @@ mod tests {
     use super::*;
     use crate::math::Rotation;
 
-    /// `exceeds` answers as the root does: on random magnitudes over 600 decades, on squares placed
-    /// within a few ulps of cap² (where the band hands the decision to the root), and on the edges
-    /// (zero, subnormal, huge, infinite and NaN values).
+    /// The cap without a branch gives what the branch on |F| > μ F_n gave: a sticking spring keeps its
+    /// bits (force −k_t u, spring u, the dashpot added), a sliding one is scaled to the cap (|F| = μ F_n
+    /// and u = −F/k_t to rounding, no dashpot), on random springs over 40 decades and on the edges
+    /// (no spring, no cap, a NaN force).
     #[test]
-    fn coulomb_test_on_squares_answers_as_the_root() {
+    fn branchless_cap_slides_and_sticks_as_the_branch() {
         use rand::{Rng, SeedableRng};
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(23);
-        let check = |x: Real, cap: Real| {
-            assert_eq!(
-                exceeds(x, cap),
-                x.sqrt() > cap,
-                "norm² {x:e}, cap {cap:e}: root {:e}",
-                x.sqrt()
+        let normal = Vector::z();
+        let run = |u0: Vector, v_t: Vector, k: Real, mu: Real, f_n: Real, c_t: Real| {
+            let mut history = TangentialHistory {
+                displacement: u0,
+                normal,
+                stiffness: k,
+            };
+            let r = incremental_spring_damped(
+                SpringRotation::Projection,
+                k,
+                mu,
+                c_t,
+                &normal,
+                f_n,
+                &v_t,
+                1e-6,
+                &mut history,
             );
+            (r, history.displacement)
         };
-        for _ in 0..200_000 {
-            let cap = 10f64.powf(rng.random_range(-300.0..300.0));
-            let x = 10f64.powf(rng.random_range(-300.0..300.0));
-            check(x, cap);
-            // Near the boundary: cap² moved by a few ulps either way.
-            let c2 = cap * cap;
-            let ulps: i64 = rng.random_range(-8..=8);
-            let near = Real::from_bits((c2.to_bits() as i64 + ulps).max(0) as u64);
-            check(near, cap);
-            check(c2, cap);
-            // A root landing on the cap exactly.
-            let root = cap * (1.0 + rng.random_range(-1e-15..1e-15));
-            check(root * root, cap);
-        }
-        let edges = [
-            0.0,
-            Real::MIN_POSITIVE,
-            5e-324,
-            1e-160,
-            1e-150,
-            1.0,
-            1e150,
-            1e160,
-            Real::MAX,
-            Real::INFINITY,
-            Real::NAN,
-        ];
-        for &x in &edges {
-            for &cap in &edges {
-                check(x, cap);
+        let (mut sliding, mut sticking) = (0, 0);
+        for _ in 0..100_000 {
+            let size = 10f64.powf(rng.random_range(-20.0..20.0));
+            let mut random = || {
+                Vector::new(
+                    rng.random_range(-1.0..1.0),
+                    rng.random_range(-1.0..1.0),
+                    0.0,
+                )
+            };
+            let (u0, v_t) = (random() * size, random() * size * 1e6);
+            let k = 10f64.powf(rng.random_range(0.0..8.0));
+            let f_n = k * size * rng.random_range(0.0..4.0);
+            let (mu, c_t) = (0.3, if rng.random_bool(0.5) { 0.0 } else { 1e-3 * k });
+            let (r, u) = run(u0, v_t, k, mu, f_n, c_t);
+            let u_trial = u0 + v_t * 1e-6;
+            let f_trial = -k * u_trial;
+            let cap = mu * f_n;
+            let expect_sliding = f_trial.norm() > cap;
+            assert_eq!(
+                r.sliding, expect_sliding,
+                "u {u_trial:?}, k {k:e}, cap {cap:e}"
+            );
+            if expect_sliding {
+                sliding += 1;
+                let tol = 1e-14 * cap.max(Real::MIN_POSITIVE);
+                assert!(
+                    (r.force.norm() - cap).abs() <= tol,
+                    "sliding: |F| {:e}, cap {cap:e}, tolerance {tol:e}",
+                    r.force.norm()
+                );
+                let u_expected = -r.force / k;
+                assert!(
+                    (u - u_expected).norm() <= 1e-14 * u_expected.norm(),
+                    "sliding: u {u:?}, -F/k {u_expected:?}"
+                );
+                assert_eq!(r.damping_force.norm(), 0.0, "no dashpot while sliding");
+            } else {
+                sticking += 1;
+                let damping = -c_t * v_t;
+                let expected = if c_t > 0.0 {
+                    f_trial + damping
+                } else {
+                    f_trial
+                };
+                assert_eq!(
+                    r.force, expected,
+                    "sticking: same bits, u {u_trial:?}, k {k:e}"
+                );
+                assert_eq!(u, u_trial, "sticking: the spring keeps its bits");
             }
         }
+        assert!(
+            sliding > 10_000 && sticking > 10_000,
+            "{sliding} sliding, {sticking} sticking"
+        );
+        // No spring: nothing slides. No cap, or a NaN normal force (no compression): the spring goes.
+        let (r, u) = run(Vector::zeros(), Vector::zeros(), 1e5, 0.3, 0.0, 0.0);
+        assert!(!r.sliding && r.force == Vector::zeros() && u == Vector::zeros());
+        let (r, u) = run(Vector::x() * 1e-6, Vector::zeros(), 1e5, 0.3, 0.0, 0.0);
+        assert!(
+            r.sliding && r.force.norm() == 0.0 && u.norm() == 0.0,
+            "{r:?} {u:?}"
+        );
+        let (r, u) = run(
+            Vector::x() * 1e-6,
+            Vector::zeros(),
+            1e5,
+            0.3,
+            Real::NAN,
+            0.0,
+        );
+        assert!(
+            r.sliding && r.force.norm() == 0.0 && u.norm() == 0.0,
+            "{r:?} {u:?}"
+        );
     }
 
     #[test]
