@@ -238,6 +238,53 @@ fn flat_path_is_the_same_on_one_two_and_four_threads() {
     }
 }
 
+/// The passes' x86-64-v3 build (AVX2, chosen at run time where the CPU has it) steps to the same bits
+/// as the baseline build, on one thread and on two (the fused job), for both laws. On a CPU without the
+/// features there is one build, and the test says so and checks that it cannot be turned on.
+#[test]
+fn flat_path_is_the_same_with_and_without_wide_instructions() {
+    for file in [
+        "scenes/sphere_bed_a_hertz_5ms.toml",
+        "scenes/sphere_bed_c_linear_5ms.toml",
+    ] {
+        let sim = scene(file);
+        for threads in [1, 2] {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .expect("pool");
+            let run = |wide: bool| {
+                pool.install(|| {
+                    let mut flat = SphereSim::from_world(&sim.world, &sim.params)
+                        .unwrap_or_else(|e| panic!("{file}: {e}"));
+                    let on = flat.set_wide_instructions(wide);
+                    for _ in 0..STEPS {
+                        flat.step()
+                            .unwrap_or_else(|e| panic!("{file}: flat step: {e}"));
+                    }
+                    let mut world = sim.world.clone();
+                    flat.write_back(&mut world);
+                    (on, world)
+                })
+            };
+            let (on, wide) = run(true);
+            let (off, narrow) = run(false);
+            assert!(!off, "{file}: the wide instructions were not turned off");
+            if !on {
+                eprintln!("{file}: this CPU lacks AVX2/BMI: only the baseline build ran");
+                continue;
+            }
+            if let Some(d) = first_difference(&narrow, &wide) {
+                panic!(
+                    "{file}, {STEPS} flat steps on {threads} thread(s), baseline against AVX2: {d}"
+                );
+            }
+            compare_stores(&narrow, &wide)
+                .unwrap_or_else(|e| panic!("{file}, {threads} thread(s), contact stores: {e}"));
+        }
+    }
+}
+
 /// Every step reports the same overlap warnings on both paths, pairs between spheres then pairs with
 /// walls, on one thread (one block of the pair loop) and on two (four blocks). The warning fraction is 0,
 /// so every overlapping contact is a warning: the lists compared are the steps' whole contact lists.

@@ -132,6 +132,7 @@ impl SphereSim {
             gravity: self.gravity,
             form: self.form,
             track_orientation: self.track_orientation,
+            v3: self.v3,
             fraction: self.params.overlap_warning_fraction,
             step_index: self.step_index,
             dt,
@@ -206,6 +207,7 @@ struct Job<'a> {
     gravity: Vector,
     form: SubRotation,
     track_orientation: bool,
+    v3: bool,
     fraction: Real,
     step_index: u64,
     dt: Real,
@@ -289,6 +291,7 @@ impl Job<'_> {
             form: self.form,
             dt: self.dt,
             track_orientation: self.track_orientation,
+            v3: self.v3,
         };
         drift.run(range.start, kin, spin)
     }
@@ -340,6 +343,7 @@ impl Job<'_> {
             wall_constants: self.wall_constants,
             gathered: &self.blocks.gathered,
             fraction: self.fraction,
+            v3: self.v3,
         };
         pass.run(bodies.start, part)
     }
@@ -380,6 +384,7 @@ impl Job<'_> {
             props: self.props,
             gravity: self.gravity,
             dt: self.dt,
+            v3: self.v3,
         };
         kick.run(range.start, force, torque, kin, spin)
     }

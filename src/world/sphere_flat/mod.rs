@@ -65,6 +65,7 @@
 //! the general step would have stored for them at the current positions.
 
 mod fused;
+mod isa;
 mod neighbours;
 mod pair;
 mod passes;
@@ -139,6 +140,8 @@ pub struct SphereSim {
     spare_constants: SpareVec<PairConstants>,
     /// Whether the drift turns the orientations (see [`SphereSim::set_track_orientation`]).
     track_orientation: bool,
+    /// Whether the passes run in their x86-64-v3 build (see [`SphereSim::set_wide_instructions`]).
+    v3: bool,
     /// The pair loop's blocks (made for the current lists and pool).
     blocks: step::Blocks,
     /// The last evaluation of every listed pair (aligned with the lists); valid when `outs_valid`.
@@ -268,6 +271,7 @@ impl SphereSim {
             spare_constants: SpareVec::default(),
             wall_constants: Vec::new(),
             track_orientation: true,
+            v3: isa::v3(),
             blocks: step::Blocks::default(),
             out: Vec::new(),
             wall_out: Vec::new(),
@@ -398,6 +402,15 @@ impl SphereSim {
     /// Whether the drift turns the orientations (see [`SphereSim::set_track_orientation`]).
     pub fn tracks_orientation(&self) -> bool {
         self.track_orientation
+    }
+
+    /// Whether the passes of a step run in their x86-64-v3 build (AVX2; see the module `isa`). On by
+    /// default where the CPU has the features; `on = true` is refused (returns false) where it has not.
+    /// The same bits either way (`tests/sphere_flat_paths.rs`); off is for that comparison and for
+    /// measuring what the wider instructions give. Returns whether they are on.
+    pub fn set_wide_instructions(&mut self, on: bool) -> bool {
+        self.v3 = on && isa::v3();
+        self.v3
     }
 
     /// Whether the per-sphere passes run on the pool (results are the same bits either way).

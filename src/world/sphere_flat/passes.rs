@@ -94,6 +94,8 @@ pub(super) struct Drift<'a> {
     pub(super) form: SubRotation,
     pub(super) dt: Real,
     pub(super) track_orientation: bool,
+    /// Whether to run the x86-64-v3 build ([`super::isa`]; the caller checked the CPU).
+    pub(super) v3: bool,
 }
 
 impl Drift<'_> {
@@ -105,6 +107,22 @@ impl Drift<'_> {
         kin: &mut [Kinematic],
         spin: &mut [Spin],
     ) -> (TopTwo, TopTwo) {
+        #[cfg(target_arch = "x86_64")]
+        if self.v3 {
+            // SAFETY: `v3` is set only where the CPU has the features (`super::isa::v3`).
+            return unsafe { self.run_v3(start, kin, spin) };
+        }
+        self.run_here(start, kin, spin)
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2,bmi1,bmi2,lzcnt,popcnt")]
+    fn run_v3(&self, start: usize, kin: &mut [Kinematic], spin: &mut [Spin]) -> (TopTwo, TopTwo) {
+        self.run_here(start, kin, spin)
+    }
+
+    #[inline(always)]
+    fn run_here(&self, start: usize, kin: &mut [Kinematic], spin: &mut [Spin]) -> (TopTwo, TopTwo) {
         let (dt, h) = (self.dt, 0.5 * self.dt);
         let (mut top, mut large) = (TopTwo::default(), TopTwo::default());
         for (k, (kin, spin)) in kin.iter_mut().zip(spin.iter_mut()).enumerate() {
@@ -197,12 +215,44 @@ pub(super) struct Kick<'a> {
     pub(super) props: &'a [Props],
     pub(super) gravity: Vector,
     pub(super) dt: Real,
+    /// Whether to run the x86-64-v3 build ([`super::isa`]; the caller checked the CPU).
+    pub(super) v3: bool,
 }
 
 impl Kick<'_> {
     /// Spheres `start..start + force.len()`: their loads (gathered where the pair loop did not sum
     /// them), second half kick and finiteness check; the first non-finite quantity, if any.
     pub(super) fn run(
+        &self,
+        start: usize,
+        force: &mut [Vector],
+        torque: &mut [Vector],
+        kin: &mut [Kinematic],
+        spin: &mut [Spin],
+    ) -> Option<(usize, &'static str)> {
+        #[cfg(target_arch = "x86_64")]
+        if self.v3 {
+            // SAFETY: `v3` is set only where the CPU has the features (`super::isa::v3`).
+            return unsafe { self.run_v3(start, force, torque, kin, spin) };
+        }
+        self.run_here(start, force, torque, kin, spin)
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2,bmi1,bmi2,lzcnt,popcnt")]
+    fn run_v3(
+        &self,
+        start: usize,
+        force: &mut [Vector],
+        torque: &mut [Vector],
+        kin: &mut [Kinematic],
+        spin: &mut [Spin],
+    ) -> Option<(usize, &'static str)> {
+        self.run_here(start, force, torque, kin, spin)
+    }
+
+    #[inline(always)]
+    fn run_here(
         &self,
         start: usize,
         force: &mut [Vector],
@@ -268,6 +318,8 @@ pub(super) struct PairBlocks<'a> {
     pub(super) gathered: &'a [bool],
     /// The overlap ratio above which a contact is warned about.
     pub(super) fraction: Real,
+    /// Whether to run the x86-64-v3 build ([`super::isa`]; the caller checked the CPU).
+    pub(super) v3: bool,
 }
 
 impl PairBlocks<'_> {
@@ -275,6 +327,22 @@ impl PairBlocks<'_> {
     /// pair order; the loads of every body of the block that no other block's pair reaches are summed
     /// here.
     pub(super) fn run(&self, first: usize, part: BlockPart<'_>) -> Found {
+        #[cfg(target_arch = "x86_64")]
+        if self.v3 {
+            // SAFETY: `v3` is set only where the CPU has the features (`super::isa::v3`).
+            return unsafe { self.run_v3(first, part) };
+        }
+        self.run_here(first, part)
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2,bmi1,bmi2,lzcnt,popcnt")]
+    fn run_v3(&self, first: usize, part: BlockPart<'_>) -> Found {
+        self.run_here(first, part)
+    }
+
+    #[inline(always)]
+    fn run_here(&self, first: usize, part: BlockPart<'_>) -> Found {
         let end = first + part.force.len();
         self.run_summing(first, part, |j| {
             j < end && !self.gathered.get(j).copied().unwrap_or(false)
@@ -284,6 +352,17 @@ impl PairBlocks<'_> {
     /// The one block of every sphere (the serial pair loop): [`PairBlocks::run`] without the test of
     /// which spheres it sums (all of them).
     pub(super) fn run_all(&self, part: BlockPart<'_>) -> Found {
+        #[cfg(target_arch = "x86_64")]
+        if self.v3 {
+            // SAFETY: `v3` is set only where the CPU has the features (`super::isa::v3`).
+            return unsafe { self.run_all_v3(part) };
+        }
+        self.run_summing(0, part, |_| true)
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2,bmi1,bmi2,lzcnt,popcnt")]
+    fn run_all_v3(&self, part: BlockPart<'_>) -> Found {
         self.run_summing(0, part, |_| true)
     }
 

@@ -239,6 +239,7 @@ impl SphereSim {
             form: self.form,
             dt,
             track_orientation: self.track_orientation,
+            v3: self.v3,
         }
     }
 
@@ -327,6 +328,7 @@ impl SphereSim {
             props: &self.props,
             gravity: self.gravity,
             dt,
+            v3: self.v3,
         };
         let non_finite = if team {
             let ranges = &self.blocks.kick;
@@ -395,6 +397,7 @@ impl SphereSim {
             wall_constants: &self.wall_constants,
             gathered: &blocks.gathered,
             fraction,
+            v3: self.v3,
         };
         if blocks.bodies.len() == 1 {
             // One block of every sphere: the same pass without the test of which spheres it sums.
