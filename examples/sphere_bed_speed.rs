@@ -10,7 +10,7 @@
 //!
 //! ```text
 //! cargo run --release --example sphere_bed_speed -- [--steps N] [--path flat|general] [--threads N]
-//!     [--ledger on|off|scene] [--skin M] [--orientation on|off] [SCENE.toml ...]
+//!     [--ledger on|off|scene] [--skin M] [--orientation on|off] [--wide on|off] [SCENE.toml ...]
 //! ```
 //! Default: 5000 steps (0.01 s of the bed) of the three variants a, b, c, on the flat sphere path
 //! (`polydem::world::SphereSim`, which runs without the per-contact ledger: `--ledger` is then `off`)
@@ -18,7 +18,9 @@
 //! overrides the scene's `energy_ledger` key (`scene`: keep it); `--skin` the Verlet skin of the broad
 //! phase (m; the candidate list changes, the trajectory does not); `--threads` the size of the pool;
 //! `--orientation` whether the flat path turns the spheres' orientations (default off, as the suite's
-//! `sphere_bed` case runs it: no output reads them, and positions and velocities are the same bits).
+//! `sphere_bed` case runs it: no output reads them, and positions and velocities are the same bits);
+//! `--wide` whether the flat path's passes run in their AVX2 build where the CPU has it (default on;
+//! `SphereSim::set_wide_instructions`; the same bits either way).
 
 use polydem::host::{load_average, thread_cpu_time};
 use std::path::PathBuf;
@@ -35,6 +37,7 @@ struct Options {
     ledger: Option<bool>,
     skin: Option<f64>,
     orientation: bool,
+    wide: bool,
     scenes: Vec<PathBuf>,
 }
 
@@ -46,6 +49,7 @@ fn parse() -> Result<Options, String> {
         ledger: None,
         skin: None,
         orientation: false,
+        wide: true,
         scenes: Vec::new(),
     };
     let mut args = std::env::args().skip(1);
@@ -73,6 +77,13 @@ fn parse() -> Result<Options, String> {
                     "on" => true,
                     "off" => false,
                     v => return Err(format!("--orientation: '{v}' is not on or off")),
+                }
+            }
+            "--wide" => {
+                o.wide = match value()?.as_str() {
+                    "on" => true,
+                    "off" => false,
+                    v => return Err(format!("--wide: '{v}' is not on or off")),
                 }
             }
             "--threads" => o.threads = value()?.parse().map_err(|e| format!("--threads: {e}"))?,
@@ -114,7 +125,7 @@ fn main() -> anyhow::Result<()> {
             let cpu0 = thread_cpu_time();
             let t = Instant::now();
             let summary = if o.flat {
-                run_flat(&mut sim, o.orientation)
+                run_flat(&mut sim, o.orientation, o.wide)
             } else {
                 sim.run(|_| Ok(()), |_, _| Ok(()))
                     .map_err(anyhow::Error::from)
@@ -132,9 +143,14 @@ fn main() -> anyhow::Result<()> {
         }
         let steps = summary.steps as f64;
         println!(
-            "scene {} ({} path, {} thread(s))",
+            "scene {} ({} path{}, {} thread(s))",
             path.display(),
             if o.flat { "flat" } else { "general" },
+            if o.flat && !o.wide {
+                ", baseline instructions"
+            } else {
+                ""
+            },
             o.threads
         );
         println!(
@@ -161,10 +177,17 @@ fn main() -> anyhow::Result<()> {
 }
 
 /// The run of `sim` on the flat sphere path, written back into its world at the end.
-fn run_flat(sim: &mut polydem::scene::Simulation, orientation: bool) -> anyhow::Result<RunSummary> {
+fn run_flat(
+    sim: &mut polydem::scene::Simulation,
+    orientation: bool,
+    wide: bool,
+) -> anyhow::Result<RunSummary> {
     let start = Instant::now();
     let mut flat = SphereSim::from_world(&sim.world, &sim.params)?;
     flat.set_track_orientation(orientation);
+    if flat.set_wide_instructions(wide) != wide {
+        eprintln!("--wide on: this CPU lacks AVX2/BMI, the baseline build runs");
+    }
     let mut summary = RunSummary::default();
     let first = flat.step_index() + 1;
     for _ in first..=sim.steps {
