@@ -38,7 +38,7 @@ use super::neighbours::{StaleTest, TopTwo};
 use super::pair::{
     Kinematic, PairConstants, PairContext, PairOut, Props, WallConstants, WallPlane,
 };
-use super::passes::{BlockPart, Drift, Found, Kick, PairBlocks, Rows};
+use super::passes::{BlockPart, Drift, Found, Kick, KickPart, PairBlocks, Rows};
 use super::step::Blocks;
 use super::team::{Barrier, PhaseSlice};
 use super::{SphereSim, Spin};
@@ -386,7 +386,13 @@ impl Job<'_> {
             dt: self.dt,
             v3: self.v3,
         };
-        kick.run(range.start, force, torque, kin, spin)
+        let part = KickPart {
+            force,
+            torque,
+            kin,
+            spin,
+        };
+        kick.run(range.start, part)
     }
 }
 

@@ -219,47 +219,40 @@ pub(super) struct Kick<'a> {
     pub(super) v3: bool,
 }
 
+/// The per-sphere arrays the kick writes, for the spheres of one part.
+pub(super) struct KickPart<'a> {
+    pub(super) force: &'a mut [Vector],
+    pub(super) torque: &'a mut [Vector],
+    pub(super) kin: &'a mut [Kinematic],
+    pub(super) spin: &'a mut [Spin],
+}
+
 impl Kick<'_> {
-    /// Spheres `start..start + force.len()`: their loads (gathered where the pair loop did not sum
+    /// Spheres `start..start + part.force.len()`: their loads (gathered where the pair loop did not sum
     /// them), second half kick and finiteness check; the first non-finite quantity, if any.
-    pub(super) fn run(
-        &self,
-        start: usize,
-        force: &mut [Vector],
-        torque: &mut [Vector],
-        kin: &mut [Kinematic],
-        spin: &mut [Spin],
-    ) -> Option<(usize, &'static str)> {
+    pub(super) fn run(&self, start: usize, part: KickPart<'_>) -> Option<(usize, &'static str)> {
         #[cfg(target_arch = "x86_64")]
         if self.v3 {
             // SAFETY: `v3` is set only where the CPU has the features (`super::isa::v3`).
-            return unsafe { self.run_v3(start, force, torque, kin, spin) };
+            return unsafe { self.run_v3(start, part) };
         }
-        self.run_here(start, force, torque, kin, spin)
+        self.run_here(start, part)
     }
 
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2,bmi1,bmi2,lzcnt,popcnt")]
-    fn run_v3(
-        &self,
-        start: usize,
-        force: &mut [Vector],
-        torque: &mut [Vector],
-        kin: &mut [Kinematic],
-        spin: &mut [Spin],
-    ) -> Option<(usize, &'static str)> {
-        self.run_here(start, force, torque, kin, spin)
+    fn run_v3(&self, start: usize, part: KickPart<'_>) -> Option<(usize, &'static str)> {
+        self.run_here(start, part)
     }
 
     #[inline(always)]
-    fn run_here(
-        &self,
-        start: usize,
-        force: &mut [Vector],
-        torque: &mut [Vector],
-        kin: &mut [Kinematic],
-        spin: &mut [Spin],
-    ) -> Option<(usize, &'static str)> {
+    fn run_here(&self, start: usize, part: KickPart<'_>) -> Option<(usize, &'static str)> {
+        let KickPart {
+            force,
+            torque,
+            kin,
+            spin,
+        } = part;
         let h = 0.5 * self.dt;
         for k in 0..force.len() {
             let i = start + k;

@@ -29,7 +29,7 @@ use super::super::step::{StepError, StepReport};
 use super::fused::Fused;
 use super::neighbours::TopTwo;
 use super::pair::{PairContext, PairOut, WallPlane};
-use super::passes::{BlockPart, Drift, Found, Kick, PairBlocks, Rows};
+use super::passes::{BlockPart, Drift, Found, Kick, KickPart, PairBlocks, Rows};
 use super::team::{for_each_part, split_at_ranges};
 use super::{SphereSim, MIN_PARALLEL_PAIRS};
 
@@ -338,14 +338,26 @@ impl SphereSim {
                 .zip(split_at_ranges(&mut kin, ranges))
                 .zip(split_at_ranges(&mut spin, ranges))
                 .collect();
-            for_each_part(parts, |k, (((f, t), kin), spin)| {
-                kick.run(ranges[k].start, f, t, kin, spin)
+            for_each_part(parts, |k, (((force, torque), kin), spin)| {
+                let part = KickPart {
+                    force,
+                    torque,
+                    kin,
+                    spin,
+                };
+                kick.run(ranges[k].start, part)
             })
             .into_iter()
             .flatten()
             .next()
         } else {
-            kick.run(0, &mut force, &mut torque, &mut kin, &mut spin)
+            let part = KickPart {
+                force: &mut force,
+                torque: &mut torque,
+                kin: &mut kin,
+                spin: &mut spin,
+            };
+            kick.run(0, part)
         };
         (self.force, self.torque, self.kin, self.spin) = (force, torque, kin, spin);
         non_finite
