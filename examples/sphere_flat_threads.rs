@@ -12,13 +12,16 @@
 //!
 //! ```text
 //! cargo run --release --example sphere_flat_threads -- [--steps N] [--warm-up N] [--threads 1,2]
-//!     [--repeat N] [--scenes spheres,a_hertz_5ms,b_hertz_200ms,c_linear_5ms]
+//!     [--repeat N] [--scenes spheres,a_hertz_5ms,b_hertz_200ms,c_linear_5ms] [--driver run|step]
 //! ```
-//! Defaults: 1000 steps after a warm-up of 1000, threads 1,2, 3 repeats, scene `spheres`.
+//! Defaults: 1000 steps after a warm-up of 1000, threads 1,2, 3 repeats, scene `spheres`, the steps run
+//! by `SphereSim::run_steps` as the suite's sphere_bed case runs them (`--driver step`: `SphereSim::step`
+//! called for each step, each step's team job a rayon broadcast).
 
 #[path = "../tests/support/bed.rs"]
 mod bed;
 
+use std::ops::ControlFlow;
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
@@ -32,6 +35,7 @@ struct Options {
     threads: Vec<usize>,
     repeat: usize,
     scenes: Vec<String>,
+    step_by_step: bool,
 }
 
 fn parse() -> Result<Options, String> {
@@ -41,6 +45,7 @@ fn parse() -> Result<Options, String> {
         threads: vec![1, 2],
         repeat: 3,
         scenes: vec!["spheres".into()],
+        step_by_step: false,
     };
     let mut args = std::env::args().skip(1);
     while let Some(a) = args.next() {
@@ -61,6 +66,13 @@ fn parse() -> Result<Options, String> {
                     .collect::<Result<_, _>>()?
             }
             "--scenes" => o.scenes = value()?.split(',').map(str::to_owned).collect(),
+            "--driver" => {
+                o.step_by_step = match value()?.as_str() {
+                    "run" => false,
+                    "step" => true,
+                    other => return Err(format!("--driver: run or step, not {other}")),
+                }
+            }
             _ => return Err(format!("unknown argument {a}")),
         }
     }
@@ -138,17 +150,27 @@ fn main() -> Result<(), String> {
                 let (cpu0, t) = (cpu_time(), Instant::now());
                 let mut stages = [Duration::ZERO; 4];
                 let mut rebuilds = 0;
+                let mut add = |c: &polydem::world::StepCounters| {
+                    for (total, d) in
+                        stages
+                            .iter_mut()
+                            .zip([c.integrate, c.broad, c.narrow, c.accumulate])
+                    {
+                        *total += d;
+                    }
+                    rebuilds += c.broad_rebuilds;
+                };
                 pool.install(|| -> Result<(), String> {
-                    for _ in 0..o.steps {
-                        let c = sim.step().map_err(|e| e.to_string())?.counters;
-                        for (total, d) in
-                            stages
-                                .iter_mut()
-                                .zip([c.integrate, c.broad, c.narrow, c.accumulate])
-                        {
-                            *total += d;
+                    if o.step_by_step {
+                        for _ in 0..o.steps {
+                            add(&sim.step().map_err(|e| e.to_string())?.counters);
                         }
-                        rebuilds += c.broad_rebuilds;
+                    } else {
+                        sim.run_steps(o.steps as u64, |_, report| {
+                            add(&report.counters);
+                            ControlFlow::Continue(())
+                        })
+                        .map_err(|e| e.to_string())?;
                     }
                     Ok(())
                 })?;

@@ -238,6 +238,102 @@ fn flat_path_is_the_same_on_one_two_and_four_threads() {
     }
 }
 
+/// A run of steps (`SphereSim::run_steps`, which on several threads holds the pool's threads for the
+/// whole run) steps to the same bits as `SphereSim::step` called as often, on 1, 2 and 3 threads, with
+/// the same reports, through builds of the lists; it calls back after every step and stops after the step at which it is told to.
+#[test]
+fn run_of_steps_is_the_same_as_stepping() {
+    use std::ops::ControlFlow;
+    // Long enough for the lists to be rebuilt a few times (the ball lands at step ~50).
+    const RUN_STEPS: u64 = 1000;
+    for file in [
+        "scenes/sphere_bed_a_hertz_5ms.toml",
+        "scenes/sphere_bed_c_linear_5ms.toml",
+    ] {
+        let sim = scene(file);
+        for threads in [1, 2, 3] {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .expect("pool");
+            let start = || {
+                SphereSim::from_world(&sim.world, &sim.params)
+                    .unwrap_or_else(|e| panic!("{file}: {e}"))
+            };
+            let (stepped, stepped_reports) = pool.install(|| {
+                let mut flat = start();
+                let reports: Vec<_> = (0..RUN_STEPS)
+                    .map(|_| {
+                        let r = flat.step().unwrap_or_else(|e| panic!("{file}: step: {e}"));
+                        (r.contacts, r.counters.broad_rebuilds, r.max_overlap_ratio)
+                    })
+                    .collect();
+                (flat, reports)
+            });
+            let (ran, ran_reports, steps_seen) = pool.install(|| {
+                let mut flat = start();
+                let mut reports = Vec::new();
+                let mut steps_seen = Vec::new();
+                let done = flat
+                    .run_steps(RUN_STEPS, |flat, r| {
+                        steps_seen.push(flat.step_index());
+                        reports.push((r.contacts, r.counters.broad_rebuilds, r.max_overlap_ratio));
+                        ControlFlow::Continue(())
+                    })
+                    .unwrap_or_else(|e| panic!("{file}: run_steps: {e}"));
+                assert_eq!(done, RUN_STEPS, "{file}, {threads} thread(s): steps run");
+                (flat, reports, steps_seen)
+            });
+            assert_eq!(
+                steps_seen,
+                (1..=RUN_STEPS).collect::<Vec<_>>(),
+                "{file}, {threads} thread(s): the step index seen by each call back"
+            );
+            assert!(
+                ran_reports == stepped_reports,
+                "{file}, {threads} thread(s): the reports of run_steps and step differ"
+            );
+            let rebuilds: u64 = ran_reports.iter().map(|r| r.1).sum();
+            assert!(
+                rebuilds >= 2,
+                "{file}: {rebuilds} builds of the lists in {RUN_STEPS} steps: the run must rebuild them"
+            );
+            let write = |flat: &SphereSim| {
+                let mut world = sim.world.clone();
+                flat.write_back(&mut world);
+                world
+            };
+            let (a, b) = (write(&stepped), write(&ran));
+            if let Some(d) = first_difference(&a, &b) {
+                panic!(
+                    "{file}, {RUN_STEPS} steps on {threads} thread(s), step against run_steps: {d}"
+                );
+            }
+            compare_stores(&a, &b)
+                .unwrap_or_else(|e| panic!("{file}, {threads} thread(s), contact stores: {e}"));
+            // Told to stop after its 7th step, a run stops there.
+            let stopped = pool.install(|| {
+                let mut flat = start();
+                let done = flat
+                    .run_steps(RUN_STEPS, |flat, _| {
+                        if flat.step_index() == 7 {
+                            ControlFlow::Break(())
+                        } else {
+                            ControlFlow::Continue(())
+                        }
+                    })
+                    .unwrap_or_else(|e| panic!("{file}: run_steps: {e}"));
+                (done, flat.step_index())
+            });
+            assert_eq!(
+                stopped,
+                (7, 7),
+                "{file}, {threads} thread(s): (steps run, step index)"
+            );
+        }
+    }
+}
+
 /// The passes' x86-64-v3 build (AVX2, chosen at run time where the CPU has it) steps to the same bits
 /// as the baseline build, on one thread and on two (the fused job), for both laws. On a CPU without the
 /// features there is one build, and the test says so and checks that it cannot be turned on.

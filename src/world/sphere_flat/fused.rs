@@ -4,7 +4,8 @@
 //! Why: each job of the team (`rayon::broadcast`) cost ~4–10 µs to start and join on the 2-core VM, on
 //! top of the work of its parts (a pass's wall time less its slowest part's, per-part timestamps on the
 //! sphere beds, 2026-11-23): about 20 µs of a two-thread step of ~200 µs. A barrier between two phases of
-//! one job costs the wait for the slower thread only.
+//! one job costs the wait for the slower thread only. In a run of steps ([`SphereSim::run_steps`]) the
+//! job is a task of the run's [`Crew`], whose threads are already running, instead of a broadcast.
 //!
 //! How: part k of each pass runs on thread k, as in the pass-by-pass step ([`super::step`]), with the
 //! same functions ([`super::passes`]), so the bits are the same. After the drift, every thread reads
@@ -34,6 +35,7 @@ use crate::law::TangentialHistory;
 use crate::math::{Point, Real, Vector};
 
 use super::super::step::StepReport;
+use super::crew::Crew;
 use super::neighbours::{StaleTest, TopTwo};
 use super::pair::{
     Kinematic, PairConstants, PairContext, PairOut, Props, WallConstants, WallPlane,
@@ -82,8 +84,14 @@ impl SphereSim {
     }
 
     /// Stages 1–8 as one job of the team, when the passes run on it with the blocks of the current lists
-    /// (else `None`: nothing ran).
-    pub(super) fn fused_step(&mut self, dt: Real, report: &mut StepReport) -> Option<Fused> {
+    /// (else `None`: nothing ran): a task of `crew` when the run holds one (of the pool's size), else a
+    /// broadcast on the pool.
+    pub(super) fn fused_step(
+        &mut self,
+        dt: Real,
+        report: &mut StepReport,
+        crew: Option<&Crew>,
+    ) -> Option<Fused> {
         if !self.fuses() {
             return None;
         }
@@ -141,7 +149,10 @@ impl SphereSim {
             failed: AtomicBool::new(false),
             barrier: Barrier::new(threads),
         };
-        let ends: Vec<ThreadEnd> = rayon::broadcast(|ctx| job.run(ctx.index()));
+        let ends: Vec<ThreadEnd> = match crew {
+            Some(crew) if crew.threads() == threads => crew.together(|k| job.run(k)),
+            _ => rayon::broadcast(|ctx| job.run(ctx.index())),
+        };
 
         // Stage timers as thread 0 saw the phases end.
         let end = Instant::now();

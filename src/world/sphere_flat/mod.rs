@@ -17,7 +17,8 @@
 //! (`super::sphere_step`): first half kick, drift (leapfrog translation, one turn about L for the
 //! orientation), walls moved, lists rebuilt when the two largest displacements since the build sum to the
 //! skin, the pair loop (closed-form geometry and the laws of [`crate::law`], [`pair`]), per-body sums, the
-//! second half kick and the finiteness checks. [`SphereSim::write_back`] puts the state back into the
+//! second half kick and the finiteness checks; [`SphereSim::run_steps`] runs many, holding the pool's
+//! threads for the run ([`crew`]). [`SphereSim::write_back`] puts the state back into the
 //! world (bodies, walls, loads, ledger, time, and a contact store with every listed pair's spring and
 //! last forces), so that checkpoints, outputs and the general step continue from it.
 //!
@@ -64,11 +65,13 @@
 //! its lists on its next step), and its contact store then holds the flat list's pairs, with the geometry
 //! the general step would have stored for them at the current positions.
 
+mod crew;
 mod fused;
 mod isa;
 mod neighbours;
 mod pair;
 mod passes;
+mod run;
 mod step;
 mod team;
 

@@ -26,6 +26,7 @@ use crate::law::TangentialHistory;
 use crate::math::{Point, Real, Vector};
 
 use super::super::step::{StepError, StepReport};
+use super::crew::Crew;
 use super::fused::Fused;
 use super::neighbours::TopTwo;
 use super::pair::{PairContext, PairOut, WallPlane};
@@ -158,6 +159,11 @@ const CONTACT_WEIGHT: usize = 8;
 impl SphereSim {
     /// Advances the simulation by one step (see the module docs).
     pub fn step(&mut self) -> Result<StepReport, StepError> {
+        self.step_on(None)
+    }
+
+    /// One step, its team job handed to `crew` when the run holds one ([`SphereSim::run_steps`]).
+    pub(super) fn step_on(&mut self, crew: Option<&Crew>) -> Result<StepReport, StepError> {
         let dt = self.params.dt;
         if !(dt.is_finite() && dt > 0.0) {
             return Err(StepError::InvalidTimeStep {
@@ -183,7 +189,7 @@ impl SphereSim {
         report.counters.integrate += t.elapsed();
 
         // 1–8 as one job of the team while the lists hold, else pass by pass.
-        let (found, non_finite) = match self.fused_step(dt, &mut report) {
+        let (found, non_finite) = match self.fused_step(dt, &mut report, crew) {
             Some(Fused::Stepped { found, non_finite }) => (found.finish()?, non_finite),
             drifted_or_not_run => {
                 // The fused job drifted and found the lists stale, or it did not run: pass by pass.

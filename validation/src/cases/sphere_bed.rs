@@ -19,6 +19,7 @@
 
 use crate::provenance::workspace_root;
 use crate::stats::relative_difference;
+use std::ops::ControlFlow;
 use std::path::Path;
 use std::time::Instant;
 
@@ -272,7 +273,7 @@ fn run_steps(
     sim: &mut Simulation,
     projectile: usize,
     history: &mut History,
-    on_step: &mut dyn FnMut(u64),
+    on_step: &mut (dyn FnMut(u64) + Send),
 ) -> Result<Real, String> {
     let mut sample = |t: Real, z: Real, vz: Real, fz: Real| {
         history.t.push(t);
@@ -312,11 +313,13 @@ fn run_steps(
     let fz = sim.world.loads.forces.get(projectile).map_or(0.0, |f| f.z);
     sample(sim.world.time, b.position.z, b.velocity.z, fz);
     let mut max_overlap: Real = 0.0;
-    let first = flat.step_index() + 1;
-    for n in first..=sim.steps {
-        let report = flat.step().map_err(|e| e.to_string())?;
+    let (last, output_every) = (sim.steps, sim.output_every);
+    // One run of the remaining steps: on two threads it holds the pool's threads throughout (the same
+    // bits as stepping one by one, `SphereSim::run_steps`).
+    flat.run_steps(last.saturating_sub(flat.step_index()), |flat, report| {
+        let n = flat.step_index();
         max_overlap = max_overlap.max(report.max_overlap_ratio);
-        if n % sim.output_every == 0 || n == sim.steps {
+        if n % output_every == 0 || n == last {
             sample(
                 flat.time(),
                 flat.position(projectile).z,
@@ -325,7 +328,9 @@ fn run_steps(
             );
         }
         on_step(n);
-    }
+        ControlFlow::Continue(())
+    })
+    .map_err(|e| e.to_string())?;
     flat.write_back(&mut sim.world);
     Ok(max_overlap)
 }
