@@ -37,7 +37,9 @@
 //! same bits. A build fills the vectors of the build before the last (`spare`) instead of fresh ones.
 //! Both together took a build of the 3000-sphere bed c from ~0.8–1.3 ms to ~0.55–0.65 ms beside the
 //! search (one thread, per-phase timers, 2026-11-22 (late); the search itself, ~1 ms, is unchanged) and
-//! its minor page faults over 5000 steps from 11 788 to 4 868.
+//! its minor page faults over 5000 steps from 11 788 to 4 868. Since 2026-11-23 each chunk of the
+//! search also merges its bodies' rows and copies their springs and constants (in parallel on several
+//! threads), and the build only joins the chunks' vectors; the walls' springs likewise.
 
 use rayon::prelude::*;
 
@@ -106,6 +108,8 @@ pub struct NeighbourList {
     pub(crate) carried_from: Vec<u32>,
     /// The vectors of the build before the last, emptied and refilled by the next build.
     spare: Spare,
+    /// Per chunk of bodies of the search, what it found (kept for the capacity; a clone holds none).
+    chunks: SpareVec<ChunkRows>,
 }
 
 /// [`NeighbourList::carried_from`] of a pair new to the lists.
@@ -132,6 +136,42 @@ struct Spare {
     wall_in_contact: SpareVec<bool>,
     centres_at_build: SpareVec<Point>,
     carried_from: SpareVec<u32>,
+}
+
+/// What the search found for one chunk of bodies, in body order: their rows (partners and row lengths),
+/// their walls, and per pair and body–wall pair what the new lists carry (see `NeighbourList::rebuild`).
+#[derive(Debug, Default)]
+struct ChunkRows {
+    partners: Vec<u32>,
+    lengths: Vec<u32>,
+    walls: Vec<u32>,
+    wall_lengths: Vec<u32>,
+    carried: Vec<u32>,
+    histories: Vec<TangentialHistory>,
+    in_contact: Vec<bool>,
+    since: Vec<u64>,
+    root_radius: Vec<Real>,
+    effective_mass: Vec<Real>,
+    wall_histories: Vec<TangentialHistory>,
+    wall_since: Vec<u64>,
+}
+
+impl ChunkRows {
+    /// Emptied, the capacity kept.
+    fn clear(&mut self) {
+        self.partners.clear();
+        self.lengths.clear();
+        self.walls.clear();
+        self.wall_lengths.clear();
+        self.carried.clear();
+        self.histories.clear();
+        self.in_contact.clear();
+        self.since.clear();
+        self.root_radius.clear();
+        self.effective_mass.clear();
+        self.wall_histories.clear();
+        self.wall_since.clear();
+    }
 }
 
 /// A vector kept only for its capacity (refilled by its owner's next use); a clone holds none.
@@ -487,33 +527,93 @@ impl NeighbourList {
                 }
             }
         };
-        // Per chunk of bodies: (pair partners, row lengths, walls, wall row lengths).
-        let chunk = chunk_len(n, parallel);
-        let search = |range: std::ops::Range<usize>| {
-            let mut partners = Vec::new();
-            let mut lengths = Vec::with_capacity(range.len());
-            let mut wall_list = Vec::new();
-            let mut wall_lengths = Vec::with_capacity(range.len());
-            for i in range {
-                let (p0, w0) = (partners.len(), wall_list.len());
-                row(i, &mut partners);
-                wall_row(i, &mut wall_list);
-                lengths.push((partners.len() - p0) as u32);
-                wall_lengths.push((wall_list.len() - w0) as u32);
+        let mut chunks = std::mem::take(&mut self.chunks.0);
+        // Each new pair's slot in the old lists, if it was listed there: a merge of the old and new rows
+        // of its first body (both sorted by the second body).
+        let old_row = |a: usize| -> (usize, &[u32]) {
+            match self.row_start.get(a..a + 2) {
+                Some(&[s, e]) => (s as usize, &self.b[s as usize..e as usize]),
+                _ => (0, &[][..]),
             }
-            (partners, lengths, wall_list, wall_lengths)
         };
+        let old_wall = |body: usize, wall: u32| -> Option<usize> {
+            let (s, e) = match self.wall_start.get(body..body + 2) {
+                Some(&[s, e]) => (s as usize, e as usize),
+                _ => return None,
+            };
+            self.wall_of[s..e]
+                .iter()
+                .position(|&w| w == wall)
+                .map(|k| s + k)
+        };
+        // Per chunk of bodies, independently: their rows, walls, and each pair's spring and constants
+        // carried over (the constants are functions of the two bodies: the same bits as forming them
+        // again), or imported, or new. Until 2026-11-23 everything after the search ran serially,
+        // ~0.45 ms of a build of ~1.4 ms on two threads (bed c).
+        let search = |(range, rows): (std::ops::Range<usize>, &mut ChunkRows)| {
+            rows.clear();
+            for i in range {
+                let (p0, w0) = (rows.partners.len(), rows.walls.len());
+                row(i, &mut rows.partners);
+                wall_row(i, &mut rows.walls);
+                rows.lengths.push((rows.partners.len() - p0) as u32);
+                rows.wall_lengths.push((rows.walls.len() - w0) as u32);
+                let (old_first, old_row) = old_row(i);
+                let mut k = 0;
+                for &j in &rows.partners[p0..] {
+                    while k < old_row.len() && old_row[k] < j {
+                        k += 1;
+                    }
+                    if k < old_row.len() && old_row[k] == j {
+                        let from = old_first + k;
+                        rows.carried.push(from as u32);
+                        rows.histories.push(self.histories[from]);
+                        rows.in_contact.push(!self.histories[from].is_cleared());
+                        rows.since.push(self.since[from]);
+                        rows.root_radius.push(self.root_radius[from]);
+                        rows.effective_mass.push(self.effective_mass[from]);
+                        continue;
+                    }
+                    let (h, since) =
+                        history_of(Some((i as u32, j)), None).unwrap_or((Default::default(), step));
+                    let (pa, pb) = (&props[i], &props[j as usize]);
+                    rows.carried.push(NOT_CARRIED);
+                    rows.histories.push(h);
+                    rows.in_contact.push(!h.is_cleared());
+                    rows.since.push(since);
+                    rows.root_radius
+                        .push(effective_contact_radius(Some(pa.radius), Some(pb.radius)).sqrt());
+                    rows.effective_mass
+                        .push(pa.mass * pb.mass / (pa.mass + pb.mass));
+                }
+                for &wall in &rows.walls[w0..] {
+                    let (h, since) = match old_wall(i, wall) {
+                        Some(k) => (self.wall_histories[k], self.wall_since[k]),
+                        None => history_of(None, Some((i as u32, wall)))
+                            .unwrap_or((Default::default(), step)),
+                    };
+                    rows.wall_histories.push(h);
+                    rows.wall_since.push(since);
+                }
+            }
+        };
+        let chunk = chunk_len(n, parallel);
         let ranges: Vec<std::ops::Range<usize>> = (0..n)
             .step_by(chunk.max(1))
             .map(|s| s..(s + chunk).min(n))
             .collect();
-        let parts: Vec<_> = if parallel {
-            ranges.into_par_iter().with_max_len(1).map(search).collect()
+        chunks.resize_with(ranges.len(), ChunkRows::default);
+        if parallel {
+            ranges
+                .into_par_iter()
+                .zip(chunks.par_iter_mut())
+                .with_max_len(1)
+                .for_each(search);
         } else {
-            ranges.into_iter().map(search).collect()
-        };
-        // Assemble the new lists in the vectors of the build before the last (their capacity kept:
-        // fresh vectors of a few hundred kB per build came back as page faults on every build).
+            ranges.into_iter().zip(chunks.iter_mut()).for_each(search);
+        }
+        // The chunks joined in the vectors of the build before the last (their capacity kept: fresh
+        // vectors of a few hundred kB per build came back as page faults on every build).
         let mut old = std::mem::take(self);
         let mut spare = std::mem::take(&mut old.spare);
         self.skin = skin;
@@ -524,25 +624,39 @@ impl NeighbourList {
         self.wall_start = recycled(&mut spare.wall_start.0);
         self.wall_of = recycled(&mut spare.wall_of.0);
         self.wall_body = recycled(&mut spare.wall_body.0);
+        self.carried_from = recycled(&mut spare.carried_from.0);
+        self.histories = recycled(&mut spare.histories.0);
+        // A held spring is a contact until the pair loop finds it apart (see `in_contact`).
+        self.in_contact = recycled(&mut spare.in_contact.0);
+        self.since = recycled(&mut spare.since.0);
+        self.root_radius = recycled(&mut spare.root_radius.0);
+        self.effective_mass = recycled(&mut spare.effective_mass.0);
+        self.wall_histories = recycled(&mut spare.wall_histories.0);
+        self.wall_since = recycled(&mut spare.wall_since.0);
         self.row_start.push(0);
         self.wall_start.push(0);
         let mut i = 0u32;
-        for (partners, lengths, wall_list, wall_lengths) in parts {
-            let mut p = 0;
-            for (&len, &wall_len) in lengths.iter().zip(&wall_lengths) {
-                for &j in &partners[p..p + len as usize] {
-                    self.a.push(i);
-                    self.b.push(j);
-                }
-                p += len as usize;
+        for rows in &chunks {
+            for (&len, &wall_len) in rows.lengths.iter().zip(&rows.wall_lengths) {
+                self.a.extend(std::iter::repeat_n(i, len as usize));
                 self.row_start.push(self.a.len() as u32);
                 self.wall_body
                     .extend(std::iter::repeat_n(i, wall_len as usize));
                 self.wall_start.push(self.wall_body.len() as u32);
                 i += 1;
             }
-            self.wall_of.extend_from_slice(&wall_list);
+            self.b.extend_from_slice(&rows.partners);
+            self.wall_of.extend_from_slice(&rows.walls);
+            self.carried_from.extend_from_slice(&rows.carried);
+            self.histories.extend_from_slice(&rows.histories);
+            self.in_contact.extend_from_slice(&rows.in_contact);
+            self.since.extend_from_slice(&rows.since);
+            self.root_radius.extend_from_slice(&rows.root_radius);
+            self.effective_mass.extend_from_slice(&rows.effective_mass);
+            self.wall_histories.extend_from_slice(&rows.wall_histories);
+            self.wall_since.extend_from_slice(&rows.wall_since);
         }
+        self.chunks = SpareVec(chunks);
         // Side-B rows: pairs in key order appended to their second body's row (so increasing a).
         self.as_b_start = recycled(&mut spare.as_b_start.0);
         self.as_b_start.resize(n + 1, 0);
@@ -559,87 +673,9 @@ impl NeighbourList {
             self.as_b[fill[b as usize] as usize] = p as u32;
             fill[b as usize] += 1;
         }
-
-        // Each new pair's slot in the old lists, if it was listed: a merge of the old and new rows of
-        // its first body (both sorted by the second).
-        self.carried_from = recycled(&mut spare.carried_from.0);
-        for a in 0..n {
-            let new_row = &self.b[self.row_start[a] as usize..self.row_start[a + 1] as usize];
-            let (old_first, old_row) = match old.row_start.get(a..a + 2) {
-                Some(&[s, e]) => (s as usize, &old.b[s as usize..e as usize]),
-                _ => (0, &[][..]),
-            };
-            let mut k = 0;
-            for &b in new_row {
-                while k < old_row.len() && old_row[k] < b {
-                    k += 1;
-                }
-                self.carried_from
-                    .push(if k < old_row.len() && old_row[k] == b {
-                        (old_first + k) as u32
-                    } else {
-                        NOT_CARRIED
-                    });
-            }
-        }
-        // Springs and pair constants carried over (the constants are functions of the two bodies:
-        // the same bits as forming them again), or imported, or new.
-        self.histories = recycled(&mut spare.histories.0);
-        self.since = recycled(&mut spare.since.0);
-        self.root_radius = recycled(&mut spare.root_radius.0);
-        self.effective_mass = recycled(&mut spare.effective_mass.0);
-        for (p, &from) in self.carried_from.iter().enumerate() {
-            let (a, b) = (self.a[p], self.b[p]);
-            let k = from as usize;
-            if from != NOT_CARRIED {
-                self.histories.push(old.histories[k]);
-                self.since.push(old.since[k]);
-                self.root_radius.push(old.root_radius[k]);
-                self.effective_mass.push(old.effective_mass[k]);
-                continue;
-            }
-            let (h, since) = history_of(Some((a, b)), None).unwrap_or((Default::default(), step));
-            self.histories.push(h);
-            self.since.push(since);
-            let (pa, pb) = (&props[a as usize], &props[b as usize]);
-            self.root_radius
-                .push(effective_contact_radius(Some(pa.radius), Some(pb.radius)).sqrt());
-            self.effective_mass
-                .push(pa.mass * pb.mass / (pa.mass + pb.mass));
-        }
-        let old_wall = |body: usize, wall: u32| -> Option<usize> {
-            if body + 1 >= old.wall_start.len() {
-                return None;
-            }
-            let (s, e) = (
-                old.wall_start[body] as usize,
-                old.wall_start[body + 1] as usize,
-            );
-            old.wall_of[s..e]
-                .iter()
-                .position(|&w| w == wall)
-                .map(|k| s + k)
-        };
-        self.wall_histories = recycled(&mut spare.wall_histories.0);
-        self.wall_since = recycled(&mut spare.wall_since.0);
         self.wall_in_contact = recycled(&mut spare.wall_in_contact.0);
-        for body in 0..n {
-            for q in self.wall_start[body] as usize..self.wall_start[body + 1] as usize {
-                let wall = self.wall_of[q];
-                let (h, s) = match old_wall(body, wall) {
-                    Some(k) => (old.wall_histories[k], old.wall_since[k]),
-                    None => history_of(None, Some((body as u32, wall)))
-                        .unwrap_or((Default::default(), step)),
-                };
-                self.wall_histories.push(h);
-                self.wall_since.push(s);
-                self.wall_in_contact.push(!h.is_cleared());
-            }
-        }
-        // A held spring is a contact until the pair loop finds it apart (see `in_contact`).
-        self.in_contact = recycled(&mut spare.in_contact.0);
-        self.in_contact
-            .extend(self.histories.iter().map(|h| !h.is_cleared()));
+        self.wall_in_contact
+            .extend(self.wall_histories.iter().map(|h| !h.is_cleared()));
         self.centres_at_build = recycled(&mut spare.centres_at_build.0);
         self.centres_at_build.extend_from_slice(centres);
         self.large_flags = (0..n).map(|i| is_large(props[i].radius)).collect();
