@@ -8,6 +8,7 @@ use crate::law::TangentialHistory;
 use crate::math::{Point, Real, Vector};
 
 use super::super::step::{first_non_finite, OverlapWarning, StepError};
+use super::super::world::Wall;
 use super::super::ContactKey;
 use super::neighbours::TopTwo;
 use super::pair::{Kinematic, PairConstants, PairContext, PairOut, Props, WallConstants};
@@ -508,6 +509,30 @@ impl Iterator for Listed {
         self.bits &= self.bits - 1;
         Some(k)
     }
+}
+
+/// Stage 9's sums, a pure function of the pair loop's wall outputs: the force on each wall, its pairs
+/// taken in pair order (bodies by increasing index), and the power the walls deliver.
+pub(super) fn wall_sums(
+    wall_out: &[PairOut],
+    wall_in_contact: &[bool],
+    wall_of: &[u32],
+    walls: &[Wall],
+    forces: &mut [Vector],
+) -> Real {
+    for f in forces.iter_mut() {
+        *f = Vector::zeros();
+    }
+    for ((o, &overlapping), &w) in wall_out.iter().zip(wall_in_contact).zip(wall_of) {
+        if overlapping {
+            forces[w as usize] -= o.force_on_b;
+        }
+    }
+    let mut external_power = 0.0;
+    for (f, wall) in forces.iter().zip(walls) {
+        external_power -= f.dot(&wall.velocity);
+    }
+    external_power
 }
 
 #[cfg(test)]

@@ -22,14 +22,14 @@
 
 use std::time::Instant;
 
-use crate::math::{Point, Real, Vector};
+use crate::math::{Point, Real};
 
 use super::super::step::{StepError, StepReport};
 use super::crew::Crew;
 use super::fused::Fused;
 use super::neighbours::TopTwo;
 use super::pair::{PairContext, PairOut, WallPlane};
-use super::passes::{BlockPart, Drift, Found, Kick, KickPart, PairBlocks, Rows};
+use super::passes::{wall_sums, BlockPart, Drift, Found, Kick, KickPart, PairBlocks, Rows};
 use super::team::{for_each_part, split_at_ranges};
 use super::{SphereSim, MIN_PARALLEL_PAIRS};
 
@@ -112,8 +112,17 @@ impl Blocks {
         // The kick: a gathered sphere also sums its pairs, which took about two kicks' time (per-thread
         // timestamps on bed c, 2026-11-22 (late): with the pair blocks' split the thread of the second
         // block, ~1700 spheres of which ~160 gathered, kicked in ~21 µs against ~13 µs for ~1300).
-        let kick_weights: Vec<usize> = gathered.iter().map(|&g| 1 + 2 * usize::from(g)).collect();
-        let kick = ranges_of_equal_weight(&kick_weights, bodies.len());
+        // The last thread also forms the walls' sums in the kick phase (`super::fused`): counted as
+        // one more item of a third of a kick per body–wall pair (the sums took 1.2–2.6 µs per step and
+        // a kick ~9 ns per sphere on beds a and c, with a few hundred to a thousand wall pairs listed).
+        let mut kick_weights: Vec<usize> =
+            gathered.iter().map(|&g| 1 + 2 * usize::from(g)).collect();
+        kick_weights.push(list.wall_pairs() / 3);
+        let mut kick = ranges_of_equal_weight(&kick_weights, bodies.len());
+        if let Some(last) = kick.last_mut() {
+            last.end = last.end.min(n);
+            last.start = last.start.min(last.end);
+        }
         let parts = bodies.len();
         let drift = (0..parts)
             .map(|k| k * n / parts..(k + 1) * n / parts)
@@ -190,8 +199,12 @@ impl SphereSim {
         report.counters.integrate += t.elapsed();
 
         // 1–8 as one job of the team while the lists hold, else pass by pass.
-        let (found, non_finite) = match self.fused_step(dt, &mut report, crew) {
-            Some(Fused::Stepped { found, non_finite }) => (found.finish()?, non_finite),
+        let (found, non_finite, walls) = match self.fused_step(dt, &mut report, crew) {
+            Some(Fused::Stepped {
+                found,
+                non_finite,
+                walls,
+            }) => (found.finish()?, non_finite, walls),
             drifted_or_not_run => {
                 // The fused job drifted and found the lists stale, or it did not run: pass by pass.
                 let moved = match drifted_or_not_run {
@@ -205,7 +218,7 @@ impl SphereSim {
                 let t = Instant::now();
                 let non_finite = self.kick(dt, found.scattered);
                 report.counters.integrate += t.elapsed();
-                (found, non_finite)
+                (found, non_finite, None)
             }
         };
         report.counters.body_pairs_tested += self.list.body_pairs() as u64;
@@ -225,7 +238,13 @@ impl SphereSim {
 
         // 9. Walls, ledger, time.
         let t = Instant::now();
-        self.sum_walls();
+        match walls {
+            Some((forces, power)) => {
+                self.wall_forces = forces;
+                self.external_power = power;
+            }
+            None => self.sum_walls(),
+        }
         report.counters.accumulate += t.elapsed();
         self.ledger.external_work += 0.5 * (external_start + self.external_power) * dt;
         self.time += dt;
@@ -507,19 +526,13 @@ impl SphereSim {
     /// The force on each wall, in pair order (bodies by increasing index), and the power the walls
     /// deliver.
     fn sum_walls(&mut self) {
-        for f in &mut self.wall_forces {
-            *f = Vector::zeros();
-        }
         let list = &self.list;
-        for (q, o) in self.wall_out.iter().enumerate() {
-            if list.wall_in_contact[q] {
-                self.wall_forces[list.wall_of[q] as usize] -= o.force_on_b;
-            }
-        }
-        let mut external_power = 0.0;
-        for (w, wall) in self.walls.iter().enumerate() {
-            external_power -= self.wall_forces[w].dot(&wall.velocity);
-        }
-        self.external_power = external_power;
+        self.external_power = wall_sums(
+            &self.wall_out,
+            &list.wall_in_contact,
+            &list.wall_of,
+            &self.walls,
+            &mut self.wall_forces,
+        );
     }
 }
