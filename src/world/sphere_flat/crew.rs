@@ -2,9 +2,10 @@
 //! step's team job ([`super::fused`]) is handed to threads that are already running instead of being
 //! started and joined as a new rayon job every step.
 //!
-//! Why: starting a `rayon::broadcast` and joining it took ~1–4 µs and ~2–8 µs per step on the 2-core
-//! VM (per-thread timestamps of the fused job on the sphere beds, 2026-11-23: bed c, ~85 µs per step on
-//! two threads, lost 4–11 µs there), about as much as the two threads' imbalance. The thread that
+//! Why: starting a `rayon::broadcast` and joining it took 0.3–7.7 µs and 0.9–8.4 µs per step on the
+//! 2-core VM (per-thread timestamps of the fused job on sphere beds a, b and c, 2026-11-23, steps of
+//! 80–240 µs on two threads), about as much as the two threads' imbalance; held in a crew, 0.1–0.6 µs
+//! and 0.8–5.4 µs (the upper ends in rounds where the host was busy). The thread that
 //! waits for the others' part of a broadcast soon sleeps in rayon's idle loop, and waking it is a
 //! system call.
 //!

@@ -120,8 +120,8 @@ impl Blocks {
         kick_weights.push(list.wall_pairs() / 3);
         let mut kick = ranges_of_equal_weight(&kick_weights, bodies.len());
         if let Some(last) = kick.last_mut() {
+            // The weight item of the walls is not a sphere (every range starts at or before n).
             last.end = last.end.min(n);
-            last.start = last.start.min(last.end);
         }
         let parts = bodies.len();
         let drift = (0..parts)
