@@ -3,20 +3,27 @@
 //! spheres dropped from a lattice into a box of five walls, `tests/support/bed.rs`) and on the sphere
 //! beds of issue 7 (`scenes/sphere_bed_*.toml`).
 //!
-//! Each scene is warmed up on the flat path (so that the lattice is in contact), then the same stretch of
-//! steps is run from the warm state once per thread count, alternately, `--repeat` times back to back.
-//! Printed per run: wall time, process CPU time (all threads), particle-steps/s (wall), the load average,
-//! the wall time per step of each stage (the step's counters: kick and drift, lists, pair loop, walls and
-//! ledger) and whether the final state is bit-identical to the first thread count's; then the median and
-//! range of the speed-up.
+//! Each scene is warmed up on the flat path (so that the lattice is in contact); then, `--repeat` times,
+//! each variant (a thread count and a split of the team's work, `SphereSim::set_team_split`)
+//! runs the same steps from the warm state. The variants take turns in stretches of `--interleave`
+//! steps, in alternating order, so that each sees the shared host as the others do (by default one
+//! stretch: each variant's steps back to back).
+//! Printed per variant and round: wall time, process CPU time (all threads), the share of the machine's
+//! CPU time the hypervisor stole during the round (a busy host), particle-steps/s (wall), the load
+//! average, the wall time per step of each stage (the step's counters: kick and drift, lists, pair
+//! loop, walls and ledger) and whether the final state is bit-identical to the first variant's; then
+//! the median and range over the rounds of each variant's speed-up over the first.
 //!
 //! ```text
 //! cargo run --release --example sphere_flat_threads -- [--steps N] [--warm-up N] [--threads 1,2]
-//!     [--repeat N] [--scenes spheres,a_hertz_5ms,b_hertz_200ms,c_linear_5ms] [--driver run|step]
+//!     [--splits default,fixed,0.2] [--interleave N] [--repeat N]
+//!     [--scenes spheres,a_hertz_5ms,b_hertz_200ms,c_linear_5ms] [--driver run|step]
 //! ```
-//! Defaults: 1000 steps after a warm-up of 1000, threads 1,2, 3 repeats, scene `spheres`, the steps run
-//! by `SphereSim::run_steps` as the suite's sphere_bed case runs them (`--driver step`: `SphereSim::step`
-//! called for each step, each step's team job a rayon broadcast).
+//! A split is `default` (`TeamSplit::default()`), `fixed` (`TeamSplit::fixed()`: the split before
+//! 2026-11-23) or a number: the default with that middle share of the pair loop.
+//! Defaults: 1000 steps after a warm-up of 1000, threads 1,2, the default split, 3 repeats, scene
+//! `spheres`, the steps run by `SphereSim::run_steps` as the suite's sphere_bed case runs them
+//! (`--driver step`: `SphereSim::step` called for each step, each step's team job a rayon broadcast).
 
 #[path = "../tests/support/bed.rs"]
 mod bed;
@@ -25,8 +32,9 @@ use std::ops::ControlFlow;
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
-use polydem::host::load_average;
+use polydem::host::{load_average, CpuTicks};
 use polydem::scene::load_scene;
+use polydem::world::sphere_flat::TeamSplit;
 use polydem::world::{SphereSim, StepParams, World};
 
 struct Options {
@@ -36,6 +44,8 @@ struct Options {
     repeat: usize,
     scenes: Vec<String>,
     step_by_step: bool,
+    splits: Vec<(String, TeamSplit)>,
+    interleave: usize,
 }
 
 fn parse() -> Result<Options, String> {
@@ -46,6 +56,8 @@ fn parse() -> Result<Options, String> {
         repeat: 3,
         scenes: vec!["spheres".into()],
         step_by_step: false,
+        splits: vec![("default".into(), TeamSplit::default())],
+        interleave: usize::MAX,
     };
     let mut args = std::env::args().skip(1);
     while let Some(a) = args.next() {
@@ -66,6 +78,32 @@ fn parse() -> Result<Options, String> {
                     .collect::<Result<_, _>>()?
             }
             "--scenes" => o.scenes = value()?.split(',').map(str::to_owned).collect(),
+            "--splits" => {
+                o.splits = value()?
+                    .split(',')
+                    .map(|name| {
+                        let split = match name {
+                            "default" => TeamSplit::default(),
+                            "fixed" => TeamSplit::fixed(),
+                            share => TeamSplit {
+                                middle_share: share.parse().map_err(|e| {
+                                    format!(
+                                        "--splits: default, fixed or a number, not {share}: {e}"
+                                    )
+                                })?,
+                                ..TeamSplit::default()
+                            },
+                        };
+                        Ok((name.to_owned(), split))
+                    })
+                    .collect::<Result<_, String>>()?
+            }
+            "--interleave" => {
+                o.interleave = value()?
+                    .parse::<usize>()
+                    .map_err(|e| format!("--interleave: {e}"))?
+                    .max(1)
+            }
             "--driver" => {
                 o.step_by_step = match value()?.as_str() {
                     "run" => false,
@@ -120,6 +158,60 @@ fn state_bits(sim: &SphereSim) -> Vec<u64> {
         .collect()
 }
 
+/// One way of running the scene: a thread count and a middle share, with its simulation and pool and
+/// what its timed steps cost so far.
+struct Variant {
+    threads: usize,
+    split: String,
+    sim: SphereSim,
+    pool: rayon::ThreadPool,
+    wall: Duration,
+    cpu: Duration,
+    stages: [Duration; 4],
+    rebuilds: u64,
+}
+
+impl Variant {
+    fn label(&self, splits: usize) -> String {
+        match splits {
+            1 => format!("{} thread(s)", self.threads),
+            _ => format!("{} thread(s) split {}", self.threads, self.split),
+        }
+    }
+
+    /// Runs `steps` more steps and adds their costs.
+    fn run(&mut self, steps: usize, step_by_step: bool) -> Result<(), String> {
+        let (cpu0, t) = (cpu_time(), Instant::now());
+        let (sim, stages, rebuilds) = (&mut self.sim, &mut self.stages, &mut self.rebuilds);
+        let mut add = |c: &polydem::world::StepCounters| {
+            for (total, d) in stages
+                .iter_mut()
+                .zip([c.integrate, c.broad, c.narrow, c.accumulate])
+            {
+                *total += d;
+            }
+            *rebuilds += c.broad_rebuilds;
+        };
+        self.pool.install(|| -> Result<(), String> {
+            if step_by_step {
+                for _ in 0..steps {
+                    add(&sim.step().map_err(|e| e.to_string())?.counters);
+                }
+            } else {
+                sim.run_steps(steps as u64, |_, report| {
+                    add(&report.counters);
+                    ControlFlow::Continue(())
+                })
+                .map_err(|e| e.to_string())?;
+            }
+            Ok(())
+        })?;
+        self.wall += t.elapsed();
+        self.cpu += cpu_time() - cpu0;
+        Ok(())
+    }
+}
+
 fn main() -> Result<(), String> {
     let o = parse()?;
     for name in &o.scenes {
@@ -131,84 +223,109 @@ fn main() -> Result<(), String> {
             warm.step().map_err(|e| e.to_string())?;
         }
         println!(
-            "scene {name}: {} spheres, {} steps after a warm-up of {}, Δt {:.3e} s",
+            "scene {name}: {} spheres, {} steps after a warm-up of {}, Δt {:.3e} s, in stretches of {}",
             warm.len(),
             o.steps,
             o.warm_up,
-            params.dt
+            params.dt,
+            o.interleave.min(o.steps)
         );
-        let mut ratios = Vec::new();
+        // Per round, per variant other than the first: its wall time over the first's.
+        let mut ratios: Vec<Vec<f64>> = Vec::new();
         for round in 0..o.repeat {
-            let mut first: Option<(Vec<u64>, f64)> = None;
+            let mut variants = Vec::new();
             for &threads in &o.threads {
-                let pool = rayon::ThreadPoolBuilder::new()
-                    .num_threads(threads)
-                    .build()
-                    .map_err(|e| e.to_string())?;
-                let mut sim = warm.clone();
-                let load = load_average();
-                let (cpu0, t) = (cpu_time(), Instant::now());
-                let mut stages = [Duration::ZERO; 4];
-                let mut rebuilds = 0;
-                let mut add = |c: &polydem::world::StepCounters| {
-                    for (total, d) in
-                        stages
-                            .iter_mut()
-                            .zip([c.integrate, c.broad, c.narrow, c.accumulate])
-                    {
-                        *total += d;
-                    }
-                    rebuilds += c.broad_rebuilds;
-                };
-                pool.install(|| -> Result<(), String> {
-                    if o.step_by_step {
-                        for _ in 0..o.steps {
-                            add(&sim.step().map_err(|e| e.to_string())?.counters);
-                        }
-                    } else {
-                        sim.run_steps(o.steps as u64, |_, report| {
-                            add(&report.counters);
-                            ControlFlow::Continue(())
-                        })
+                for (name, split) in &o.splits {
+                    let pool = rayon::ThreadPoolBuilder::new()
+                        .num_threads(threads)
+                        .build()
                         .map_err(|e| e.to_string())?;
-                    }
-                    Ok(())
-                })?;
-                let wall = t.elapsed().as_secs_f64();
-                let per_step = |d: Duration| d.as_secs_f64() * 1e6 / o.steps as f64;
-                let cpu = (cpu_time() - cpu0).as_secs_f64();
-                let bits = state_bits(&sim);
-                let same = first.as_ref().map(|(b, _)| *b == bits);
-                let rate = sim.len() as f64 * o.steps as f64 / wall;
-                println!(
-                    "  round {round}, {threads} thread(s): wall {wall:.3} s, CPU {cpu:.3} s, {rate:.3e} particle-steps/s, load {load}; µs per step: kick+drift {:.1}, lists {:.1} ({rebuilds} builds), pairs {:.1}, walls {:.1}{}",
-                    per_step(stages[0]),
-                    per_step(stages[1]),
-                    per_step(stages[2]),
-                    per_step(stages[3]),
-                    match same {
-                        Some(true) => ", bit-identical to the first".to_owned(),
-                        Some(false) => ", DIFFERS from the first".to_owned(),
-                        None => String::new(),
-                    }
-                );
-                match &first {
-                    None => first = Some((bits, wall)),
-                    Some((_, wall_1)) => ratios.push(wall_1 / wall),
+                    let mut sim = warm.clone();
+                    sim.set_team_split(*split);
+                    variants.push(Variant {
+                        threads,
+                        split: name.clone(),
+                        sim,
+                        pool,
+                        wall: Duration::ZERO,
+                        cpu: Duration::ZERO,
+                        stages: [Duration::ZERO; 4],
+                        rebuilds: 0,
+                    });
                 }
             }
+            let load = load_average();
+            let ticks = CpuTicks::now();
+            // The variants take turns, stretch by stretch, in alternating order: each sees the host as
+            // the others do.
+            let (mut done, mut stretch) = (0, 0);
+            while done < o.steps {
+                let steps = o.interleave.min(o.steps - done);
+                let order: Vec<usize> = match stretch % 2 {
+                    0 => (0..variants.len()).collect(),
+                    _ => (0..variants.len()).rev().collect(),
+                };
+                for v in order {
+                    variants[v].run(steps, o.step_by_step)?;
+                }
+                done += steps;
+                stretch += 1;
+            }
+            let steal = CpuTicks::now()
+                .zip(ticks)
+                .and_then(|(now, then)| now.steal_since(&then))
+                .map_or("n/a".to_owned(), |s| format!("{:.1} %", 100.0 * s));
+            let first_bits = state_bits(&variants[0].sim);
+            let first_wall = variants[0].wall.as_secs_f64();
+            let mut round_ratios = Vec::new();
+            for (k, v) in variants.iter().enumerate() {
+                let wall = v.wall.as_secs_f64();
+                let per_step = |d: Duration| d.as_secs_f64() * 1e6 / o.steps as f64;
+                let rate = v.sim.len() as f64 * o.steps as f64 / wall;
+                let same = (k > 0).then(|| state_bits(&v.sim) == first_bits);
+                println!(
+                    "  round {round}, {}: wall {wall:.3} s, CPU {:.3} s, steal {steal}, {rate:.3e} particle-steps/s, load {load}; µs per step: kick+drift {:.1}, lists {:.1} ({} builds), pairs {:.1}, walls {:.1}{}",
+                    v.label(o.splits.len()),
+                    v.cpu.as_secs_f64(),
+                    per_step(v.stages[0]),
+                    per_step(v.stages[1]),
+                    v.rebuilds,
+                    per_step(v.stages[2]),
+                    per_step(v.stages[3]),
+                    match same {
+                        Some(true) => ", bit-identical to the first",
+                        Some(false) => ", DIFFERS from the first",
+                        None => "",
+                    }
+                );
+                if k > 0 {
+                    round_ratios.push(first_wall / wall);
+                }
+            }
+            ratios.push(round_ratios);
         }
-        ratios.sort_by(|a, b| a.total_cmp(b));
-        if let (Some(lo), Some(hi)) = (ratios.first(), ratios.last()) {
-            println!(
-                "  speed-up of {} thread(s) over {}: median {:.2}, range {:.2}–{:.2} over {} runs",
-                o.threads.last().unwrap_or(&1),
-                o.threads.first().unwrap_or(&1),
-                ratios[ratios.len() / 2],
-                lo,
-                hi,
-                ratios.len()
-            );
+        let labels: Vec<String> = o
+            .threads
+            .iter()
+            .flat_map(|&t| o.splits.iter().map(move |(name, _)| (t, name)))
+            .map(|(threads, name)| match o.splits.len() {
+                1 => format!("{threads} thread(s)"),
+                _ => format!("{threads} thread(s) split {name}"),
+            })
+            .collect();
+        for (k, label) in labels.iter().enumerate().skip(1) {
+            let mut of_variant: Vec<f64> = ratios.iter().map(|r| r[k - 1]).collect();
+            of_variant.sort_by(|a, b| a.total_cmp(b));
+            if let (Some(lo), Some(hi)) = (of_variant.first(), of_variant.last()) {
+                println!(
+                    "  speed-up of {label} over {}: median {:.3}, range {:.3}–{:.3} over {} rounds",
+                    labels[0],
+                    of_variant[of_variant.len() / 2],
+                    lo,
+                    hi,
+                    of_variant.len()
+                );
+            }
         }
     }
     Ok(())

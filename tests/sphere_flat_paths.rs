@@ -12,10 +12,12 @@
 #[path = "support/world_bits.rs"]
 mod world_bits;
 
+use std::ops::ControlFlow;
 use std::path::Path;
 
 use polydem::law::SpringRotation;
 use polydem::scene::{load_scene, Simulation};
+use polydem::world::sphere_flat::TeamSplit;
 use polydem::world::{step, ContactKey, SphereSim, StepScratch, World};
 
 const STEPS: u64 = 300;
@@ -243,7 +245,6 @@ fn flat_path_is_the_same_on_one_two_and_four_threads() {
 /// the same reports, through builds of the lists; it calls back after every step and stops after the step at which it is told to.
 #[test]
 fn run_of_steps_is_the_same_as_stepping() {
-    use std::ops::ControlFlow;
     // Long enough for the lists to be rebuilt a few times (the ball lands at step ~50).
     const RUN_STEPS: u64 = 1000;
     for file in [
@@ -330,6 +331,60 @@ fn run_of_steps_is_the_same_as_stepping() {
                 (7, 7),
                 "{file}, {threads} thread(s): (steps run, step index)"
             );
+        }
+    }
+}
+
+/// Any split of the team's work gives the same bits as one thread: blocks only (`TeamSplit::fixed`),
+/// the default, and middles as wide as a thread's share in every pass (the threads share out most of
+/// each pass while it runs), on 2 and 3 threads, the split changed halfway through a build of the lists.
+#[test]
+fn flat_path_is_the_same_for_any_split_of_the_team() {
+    let sim = scene("scenes/sphere_bed_a_hertz_5ms.toml");
+    let wide = TeamSplit {
+        middle_share: 1.0,
+        pass_middle_share: 1.0,
+        follow_speeds: true,
+    };
+    let run = |threads: usize, first: TeamSplit, then: TeamSplit| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .expect("pool");
+        pool.install(|| {
+            let mut flat = SphereSim::from_world(&sim.world, &sim.params)
+                .unwrap_or_else(|e| panic!("the sphere bed must take the flat path: {e}"));
+            flat.set_team_split(first);
+            let half = STEPS / 2 + 7;
+            flat.run_steps(half, |_, _| ControlFlow::Continue(()))
+                .unwrap_or_else(|e| panic!("flat steps: {e}"));
+            flat.set_team_split(then);
+            flat.run_steps(STEPS - half, |_, _| ControlFlow::Continue(()))
+                .unwrap_or_else(|e| panic!("flat steps: {e}"));
+            let mut world = sim.world.clone();
+            flat.write_back(&mut world);
+            world
+        })
+    };
+    let one = run(1, TeamSplit::default(), TeamSplit::default());
+    let splits = [
+        ("fixed", TeamSplit::fixed()),
+        ("default", TeamSplit::default()),
+        ("wide", wide),
+    ];
+    for threads in [2, 3] {
+        for (k, (name, split)) in splits.iter().enumerate() {
+            let (then_name, then) = splits[(k + 1) % splits.len()];
+            let other = run(threads, *split, then);
+            if let Some(d) = first_difference(&one, &other) {
+                panic!(
+                    "sphere bed a, {STEPS} flat steps, 1 thread against {threads} with the split \
+                     {name} then {then_name}: {d}"
+                );
+            }
+            compare_stores(&one, &other).unwrap_or_else(|e| {
+                panic!("sphere bed a, {threads} threads, split {name} then {then_name}: {e}")
+            });
         }
     }
 }

@@ -7,8 +7,9 @@
 //! one job costs the wait for the slower thread only. In a run of steps ([`SphereSim::run_steps`]) the
 //! job is a task of the run's [`Crew`], whose threads are already running, instead of a broadcast.
 //!
-//! How: part k of each pass runs on thread k, as in the pass-by-pass step ([`super::step`]), with the
-//! same functions ([`super::passes`]), so the bits are the same. After the drift, every thread reads
+//! How: thread k runs part k of each pass, then takes pieces of the pass's middles until it meets the
+//! neighbouring thread ([`super::blocks::Blocks`], [`TwoEnded`]), with the functions of the pass-by-pass
+//! step ([`super::step`], [`super::passes`]), so the bits are the same. After the drift, every thread reads
 //! every thread's displacements and decides for itself whether the lists hold ([`StaleTest`]: the same
 //! inputs, so the same answer). If they do not, the job ends there and the step goes on pass by pass
 //! (the lists are rebuilt serially); otherwise the pair loop and the kick follow in the same job. A
@@ -23,6 +24,8 @@
 //!  spin         write D_k          -                                    write K_k
 //!  force/torque read all           write B_k                            write K_k (gathered: read outs)
 //!  springs, flags, outputs  -      write P_k                            read all
+//!
+//!  (D_k, B_k, K_k: thread k's range and the pieces of the middles it took; P_k: their pairs)
 //! ```
 
 use std::ops::Range;
@@ -36,14 +39,14 @@ use crate::math::{Point, Real, Vector};
 
 use super::super::step::StepReport;
 use super::super::world::Wall;
+use super::blocks::Blocks;
 use super::crew::Crew;
 use super::neighbours::{StaleTest, TopTwo};
 use super::pair::{
     Kinematic, PairConstants, PairContext, PairOut, Props, WallConstants, WallPlane,
 };
 use super::passes::{wall_sums, BlockPart, Drift, Found, Kick, KickPart, PairBlocks, Rows};
-use super::step::Blocks;
-use super::team::{Barrier, PhaseSlice};
+use super::team::{Barrier, PhaseSlice, TwoEnded};
 use super::{SphereSim, Spin};
 
 /// How a fused step ended.
@@ -71,6 +74,8 @@ struct ThreadEnd {
     /// When the drift and the pair loop ended (timers of the step's stages).
     drift_end: Instant,
     pairs_end: Instant,
+    /// The time the thread took for its block of the pair loop (s), if it ran.
+    block_seconds: Option<f64>,
 }
 
 impl SphereSim {
@@ -108,15 +113,18 @@ impl SphereSim {
         let list = &mut self.list;
         let blocks = &self.blocks;
         let job = Job {
-            pair_ranges: blocks
-                .bodies
+            middles: blocks.middles.iter().cloned().map(TwoEnded::new).collect(),
+            kick_middles: blocks
+                .kick_middles
                 .iter()
-                .map(|r| list.row_start[r.start] as usize..list.row_start[r.end] as usize)
+                .cloned()
+                .map(TwoEnded::new)
                 .collect(),
-            wall_ranges: blocks
-                .bodies
+            drift_middles: blocks
+                .drift_middles
                 .iter()
-                .map(|r| list.wall_start[r.start] as usize..list.wall_start[r.end] as usize)
+                .cloned()
+                .map(TwoEnded::new)
                 .collect(),
             blocks,
             kin: PhaseSlice::new(&mut self.kin),
@@ -171,6 +179,11 @@ impl SphereSim {
         report.counters.integrate += (drift_end - start) + (end - pairs_end);
         report.counters.narrow += pairs_end.saturating_duration_since(drift_end);
         let mut stepped = Vec::with_capacity(ends.len());
+        for (k, e) in ends.iter().enumerate() {
+            if let (Some(seconds), Some(&weight)) = (e.block_seconds, blocks.block_weights.get(k)) {
+                self.speeds.add(k, weight, seconds);
+            }
+        }
         for e in ends {
             match e.stepped {
                 Some(s) => stepped.push(s),
@@ -185,11 +198,15 @@ impl SphereSim {
             .into_inner()
             .unwrap_or_else(|e| e.into_inner());
         self.outs_valid = true;
-        let mut non_finite = None;
+        let mut non_finite: Option<(usize, &str)> = None;
         let mut found = Found::default();
         for (f, nf) in stepped {
             found = found.merge(f);
-            non_finite = non_finite.or(nf);
+            // The lowest sphere's (see `Job::kick`).
+            non_finite = match (non_finite, nf) {
+                (Some(a), Some(b)) if b.0 < a.0 => Some(b),
+                (a, b) => a.or(b),
+            };
         }
         Some(Fused::Stepped {
             found,
@@ -203,9 +220,10 @@ impl SphereSim {
 /// what the threads exchange (the drift's displacements, a failed block, the barrier).
 struct Job<'a> {
     blocks: &'a Blocks,
-    /// Per block, its range of body pairs and of body–wall pairs.
-    pair_ranges: Vec<Range<usize>>,
-    wall_ranges: Vec<Range<usize>>,
+    /// The middles of the pair loop, the kick and the drift, as their two threads share them out.
+    middles: Vec<TwoEnded>,
+    kick_middles: Vec<TwoEnded>,
+    drift_middles: Vec<TwoEnded>,
     kin: PhaseSlice<'a, Kinematic>,
     spin: PhaseSlice<'a, Spin>,
     force: PhaseSlice<'a, Vector>,
@@ -265,9 +283,10 @@ impl Job<'_> {
                 stepped: None,
                 drift_end,
                 pairs_end: drift_end,
+                block_seconds: None,
             };
         }
-        let found = unsafe { self.pairs(k) };
+        let (found, block_seconds) = unsafe { self.pairs(k) };
         if found.failed() {
             self.failed.store(true, Ordering::Release);
         }
@@ -287,6 +306,7 @@ impl Job<'_> {
             stepped: Some((found, non_finite)),
             drift_end,
             pairs_end,
+            block_seconds: Some(block_seconds),
         }
     }
 
@@ -300,13 +320,34 @@ impl Job<'_> {
             })
     }
 
-    /// Thread `k`'s part of the drift.
+    /// Thread `k`'s part of the drift: its range, then pieces of the drift's middles, taken as in the
+    /// pair loop ([`Job::pairs`]); the two largest displacements of each kind among its spheres.
     ///
     /// # Safety
-    /// Called once per thread index in the drift phase: the drift ranges tile the spheres, kin and spin
-    /// are written only in these parts, and force and torque only read.
+    /// Called once per thread index in the drift phase.
     unsafe fn drift(&self, k: usize) -> (TopTwo, TopTwo) {
-        let range = self.blocks.drift[k].clone();
+        let merge = |(a, b): (TopTwo, TopTwo), (c, d): (TopTwo, TopTwo)| (a.merge(c), b.merge(d));
+        // SAFETY (of each `drift_spheres`): the drift's ranges, middles and pieces are disjoint.
+        let mut moved = unsafe { self.drift_spheres(self.blocks.drift[k].clone()) };
+        if let Some(middle) = self.drift_middles.get(k) {
+            while let Some(piece) = middle.take_front() {
+                moved = merge(moved, unsafe { self.drift_spheres(piece) });
+            }
+        }
+        if let Some(middle) = k.checked_sub(1).and_then(|m| self.drift_middles.get(m)) {
+            while let Some(piece) = middle.take_back() {
+                moved = merge(moved, unsafe { self.drift_spheres(piece) });
+            }
+        }
+        moved
+    }
+
+    /// The drift of spheres `range`.
+    ///
+    /// # Safety
+    /// Called in the drift phase with `range` disjoint from every other call's: kin and spin are
+    /// written only in these parts, and force and torque only read.
+    unsafe fn drift_spheres(&self, range: Range<usize>) -> (TopTwo, TopTwo) {
         // SAFETY: the caller's promise.
         let (kin, spin, force, torque) = unsafe {
             (
@@ -331,18 +372,48 @@ impl Job<'_> {
         drift.run(range.start, kin, spin)
     }
 
-    /// Thread `k`'s block of the pair loop.
+    /// Thread `k`'s part of the pair loop: its block, then pieces of the middle after it from the front
+    /// and of the middle before it from the back, until the middles' other threads meet it; what it
+    /// found, in pair order, and the seconds its block took. A thread stops at the first failed piece: the pieces it leaves lie after
+    /// that failure, so the first failure in pair order is still found.
     ///
     /// # Safety
-    /// Called once per thread index in the pair phase: blocks, their pairs and their walls are disjoint
-    /// between threads, the springs, flags, outputs and loads are written only in these parts, and kin
-    /// only read.
-    unsafe fn pairs(&self, k: usize) -> Found {
-        let (bodies, pairs, walls) = (
-            self.blocks.bodies[k].clone(),
-            self.pair_ranges[k].clone(),
-            self.wall_ranges[k].clone(),
-        );
+    /// Called once per thread index in the pair phase.
+    unsafe fn pairs(&self, k: usize) -> (Found, f64) {
+        // SAFETY (of each `segment`): blocks, middles and the middles' pieces are disjoint.
+        let start = Instant::now();
+        let mut found = unsafe { self.segment(self.blocks.bodies[k].clone()) };
+        let block_seconds = start.elapsed().as_secs_f64();
+        if let Some(middle) = self.middles.get(k) {
+            while !found.failed() {
+                let Some(piece) = middle.take_front() else {
+                    break;
+                };
+                found = found.merge(unsafe { self.segment(piece) });
+            }
+        }
+        if let Some(middle) = k.checked_sub(1).and_then(|m| self.middles.get(m)) {
+            // Taken from the back: each piece comes before what this thread found so far.
+            while !found.failed() {
+                let Some(piece) = middle.take_back() else {
+                    break;
+                };
+                found = unsafe { self.segment(piece) }.merge(found);
+            }
+        }
+        (found, block_seconds)
+    }
+
+    /// The pair loop over the rows and walls of spheres `bodies`, summing the loads of the spheres no
+    /// other segment's pair reaches (none in a middle).
+    ///
+    /// # Safety
+    /// Called in the pair phase with `bodies` disjoint from every other call's: their pairs and walls
+    /// are then disjoint too, the springs, flags, outputs and loads are written only in these parts,
+    /// and kin only read.
+    unsafe fn segment(&self, bodies: Range<usize>) -> Found {
+        let pairs = self.row_start[bodies.start] as usize..self.row_start[bodies.end] as usize;
+        let walls = self.wall_start[bodies.start] as usize..self.wall_start[bodies.end] as usize;
         // SAFETY: the caller's promise.
         let (part, kin) = unsafe {
             (
@@ -403,13 +474,41 @@ impl Job<'_> {
         (forces, power)
     }
 
-    /// Thread `k`'s part of the kick.
+    /// Thread `k`'s part of the kick: its range, then pieces of the kick's middles, taken as in the pair
+    /// loop ([`Job::pairs`]); the first non-finite quantity it met (the lowest sphere), where it
+    /// stopped. The lowest over the threads is the first of all: the pieces a thread leaves lie after
+    /// its find or are taken by the middle's other thread.
     ///
     /// # Safety
-    /// Called once per thread index in the kick phase: the kick ranges tile the spheres, the loads, kin
-    /// and spin are written only in these parts, and the springs' flags and the outputs only read.
+    /// Called once per thread index in the kick phase.
     unsafe fn kick(&self, k: usize) -> Option<(usize, &'static str)> {
-        let range = self.blocks.kick[k].clone();
+        // SAFETY (of each `kick_spheres`): the kick's ranges, middles and pieces are disjoint.
+        let mut first = unsafe { self.kick_spheres(self.blocks.kick[k].clone()) };
+        if let Some(middle) = self.kick_middles.get(k) {
+            while first.is_none() {
+                let Some(piece) = middle.take_front() else {
+                    break;
+                };
+                first = unsafe { self.kick_spheres(piece) };
+            }
+        }
+        if let Some(middle) = k.checked_sub(1).and_then(|m| self.kick_middles.get(m)) {
+            while first.is_none() {
+                let Some(piece) = middle.take_back() else {
+                    break;
+                };
+                first = unsafe { self.kick_spheres(piece) };
+            }
+        }
+        first
+    }
+
+    /// The kick of spheres `range`.
+    ///
+    /// # Safety
+    /// Called in the kick phase with `range` disjoint from every other call's: the loads, kin and spin
+    /// are written only in these parts, and the springs' flags and the outputs only read.
+    unsafe fn kick_spheres(&self, range: Range<usize>) -> Option<(usize, &'static str)> {
         // SAFETY: the caller's promise.
         let (force, torque, kin, spin, in_contact, wall_in_contact, out, wall_out) = unsafe {
             (

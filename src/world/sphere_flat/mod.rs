@@ -65,6 +65,7 @@
 //! its lists on its next step), and its contact store then holds the flat list's pairs, with the geometry
 //! the general step would have stored for them at the current positions.
 
+mod blocks;
 mod crew;
 mod fused;
 mod isa;
@@ -90,6 +91,7 @@ use super::skips;
 use super::step::{effective_model, StepError, StepParams};
 use super::world::{Wall, World};
 
+pub use blocks::TeamSplit;
 pub use neighbours::{NeighbourList, LARGE_RADIUS_FACTOR, MAX_CELLS_PER_BODY};
 use neighbours::{SpareVec, NOT_CARRIED};
 use pair::{Kinematic, PairConstants, PairOut, Props, WallConstants, WallPlane};
@@ -143,10 +145,14 @@ pub struct SphereSim {
     spare_constants: SpareVec<PairConstants>,
     /// Whether the drift turns the orientations (see [`SphereSim::set_track_orientation`]).
     track_orientation: bool,
+    /// How the team's threads share a step's work (see [`SphereSim::set_team_split`]).
+    split: TeamSplit,
+    /// The threads' speeds the blocks are made for.
+    speeds: blocks::ThreadSpeeds,
     /// Whether the passes run in their x86-64-v3 build (see [`SphereSim::set_wide_instructions`]).
     v3: bool,
     /// The pair loop's blocks (made for the current lists and pool).
-    blocks: step::Blocks,
+    blocks: blocks::Blocks,
     /// The last evaluation of every listed pair (aligned with the lists); valid when `outs_valid`.
     out: Vec<PairOut>,
     wall_out: Vec<PairOut>,
@@ -274,8 +280,10 @@ impl SphereSim {
             spare_constants: SpareVec::default(),
             wall_constants: Vec::new(),
             track_orientation: true,
+            split: TeamSplit::default(),
+            speeds: blocks::ThreadSpeeds::default(),
             v3: isa::v3(),
-            blocks: step::Blocks::default(),
+            blocks: blocks::Blocks::default(),
             out: Vec::new(),
             wall_out: Vec::new(),
             outs_valid: false,
@@ -405,6 +413,20 @@ impl SphereSim {
     /// Whether the drift turns the orientations (see [`SphereSim::set_track_orientation`]).
     pub fn tracks_orientation(&self) -> bool {
         self.track_orientation
+    }
+
+    /// How the threads of a team share a step's work ([`TeamSplit`]; shares outside 0..=1 are clamped,
+    /// non-finite ones replaced by the default's). The bits are the same for any split; only the speed
+    /// changes. Takes effect from the next step, which runs its passes one by one and makes the blocks
+    /// anew.
+    pub fn set_team_split(&mut self, split: TeamSplit) {
+        self.split = split.sanitized();
+        self.blocks.built_for = (u64::MAX, 0);
+    }
+
+    /// How the threads of a team share a step's work (see [`SphereSim::set_team_split`]).
+    pub fn team_split(&self) -> TeamSplit {
+        self.split
     }
 
     /// Whether the passes of a step run in their x86-64-v3 build (AVX2; see the module `isa`). On by

@@ -17,7 +17,7 @@ use super::Spin;
 /// What the pair loop found, summed over its blocks in pair order.
 #[derive(Default)]
 pub(super) struct Found {
-    /// Whether the pair loop summed the loads of the spheres it could (see [`super::step::Blocks`]).
+    /// Whether the pair loop summed the loads of the spheres it could (see [`super::blocks::Blocks`]).
     pub(super) scattered: bool,
     pub(super) contacts: usize,
     pub(super) max_overlap_ratio: Real,
@@ -209,7 +209,7 @@ pub(super) struct Kick<'a> {
     pub(super) rows: Rows<'a>,
     pub(super) out: &'a [PairOut],
     pub(super) wall_out: &'a [PairOut],
-    /// Per sphere, whether its loads are gathered here (see [`super::step::Blocks`]).
+    /// Per sphere, whether its loads are gathered here (see [`super::blocks::Blocks`]).
     pub(super) gathered: &'a [bool],
     /// Whether the pair loop summed the loads of the other spheres.
     pub(super) scattered: bool,

@@ -9,15 +9,15 @@
 //!  9.   wall forces and the walls' power (serial, pair order), ledger, time
 //! ```
 //! Every per-sphere and per-pair pass writes only its own items' slots, so it runs on rayon's current
-//! pool with the same bits for any number of threads: each thread always takes the same part of each
+//! pool with the same bits for any number of threads: each thread takes mostly the same part of each
 //! pass ([`super::team`]), so that a block's records stay in one core's cache from pass to pass; when
-//! the lists hold, the three passes run as one job of the team ([`super::fused`]). The pair
-//! loop runs in blocks of consecutive spheres ([`Blocks`]: one when serial, one per thread otherwise)
-//! and adds each overlapping
-//! pair's loads to its spheres as it goes, for every sphere that only its own block's pairs reach: in
-//! pair order such a sphere i receives its pairs (a, i) by increasing a (rows of a < i come first), then
-//! its own row (i, b) by increasing b, then its walls — the gather's order, so the same sums, bit for
-//! bit. Stage 6 gathers the loads of the other spheres (reached by a pair of an earlier block).
+//! the lists hold, the three passes run as one job of the team ([`super::fused`]). The pair loop runs
+//! in blocks of consecutive spheres, with middles between them ([`Blocks`]: one block when serial, one
+//! per thread otherwise), and adds each overlapping pair's loads to its spheres as it goes, for every
+//! sphere that only its own block's pairs reach: in pair order such a sphere i receives its pairs
+//! (a, i) by increasing a (rows of a < i come first), then its own row (i, b) by increasing b, then its
+//! walls — the gather's order, so the same sums, bit for bit. Stage 6 gathers the loads of the other
+//! spheres (in a middle, or reached by a pair of an earlier block or middle).
 //! The passes themselves are in [`super::passes`].
 
 use std::time::Instant;
@@ -25,6 +25,7 @@ use std::time::Instant;
 use crate::math::{Point, Real};
 
 use super::super::step::{StepError, StepReport};
+use super::blocks::Blocks;
 use super::crew::Crew;
 use super::fused::Fused;
 use super::neighbours::TopTwo;
@@ -32,139 +33,6 @@ use super::pair::{PairContext, PairOut, WallPlane};
 use super::passes::{wall_sums, BlockPart, Drift, Found, Kick, KickPart, PairBlocks, Rows};
 use super::team::{for_each_part, split_at_ranges};
 use super::{SphereSim, MIN_PARALLEL_PAIRS};
-
-/// The split of the pair loop into blocks of consecutive spheres, one per thread, each with the pairs of
-/// its spheres' rows and their walls, of about equal work: pairs weighted by whether they are in contact
-/// ([`CONTACT_WEIGHT`]; before 2026-11-22 (night), equal numbers of pairs). With the split of the
-/// per-sphere passes ([`Blocks::kick`], [`Blocks::drift`]) it is what each thread of the team takes
-/// ([`super::team`]).
-///
-/// One block per thread, no more: a sphere reached by a pair of another block has its loads gathered
-/// in stage 6 instead of summed by the pair loop (on the settled bed of the sphere-bed scenes, whose
-/// spheres are numbered by height, about 5 % of the spheres with 2 blocks, 15 % with 4, 35 % with 8;
-/// counted on its initial list), and the team gives each thread its parts statically, so more blocks
-/// would not balance the threads (until 2026-11-22 (late) rayon shared two blocks per thread by work
-/// stealing).
-///
-/// A block's pairs come in pair order, so a sphere all of whose pairs lie in its own block receives
-/// its loads in the order of the stage-6 gather (pairs (a, i) by increasing a, its row, its walls): the
-/// block sums them as it goes, the same bits as the gather. A sphere that a pair of an earlier block
-/// reaches (`gathered`) is left to the gather, whose order the blocks cannot keep.
-#[derive(Clone, Debug, Default)]
-pub(super) struct Blocks {
-    /// The lists' build and the number of blocks wanted that these blocks were made for.
-    pub(super) built_for: (u64, usize),
-    pub(super) bodies: Vec<std::ops::Range<usize>>,
-    /// Per sphere, whether a pair of another block reaches it.
-    pub(super) gathered: Vec<bool>,
-    /// The spheres of each thread in the second half kick (balanced with the gathered spheres' sums)
-    /// and in the drift (equal numbers).
-    pub(super) kick: Vec<std::ops::Range<usize>>,
-    pub(super) drift: Vec<std::ops::Range<usize>>,
-}
-
-impl Blocks {
-    /// Whether the per-sphere passes run on the team (several blocks).
-    pub(super) fn team(&self) -> bool {
-        self.bodies.len() > 1
-    }
-
-    pub(super) fn new(list: &super::NeighbourList, wanted: usize) -> Self {
-        let n = list.row_start.len().saturating_sub(1);
-        if wanted <= 1 {
-            // One block of every sphere (the serial loop): no weights to form, no sphere gathered.
-            return Self {
-                built_for: (list.builds(), wanted),
-                bodies: std::iter::once(0..n).collect(),
-                gathered: vec![false; n],
-                kick: std::iter::once(0..n).collect(),
-                drift: std::iter::once(0..n).collect(),
-            };
-        }
-        // Per sphere: its row's pairs and its walls, a pair in contact counting CONTACT_WEIGHT, plus
-        // one for the sphere itself. In contact: the pair's flag, which a build sets when the pair holds
-        // a spring and an evaluation when it overlaps (blocks made for a new pool between builds). Until
-        // 2026-11-23 the springs themselves were read: ~40 µs of ~55 µs per build of bed c.
-        let cost = |in_contact: &[bool]| -> usize {
-            in_contact
-                .iter()
-                .map(|&c| if c { CONTACT_WEIGHT } else { 1 })
-                .sum()
-        };
-        let weights: Vec<usize> = (0..n)
-            .map(|i| {
-                let (r0, r1) = (list.row_start[i] as usize, list.row_start[i + 1] as usize);
-                let (w0, w1) = (list.wall_start[i] as usize, list.wall_start[i + 1] as usize);
-                cost(&list.in_contact[r0..r1]) + cost(&list.wall_in_contact[w0..w1]) + 1
-            })
-            .collect();
-        let bodies = ranges_of_equal_weight(&weights, wanted);
-        let mut gathered = vec![false; n];
-        if bodies.len() > 1 {
-            for range in &bodies {
-                for j in range.clone() {
-                    let (s, e) = (list.as_b_start[j] as usize, list.as_b_start[j + 1] as usize);
-                    // Side-B pairs come by increasing a: the first has the smallest.
-                    gathered[j] = s < e && (list.a[list.as_b[s] as usize] as usize) < range.start;
-                }
-            }
-        }
-        // The kick: a gathered sphere also sums its pairs, which took about two kicks' time (per-thread
-        // timestamps on bed c, 2026-11-22 (late): with the pair blocks' split the thread of the second
-        // block, ~1700 spheres of which ~160 gathered, kicked in ~21 µs against ~13 µs for ~1300).
-        // The last thread also forms the walls' sums in the kick phase (`super::fused`): counted as
-        // one more item of a third of a kick per body–wall pair (the sums took 1.2–2.6 µs per step and
-        // a kick ~9 ns per sphere on beds a and c, with a few hundred to a thousand wall pairs listed).
-        let mut kick_weights: Vec<usize> =
-            gathered.iter().map(|&g| 1 + 2 * usize::from(g)).collect();
-        kick_weights.push(list.wall_pairs() / 3);
-        let mut kick = ranges_of_equal_weight(&kick_weights, bodies.len());
-        if let Some(last) = kick.last_mut() {
-            // The weight item of the walls is not a sphere (every range starts at or before n).
-            last.end = last.end.min(n);
-        }
-        let parts = bodies.len();
-        let drift = (0..parts)
-            .map(|k| k * n / parts..(k + 1) * n / parts)
-            .collect();
-        Self {
-            built_for: (list.builds(), wanted),
-            bodies,
-            gathered,
-            kick,
-            drift,
-        }
-    }
-}
-
-/// Consecutive ranges of `weights`' indices, at most `wanted`, each of about the same total weight (the
-/// last takes the rest).
-fn ranges_of_equal_weight(weights: &[usize], wanted: usize) -> Vec<std::ops::Range<usize>> {
-    let n = weights.len();
-    let total: usize = weights.iter().sum();
-    let target = total.div_ceil(wanted.max(1)).max(1);
-    let mut ranges = Vec::with_capacity(wanted);
-    let (mut first, mut weight) = (0, 0);
-    for (i, w) in weights.iter().enumerate() {
-        weight += w;
-        if weight >= target && i + 1 < n {
-            ranges.push(first..i + 1);
-            (first, weight) = (i + 1, 0);
-        }
-    }
-    ranges.push(first..n);
-    ranges
-}
-
-/// A listed pair's weight in the split into blocks when its spring holds a contact at the build (such a
-/// pair mostly stays in contact until the next build), against 1 for one that does not: the law costs
-/// several times the distance test, and the contacts crowd where the projectile strikes and at the
-/// floor, so blocks of equal pair counts are not blocks of equal work. 8 is the best of 1, 4, 6, 8, 12
-/// and 16 measured on the sphere beds a–c on two threads (`examples/sphere_flat_threads`, medians of 4–5
-/// runs, 2026-11-22: 1.43 / 1.67 / 1.43× over one thread with 1, 1.79 / 1.79 / 1.63× with 8); the
-/// 10^4-sphere settling scene came out slightly slower (medians 1.39–1.51× against 1.51–1.57×, not
-/// understood). A frictionless law keeps no spring, so its pairs all weigh 1, as before.
-const CONTACT_WEIGHT: usize = 8;
 
 impl SphereSim {
     /// Advances the simulation by one step (see the module docs).
@@ -279,7 +147,7 @@ impl SphereSim {
         let drift = self.drift_inputs(dt);
         let moved = if team {
             // About the spheres of the thread that pairs and kicks them ([`super::team`]).
-            let ranges = &self.blocks.drift;
+            let ranges = &self.blocks.drift_by_thread();
             let parts: Vec<_> = split_at_ranges(&mut kin, ranges)
                 .into_iter()
                 .zip(split_at_ranges(&mut spin, ranges))
@@ -357,7 +225,7 @@ impl SphereSim {
             v3: self.v3,
         };
         let non_finite = if team {
-            let ranges = &self.blocks.kick;
+            let ranges = &self.blocks.kick_by_thread();
             let parts: Vec<_> = split_at_ranges(&mut force, ranges)
                 .into_iter()
                 .zip(split_at_ranges(&mut torque, ranges))
@@ -400,7 +268,8 @@ impl SphereSim {
             1
         };
         if self.blocks.built_for != (self.list.builds(), wanted) {
-            self.blocks = Blocks::new(&self.list, wanted);
+            let speeds = self.speeds.estimate(wanted);
+            self.blocks = Blocks::new(&self.list, wanted, &self.split, &speeds);
         }
         self.out.resize(self.list.body_pairs(), PairOut::default());
         self.wall_out
@@ -454,8 +323,10 @@ impl SphereSim {
             // a step on one block reported no overlap warning against a wall.
             return found.finish();
         }
-        // Split every array at the blocks' boundaries.
-        let mut parts = Vec::with_capacity(blocks.bodies.len());
+        // Split every array at the boundaries of the blocks and middles; thread k runs block k, then
+        // the middle after it (the whole middle: no sharing out when the passes run one by one).
+        let mut parts: Vec<Vec<(usize, BlockPart)>> =
+            blocks.bodies.iter().map(|_| Vec::new()).collect();
         {
             let (mut h, mut c, mut o) = (
                 &mut list.histories[..],
@@ -468,7 +339,8 @@ impl SphereSim {
                 &mut self.wall_out[..],
             );
             let (mut f, mut t) = (&mut self.force[..], &mut self.torque[..]);
-            for range in &blocks.bodies {
+            let mut thread = 0;
+            for (s, range) in blocks.segments().enumerate() {
                 let (first, last) = (range.start, range.end);
                 let pairs = (pass.row_start[last] - pass.row_start[first]) as usize;
                 let walls = (pass.wall_start[last] - pass.wall_start[first]) as usize;
@@ -481,7 +353,7 @@ impl SphereSim {
                 let (f1, f2) = std::mem::take(&mut f).split_at_mut(last - first);
                 let (t1, t2) = std::mem::take(&mut t).split_at_mut(last - first);
                 (h, c, o, wh, wc, wo, f, t) = (h2, c2, o2, wh2, wc2, wo2, f2, t2);
-                parts.push((
+                parts[thread].push((
                     first,
                     BlockPart {
                         histories: h1,
@@ -494,16 +366,24 @@ impl SphereSim {
                         torque: t1,
                     },
                 ));
+                // Segments alternate block, middle: a middle closes its thread's list.
+                thread += s % 2;
             }
         }
+        let run = |segments: Vec<(usize, BlockPart)>| {
+            segments
+                .into_iter()
+                .map(|(first, part)| pass.run(first, part))
+                .fold(Found::default(), Found::merge)
+        };
         let found = if parts.len() > 1 && rayon::current_num_threads() > 1 {
-            for_each_part(parts, |_, (first, part)| pass.run(first, part))
+            for_each_part(parts, |_, segments| run(segments))
                 .into_iter()
                 .fold(Found::default(), Found::merge)
         } else {
             parts
                 .into_iter()
-                .map(|(first, part)| pass.run(first, part))
+                .map(run)
                 .fold(Found::default(), Found::merge)
         };
         self.outs_valid = true;

@@ -6,8 +6,10 @@
 //! or kicked by the other, and their records (positions, velocities, springs, pair outputs: ~3 MB for the
 //! 3000-sphere beds) move between the cores' caches from pass to pass. A broadcast job is never stolen:
 //! giving part k to the thread of index k keeps each block's spheres and pairs on one core (the blocks
-//! are made for the pool, one per thread: [`super::step::Blocks`]). The results do not depend on which
-//! thread computes a part, so the bits are the same as serial.
+//! are made for the pool, one per thread: [`super::blocks::Blocks`]). The results do not depend on which
+//! thread computes a part, so the bits are the same as serial. Only the middles between neighbouring
+//! parts are shared out while the pass runs ([`TwoEnded`]): the faster of two neighbours takes more of
+//! them, and most records still stay on one core.
 //!
 //! A thread that ends its part first spins until the others end theirs ([`spin_until_all`]) instead of
 //! returning to rayon, whose idle loop soon puts it to sleep: starting and joining the other thread cost
@@ -20,7 +22,7 @@
 //! wait until the others' threads come back to rayon (their next pass or join); nothing in polydem does
 //! (the suite steps one simulation at a time, on its own pool).
 
-use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering};
 use std::sync::Mutex;
 use std::time::{Duration, Instant};
 
@@ -154,6 +156,77 @@ impl<'a, T> PhaseSlice<'a, T> {
     }
 }
 
+/// A range of items that two threads share out while they run: one takes pieces from its front, the
+/// other from its back, until they meet; every item is taken once (the middles of the pair loop,
+/// [`super::blocks::Blocks`]). The pieces shrink as the range does (a quarter of what is left, at
+/// least [`MIN_PIECE`]), so the threads take few pieces while far apart and end within a small piece of
+/// each other.
+pub(super) struct TwoEnded {
+    /// The front (high 32 bits) and the back (low 32 bits) of what is left.
+    ends: AtomicU64,
+}
+
+/// The smallest piece of a [`TwoEnded`]: 16 spheres' rows are ~0.5–1 µs of the pair loop on the
+/// sphere beds (~40 ns per sphere on one thread), against ~0.1–0.2 µs for a compare-and-swap whose
+/// cache line the other core holds.
+const MIN_PIECE: usize = 16;
+
+impl TwoEnded {
+    pub(super) fn new(range: std::ops::Range<usize>) -> Self {
+        let (front, back) = (
+            u32::try_from(range.start).expect("a middle's start fits in 32 bits"),
+            u32::try_from(range.end.max(range.start)).expect("a middle's end fits in 32 bits"),
+        );
+        Self {
+            ends: AtomicU64::new((u64::from(front) << 32) | u64::from(back)),
+        }
+    }
+
+    /// The next piece from the front, if any is left.
+    pub(super) fn take_front(&self) -> Option<std::ops::Range<usize>> {
+        self.take(|front, back| {
+            let end = front + piece(back - front);
+            (front..end, (end, back))
+        })
+    }
+
+    /// The next piece from the back, if any is left.
+    pub(super) fn take_back(&self) -> Option<std::ops::Range<usize>> {
+        self.take(|front, back| {
+            let start = back - piece(back - front);
+            (start..back, (front, start))
+        })
+    }
+
+    /// Takes the piece that `cut(front, back)` names (with the ends left after it), atomically.
+    fn take(
+        &self,
+        cut: impl Fn(usize, usize) -> (std::ops::Range<usize>, (usize, usize)),
+    ) -> Option<std::ops::Range<usize>> {
+        let mut ends = self.ends.load(Ordering::Acquire);
+        loop {
+            let (front, back) = ((ends >> 32) as usize, (ends & 0xffff_ffff) as usize);
+            if front >= back {
+                return None;
+            }
+            let (piece, (front, back)) = cut(front, back);
+            let left = ((front as u64) << 32) | back as u64;
+            match self
+                .ends
+                .compare_exchange_weak(ends, left, Ordering::AcqRel, Ordering::Acquire)
+            {
+                Ok(_) => return Some(piece),
+                Err(now) => ends = now,
+            }
+        }
+    }
+}
+
+/// The size of the next piece of a [`TwoEnded`] with `left` items left (at least one).
+fn piece(left: usize) -> usize {
+    (left / 4).max(MIN_PIECE).min(left)
+}
+
 /// `slice` cut into the consecutive pieces of `ranges` (which must tile `0..slice.len()` in order).
 pub(super) fn split_at_ranges<'a, T>(
     mut slice: &'a mut [T],
@@ -239,5 +312,48 @@ mod tests {
         let lens: Vec<usize> = pieces.iter().map(|p| p.len()).collect();
         assert_eq!(lens, vec![3, 0, 4]);
         assert_eq!(pieces[2][0], 3);
+    }
+
+    #[test]
+    fn two_ended_range_gives_every_item_once() {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(2)
+            .build()
+            .unwrap();
+        for range in [0..0, 5..6, 10..27, 100..1100] {
+            for _ in 0..20 {
+                let shared = TwoEnded::new(range.clone());
+                let pieces = pool.install(|| {
+                    rayon::broadcast(|ctx| {
+                        let mut mine = Vec::new();
+                        let take = || match ctx.index() {
+                            0 => shared.take_front(),
+                            _ => shared.take_back(),
+                        };
+                        while let Some(piece) = take() {
+                            assert!(!piece.is_empty(), "empty piece {piece:?} of {range:?}");
+                            mine.push(piece);
+                        }
+                        mine
+                    })
+                });
+                let mut items: Vec<usize> = pieces.into_iter().flatten().flatten().collect();
+                items.sort_unstable();
+                let want: Vec<usize> = range.clone().collect();
+                assert_eq!(items, want, "the pieces of {range:?}");
+            }
+        }
+    }
+
+    #[test]
+    fn pieces_shrink_to_the_smallest() {
+        let shared = TwoEnded::new(0..1000);
+        assert_eq!(shared.take_front(), Some(0..250));
+        assert_eq!(shared.take_back(), Some(813..1000));
+        let mut last = 0..0;
+        while let Some(p) = shared.take_front() {
+            last = p;
+        }
+        assert!(last.len() <= MIN_PIECE, "last piece {last:?}");
     }
 }

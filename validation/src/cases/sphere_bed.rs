@@ -23,7 +23,7 @@ use std::ops::ControlFlow;
 use std::path::Path;
 use std::time::Instant;
 
-use polydem::host::{load_average, thread_cpu_time};
+use polydem::host::{load_average, thread_cpu_time, CpuTicks};
 use polydem::math::Real;
 use polydem::scene::{load_scene, Simulation};
 use polydem::world::{SphereSim, StepFlatError};
@@ -189,6 +189,8 @@ struct Run {
     particles: usize,
     wall_time_s: Real,
     cpu_time_s: Option<Real>,
+    /// The load average before the run and the share of the machine's CPU time the hypervisor stole
+    /// during it, as the speed rows print them.
     load: String,
     max_overlap_ratio: Real,
 }
@@ -235,6 +237,7 @@ fn run_polydem(
         .build()
         .map_err(|e| fail(format!("pool of {threads} thread(s): {e}")))?;
     let progress = ctx.progress();
+    let ticks = CpuTicks::now();
     let (max_overlap_ratio, wall_time_s, cpu_time_s) = pool.install(|| {
         let cpu_start = thread_cpu_time();
         let start = Instant::now();
@@ -250,6 +253,14 @@ fn run_polydem(
         };
         (max_overlap, wall, cpu)
     });
+    // A busy host slows a run on two threads more than one on one: each step waits for both.
+    let load = match CpuTicks::now()
+        .zip(ticks)
+        .and_then(|(now, then)| now.steal_since(&then))
+    {
+        Some(steal) => format!("{load}; host steal {:.1} %", 100.0 * steal),
+        None => load,
+    };
     let max_overlap_ratio =
         max_overlap_ratio.map_err(|e| fail(format!("{}: {e}", variant.scene)))?;
     Ok(Run {
@@ -980,7 +991,10 @@ impl Case for SphereBed {
              `speed_rounds` rounds per variant (polydem, then each re-run code; rows **round k**) and \
              checks the median of each code's ratios. Each one-thread polydem run of the full profile is followed by the \
              same run on two threads (the same trajectory, checked), and the median of the wall-time \
-             ratios is checked against issue 7's 1.8×.",
+             ratios is checked against issue 7's 1.8×. Beside each polydem run's load average: the share \
+             of the machine's CPU time that the hypervisor gave to other machines during the run \
+             (**host steal**, `/proc/stat`); a run on two threads loses more to it than a run on one, \
+             since each step waits for both threads.",
         );
         ctx.table(
             Some("speed"),
