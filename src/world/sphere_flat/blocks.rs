@@ -222,8 +222,9 @@ fn blocks_and_middles(
 }
 
 /// Each thread's speed as the split into blocks assumes it: measured on the pair loop, as the weight of
-/// the thread's block over the time the thread took for it, summed over the steps since the blocks were
-/// made, and blended half and half with the previous estimate.
+/// the thread's block over the time the thread took for it, the median over the steps since the blocks
+/// were made (a step in which the host left the thread unrun for a while does not count), blended half
+/// and half with the previous estimate.
 ///
 /// Why: on the shared 2-core host one core ran 20–40 % slower than the other for seconds at a time, in
 /// every pass alike, and which one changed from run to run (per-thread timers of the fused step on beds
@@ -233,15 +234,14 @@ fn blocks_and_middles(
 /// to follow such a change. The bits do not depend on the split.
 #[derive(Clone, Debug, Default)]
 pub(super) struct ThreadSpeeds {
-    /// Per thread, since the last estimate: the weight of the blocks it ran and the seconds they took.
-    weight: Vec<f64>,
-    seconds: Vec<f64>,
+    /// Per thread, since the last estimate: the rate (weight per second) of each step's block.
+    rates: Vec<Vec<f64>>,
     /// The last estimate, relative to the mean (empty: none).
     estimate: Vec<f64>,
 }
 
-/// The least time measured on every thread for an estimate to be updated (~5 steps of a sphere bed).
-const MIN_MEASURED_SECONDS: f64 = 2e-4;
+/// The least number of steps measured on every thread for an estimate to be updated.
+const MIN_MEASURED_STEPS: usize = 5;
 
 /// The widest ratio of the speeds an estimate admits: beyond it, a measurement is taken for a thread
 /// that the host did not run for a while, not for a slower core.
@@ -250,31 +250,29 @@ const MAX_SPEED_RATIO: f64 = 2.0;
 impl ThreadSpeeds {
     /// Thread `k` ran a block of `weight` in `seconds`.
     pub(super) fn add(&mut self, k: usize, weight: f64, seconds: f64) {
-        if self.weight.len() <= k {
-            self.weight.resize(k + 1, 0.0);
-            self.seconds.resize(k + 1, 0.0);
+        if self.rates.len() <= k {
+            self.rates.resize_with(k + 1, Vec::new);
         }
-        self.weight[k] += weight;
-        self.seconds[k] += seconds;
+        if weight > 0.0 && seconds > 0.0 {
+            self.rates[k].push(weight / seconds);
+        }
     }
 
     /// The estimate for `threads` threads (relative speeds, mean 1; empty when there is none), updated
     /// with what was measured since the last call, which starts a new measurement.
     pub(super) fn estimate(&mut self, threads: usize) -> Vec<f64> {
-        let measured = self.weight.len() == threads
-            && self
-                .seconds
-                .iter()
-                .zip(&self.weight)
-                .all(|(&t, &w)| t >= MIN_MEASURED_SECONDS && w > 0.0);
+        let measured =
+            self.rates.len() == threads && self.rates.iter().all(|r| r.len() >= MIN_MEASURED_STEPS);
         if measured {
-            let rates: Vec<f64> = self
-                .weight
-                .iter()
-                .zip(&self.seconds)
-                .map(|(w, t)| w / t)
+            let medians: Vec<f64> = self
+                .rates
+                .iter_mut()
+                .map(|r| {
+                    r.sort_unstable_by(f64::total_cmp);
+                    r[r.len() / 2]
+                })
                 .collect();
-            let fresh = relative(&rates);
+            let fresh = relative(&medians);
             self.estimate = match self.estimate.len() == threads {
                 true => relative(
                     &self
@@ -289,8 +287,7 @@ impl ThreadSpeeds {
         } else if self.estimate.len() != threads {
             self.estimate.clear();
         }
-        self.weight.clear();
-        self.seconds.clear();
+        self.rates.iter_mut().for_each(Vec::clear);
         self.estimate.clone()
     }
 }
@@ -446,28 +443,34 @@ mod tests {
     #[test]
     fn speeds_are_measured_blended_and_bounded() {
         let mut speeds = ThreadSpeeds::default();
+        let steps = |speeds: &mut ThreadSpeeds, k: usize, seconds: &[f64]| {
+            for &t in seconds {
+                speeds.add(k, 100.0, t);
+            }
+        };
         assert!(speeds.estimate(2).is_empty(), "no measurement, no estimate");
-        // Thread 1 ran its block of the same weight in twice the time: half the speed.
-        speeds.add(0, 100.0, 1e-3);
-        speeds.add(1, 100.0, 2e-3);
+        // Thread 1 ran its block of the same weight in twice the time: half the speed; one step in
+        // which it was left unrun for 50 ms does not count.
+        steps(&mut speeds, 0, &[1e-3; 6]);
+        steps(&mut speeds, 1, &[2e-3, 2e-3, 50e-3, 2e-3, 2e-3, 2e-3]);
         let first = speeds.estimate(2);
         assert!(
             (first[0] - 4.0 / 3.0).abs() < 1e-12 && (first[1] - 2.0 / 3.0).abs() < 1e-12,
             "{first:?}"
         );
         // Equal speeds next: halfway back.
-        speeds.add(0, 100.0, 1e-3);
-        speeds.add(1, 100.0, 1e-3);
+        steps(&mut speeds, 0, &[1e-3; 5]);
+        steps(&mut speeds, 1, &[1e-3; 5]);
         let second = speeds.estimate(2);
         assert!((second[0] - 7.0 / 6.0).abs() < 1e-12, "{second:?}");
-        // Too short a measurement keeps the estimate; another thread count drops it.
-        speeds.add(0, 1.0, 1e-6);
-        speeds.add(1, 1.0, 1e-6);
+        // Too few steps keep the estimate; another thread count drops it.
+        steps(&mut speeds, 0, &[1e-3; 4]);
+        steps(&mut speeds, 1, &[1e-3; 4]);
         assert_eq!(speeds.estimate(2), second);
         assert!(speeds.estimate(3).is_empty());
-        // A thread the host left unrun for long counts as at most twice slower.
-        speeds.add(0, 100.0, 1e-3);
-        speeds.add(1, 100.0, 50e-3);
+        // A thread slower than twice the other counts as twice slower.
+        steps(&mut speeds, 0, &[1e-3; 5]);
+        steps(&mut speeds, 1, &[5e-3; 5]);
         let bounded = speeds.estimate(2);
         assert!((bounded[0] / bounded[1] - 2.0).abs() < 1e-12, "{bounded:?}");
     }
