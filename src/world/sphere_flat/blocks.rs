@@ -23,7 +23,7 @@ use super::NeighbourList;
 /// blocks only, the two threads' pair loops differed by 2–18 µs per step of ~70 µs, which thread was
 /// slower changing from run to run (per-thread timers, 2026-11-23). Every sphere of a middle is
 /// gathered, since either thread may run its row: that costs its kick about two kicks' time more
-/// (below), the price of the middle's size ([`MIDDLE_SHARE`]).
+/// (below), the price of the middle's size ([`TeamSplit::middle_share`]).
 ///
 /// **Weights.** Blocks and middles are cut at equal sums of a per-sphere weight: its row's pairs and
 /// its walls, a pair in contact counting [`CONTACT_WEIGHT`], plus one for the sphere itself (before
