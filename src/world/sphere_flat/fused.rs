@@ -46,7 +46,7 @@ use super::pair::{
     Kinematic, PairConstants, PairContext, PairOut, Props, WallConstants, WallPlane,
 };
 use super::passes::{wall_sums, BlockPart, Drift, Found, Kick, KickPart, PairBlocks, Rows};
-use super::team::{Barrier, PhaseSlice, TwoEnded};
+use super::team::{pieces_of, Barrier, PhaseSlice, TwoEnded};
 use super::{SphereSim, Spin};
 
 /// How a fused step ended.
@@ -329,15 +329,8 @@ impl Job<'_> {
         let merge = |(a, b): (TopTwo, TopTwo), (c, d): (TopTwo, TopTwo)| (a.merge(c), b.merge(d));
         // SAFETY (of each `drift_spheres`): the drift's ranges, middles and pieces are disjoint.
         let mut moved = unsafe { self.drift_spheres(self.blocks.drift[k].clone()) };
-        if let Some(middle) = self.drift_middles.get(k) {
-            while let Some(piece) = middle.take_front() {
-                moved = merge(moved, unsafe { self.drift_spheres(piece) });
-            }
-        }
-        if let Some(middle) = k.checked_sub(1).and_then(|m| self.drift_middles.get(m)) {
-            while let Some(piece) = middle.take_back() {
-                moved = merge(moved, unsafe { self.drift_spheres(piece) });
-            }
+        for (piece, _) in pieces_of(&self.drift_middles, k) {
+            moved = merge(moved, unsafe { self.drift_spheres(piece) });
         }
         moved
     }
@@ -384,22 +377,18 @@ impl Job<'_> {
         let start = Instant::now();
         let mut found = unsafe { self.segment(self.blocks.bodies[k].clone()) };
         let block_seconds = start.elapsed().as_secs_f64();
-        if let Some(middle) = self.middles.get(k) {
-            while !found.failed() {
-                let Some(piece) = middle.take_front() else {
-                    break;
-                };
-                found = found.merge(unsafe { self.segment(piece) });
-            }
-        }
-        if let Some(middle) = k.checked_sub(1).and_then(|m| self.middles.get(m)) {
-            // Taken from the back: each piece comes before what this thread found so far.
-            while !found.failed() {
-                let Some(piece) = middle.take_back() else {
-                    break;
-                };
-                found = unsafe { self.segment(piece) }.merge(found);
-            }
+        let mut pieces = pieces_of(&self.middles, k);
+        // Checked before each piece is taken: a piece taken is run by no other thread.
+        while !found.failed() {
+            let Some((piece, from_back)) = pieces.next() else {
+                break;
+            };
+            let more = unsafe { self.segment(piece) };
+            // A piece from the back comes before what this thread found so far.
+            found = match from_back {
+                true => more.merge(found),
+                false => found.merge(more),
+            };
         }
         (found, block_seconds)
     }
@@ -484,21 +473,12 @@ impl Job<'_> {
     unsafe fn kick(&self, k: usize) -> Option<(usize, &'static str)> {
         // SAFETY (of each `kick_spheres`): the kick's ranges, middles and pieces are disjoint.
         let mut first = unsafe { self.kick_spheres(self.blocks.kick[k].clone()) };
-        if let Some(middle) = self.kick_middles.get(k) {
-            while first.is_none() {
-                let Some(piece) = middle.take_front() else {
-                    break;
-                };
-                first = unsafe { self.kick_spheres(piece) };
-            }
-        }
-        if let Some(middle) = k.checked_sub(1).and_then(|m| self.kick_middles.get(m)) {
-            while first.is_none() {
-                let Some(piece) = middle.take_back() else {
-                    break;
-                };
-                first = unsafe { self.kick_spheres(piece) };
-            }
+        let mut pieces = pieces_of(&self.kick_middles, k);
+        while first.is_none() {
+            let Some((piece, _)) = pieces.next() else {
+                break;
+            };
+            first = unsafe { self.kick_spheres(piece) };
         }
         first
     }

@@ -222,6 +222,24 @@ impl TwoEnded {
     }
 }
 
+/// Thread `k`'s pieces of the middles beside its part, taken one at a time as the caller asks: the
+/// middle after its part from the front, then the middle before it from the back (each piece with
+/// whether it came from the back, i.e. lies before the thread's part), until the neighbours meet.
+pub(super) fn pieces_of(
+    middles: &[TwoEnded],
+    k: usize,
+) -> impl Iterator<Item = (std::ops::Range<usize>, bool)> + '_ {
+    let front = middles
+        .get(k)
+        .into_iter()
+        .flat_map(|m| std::iter::from_fn(|| m.take_front()));
+    let back = k.checked_sub(1).and_then(|m| middles.get(m));
+    let back = back
+        .into_iter()
+        .flat_map(|m| std::iter::from_fn(|| m.take_back()));
+    front.map(|r| (r, false)).chain(back.map(|r| (r, true)))
+}
+
 /// The size of the next piece of a [`TwoEnded`] with `left` items left (at least one).
 fn piece(left: usize) -> usize {
     (left / 4).max(MIN_PIECE).min(left)
