@@ -4,13 +4,15 @@
 //! spheres, Hertz–Mindlin or linear spring–dashpot with friction and damping, a steel projectile) for the
 //! given number of steps on a rayon pool of one thread, as the suite's speed rows do, and prints per
 //! scene: the thread's CPU time and the wall time of the stepping loop, particle-steps/s (CPU and wall),
-//! the stage timers and counters of the step, the load average before and after, and a checksum of the
+//! the stage timers and counters of the step, the load average before and after (on several threads
+//! also the core-to-core round trip, `polydem::host::core_round_trip_ns`), and a checksum of the
 //! final positions and velocities (the bits: two builds that print the same checksum ran the same
 //! trajectory).
 //!
 //! ```text
 //! cargo run --release --example sphere_bed_speed -- [--steps N] [--path flat|general] [--threads N]
-//!     [--ledger on|off|scene] [--skin M] [--orientation on|off] [--wide on|off] [SCENE.toml ...]
+//!     [--ledger on|off|scene] [--skin M] [--orientation on|off] [--wide on|off] [--driver run|step]
+//!     [SCENE.toml ...]
 //! ```
 //! Default: 5000 steps (0.01 s of the bed) of the three variants a, b, c, on the flat sphere path
 //! (`polydem::world::SphereSim`, which runs without the per-contact ledger: `--ledger` is then `off`)
@@ -20,9 +22,13 @@
 //! `--orientation` whether the flat path turns the spheres' orientations (default off, as the suite's
 //! `sphere_bed` case runs it: no output reads them, and positions and velocities are the same bits);
 //! `--wide` whether the flat path's passes run in their AVX2 build where the CPU has it (default on;
-//! `SphereSim::set_wide_instructions`; the same bits either way).
+//! `SphereSim::set_wide_instructions`; the same bits either way); `--driver` how the flat steps are
+//! driven: `run` (default) by `SphereSim::run_steps`, as the suite's `sphere_bed` case drives them (on
+//! several threads the pool's threads are held for the run), `step` by `SphereSim::step` once per step
+//! (each step's team job a rayon broadcast; the same bits, slower on two threads).
 
-use polydem::host::{load_average, thread_cpu_time};
+use polydem::host::{core_round_trip_text, load_average, thread_cpu_time};
+use std::ops::ControlFlow;
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -38,6 +44,7 @@ struct Options {
     skin: Option<f64>,
     orientation: bool,
     wide: bool,
+    step_by_step: bool,
     scenes: Vec<PathBuf>,
 }
 
@@ -50,6 +57,7 @@ fn parse() -> Result<Options, String> {
         skin: None,
         orientation: false,
         wide: true,
+        step_by_step: false,
         scenes: Vec::new(),
     };
     let mut args = std::env::args().skip(1);
@@ -84,6 +92,13 @@ fn parse() -> Result<Options, String> {
                     "on" => true,
                     "off" => false,
                     v => return Err(format!("--wide: '{v}' is not on or off")),
+                }
+            }
+            "--driver" => {
+                o.step_by_step = match value()?.as_str() {
+                    "run" => false,
+                    "step" => true,
+                    v => return Err(format!("--driver: '{v}' is not run or step")),
                 }
             }
             "--threads" => o.threads = value()?.parse().map_err(|e| format!("--threads: {e}"))?,
@@ -121,18 +136,19 @@ fn main() -> anyhow::Result<()> {
         sim.steps = sim.steps.min(o.steps);
         let particles = sim.world.bodies.len();
         let load_before = load_average();
-        let (summary, wall, cpu) = pool.install(|| {
+        let (summary, wall, cpu, round_trips) = pool.install(|| {
+            let before = core_round_trip_text();
             let cpu0 = thread_cpu_time();
             let t = Instant::now();
             let summary = if o.flat {
-                run_flat(&mut sim, o.orientation, o.wide)
+                run_flat(&mut sim, o.orientation, o.wide, o.step_by_step)
             } else {
                 sim.run(|_| Ok(()), |_, _| Ok(()))
                     .map_err(anyhow::Error::from)
             };
             let wall = t.elapsed().as_secs_f64();
             let cpu = cpu0.zip(thread_cpu_time()).map(|(a, b)| b - a);
-            (summary, wall, cpu)
+            (summary, wall, cpu, [before, core_round_trip_text()])
         });
         let summary = summary?;
         let mut hash: u64 = 0xcbf2_9ce4_8422_2325;
@@ -168,6 +184,12 @@ fn main() -> anyhow::Result<()> {
             "  load average before {load_before}, after {}",
             load_average()
         );
+        if o.threads > 1 {
+            println!(
+                "  core-to-core round trip before {}, after {}",
+                round_trips[0], round_trips[1]
+            );
+        }
         println!("  final state checksum {hash:016x}");
         for line in summary.counters.to_string().lines() {
             println!("  {line}");
@@ -181,6 +203,7 @@ fn run_flat(
     sim: &mut polydem::scene::Simulation,
     orientation: bool,
     wide: bool,
+    step_by_step: bool,
 ) -> anyhow::Result<RunSummary> {
     let start = Instant::now();
     let mut flat = SphereSim::from_world(&sim.world, &sim.params)?;
@@ -190,10 +213,19 @@ fn run_flat(
     }
     let mut summary = RunSummary::default();
     let first = flat.step_index() + 1;
-    for _ in first..=sim.steps {
-        let report = flat.step()?;
+    let mut add = |report: &polydem::world::StepReport| {
         summary.counters.merge(&report.counters);
         summary.max_overlap_ratio = summary.max_overlap_ratio.max(report.max_overlap_ratio);
+    };
+    if step_by_step {
+        for _ in first..=sim.steps {
+            add(&flat.step()?);
+        }
+    } else {
+        flat.run_steps((sim.steps + 1).saturating_sub(first), |_, report| {
+            add(report);
+            ControlFlow::Continue(())
+        })?;
     }
     flat.write_back(&mut sim.world);
     summary.steps = (sim.steps + 1).saturating_sub(first);

@@ -9,7 +9,9 @@
 //! steps, in alternating order, so that each sees the shared host as the others do (by default one
 //! stretch: each variant's steps back to back).
 //! Printed per variant and round: wall time, process CPU time (all threads), the share of the machine's
-//! CPU time the hypervisor stole during the round (a busy host), particle-steps/s (wall), the load
+//! CPU time the hypervisor stole during the round (a busy host), on several threads the core-to-core
+//! round trip right after the round (`polydem::host::core_round_trip_ns`: ~100 ns when the host keeps
+//! both virtual CPUs on one die, ~450 ns when not, 2026-11-27), particle-steps/s (wall), the load
 //! average, the wall time per step of each stage (the step's counters: kick and drift, lists, pair
 //! loop, walls and ledger) and whether the final state is bit-identical to the first variant's; then
 //! the median and range over the rounds of each variant's speed-up over the first.
@@ -32,7 +34,7 @@ use std::ops::ControlFlow;
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
-use polydem::host::{load_average, CpuTicks};
+use polydem::host::{core_round_trip_text, load_average, CpuTicks};
 use polydem::scene::load_scene;
 use polydem::world::sphere_flat::TeamSplit;
 use polydem::world::{SphereSim, StepParams, World};
@@ -283,8 +285,13 @@ fn main() -> Result<(), String> {
                 let per_step = |d: Duration| d.as_secs_f64() * 1e6 / o.steps as f64;
                 let rate = v.sim.len() as f64 * o.steps as f64 / wall;
                 let same = (k > 0).then(|| state_bits(&v.sim) == first_bits);
+                // After the round: which state the host's cores were in (`host::core_round_trip_ns`).
+                let round_trip = match v.threads {
+                    1 => String::new(),
+                    _ => format!(", core round trip {}", v.pool.install(core_round_trip_text)),
+                };
                 println!(
-                    "  round {round}, {}: wall {wall:.3} s, CPU {:.3} s, steal {steal}, {rate:.3e} particle-steps/s, load {load}; µs per step: kick+drift {:.1}, lists {:.1} ({} builds), pairs {:.1}, walls {:.1}{}",
+                    "  round {round}, {}: wall {wall:.3} s, CPU {:.3} s, steal {steal}{round_trip}, {rate:.3e} particle-steps/s, load {load}; µs per step: kick+drift {:.1}, lists {:.1} ({} builds), pairs {:.1}, walls {:.1}{}",
                     v.label(o.splits.len()),
                     v.cpu.as_secs_f64(),
                     per_step(v.stages[0]),

@@ -1,5 +1,9 @@
-//! Readings of the host that speed reports print beside their figures: the calling thread's CPU time and
-//! the load average (one place for the example programs, the validation suite and the region profile).
+//! Readings of the host that speed reports print beside their figures: the calling thread's CPU time,
+//! the load average, the hypervisor's steal and the core-to-core round trip (one place for the example
+//! programs, the validation suite and the region profile).
+
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::time::{Duration, Instant};
 
 /// CPU time of the calling thread (ns); `None` where the clock is unavailable.
 pub fn thread_cpu_ns() -> Option<u64> {
@@ -69,9 +73,111 @@ impl CpuTicks {
     }
 }
 
+/// A counter alone on its cache lines (two: the adjacent-line prefetcher pairs them), so that the round
+/// trip measures one line passed between two cores and nothing that shares it.
+#[repr(align(128))]
+struct PaddedCounter(AtomicU64);
+
+/// The mean time (ns) for one cache line to go from thread 0 of rayon's current pool to thread 1 and
+/// back: thread 0 writes an odd count, thread 1 waits for it and writes the next even one, `trips`
+/// times. `None` on a pool of one thread, or when one wait outlasts `timeout` (a busy host left a
+/// thread unrun).
+///
+/// Why: on the 2-core virtual machine this project runs on, the two virtual CPUs lie on one die of the
+/// host for a while and on two dies at other times. Measured between whole runs of sphere bed a
+/// (2026-11-27, 3000 steps, each run of two threads beside the round trip just before and after it):
+/// round trips of 96–113 ns went with two-thread runs of 0.334–0.353 s, of 419–486 ns with 0.419–0.442
+/// s, while one-thread runs took 0.605–0.647 s throughout and two independent one-thread runs at once
+/// lost at most 5 % in either state. A run on two threads passes a few hundred cache lines between
+/// the cores every step (barriers, the spheres at the split, the gathered loads), so its speed-up
+/// depends on which of the two states the host is in; speed reports print this reading beside it.
+pub fn core_round_trip_ns(trips: u32, timeout: Duration) -> Option<f64> {
+    if rayon::current_num_threads() < 2 || trips == 0 {
+        return None;
+    }
+    let counter = PaddedCounter(AtomicU64::new(0));
+    // Either thread gives up when the other has not answered within `timeout`, and says so here, so
+    // that the other stops waiting too.
+    let abandoned = PaddedCounter(AtomicU64::new(0));
+    let wait_for = |value: u64| -> bool {
+        let start = Instant::now();
+        let mut spins = 0u32;
+        while counter.0.load(Ordering::Acquire) != value {
+            std::hint::spin_loop();
+            spins = spins.wrapping_add(1);
+            if spins.is_multiple_of(1024)
+                && (abandoned.0.load(Ordering::Relaxed) != 0 || start.elapsed() > timeout)
+            {
+                abandoned.0.store(1, Ordering::Relaxed);
+                return false;
+            }
+        }
+        true
+    };
+    let times = rayon::broadcast(|ctx| match ctx.index() {
+        0 => {
+            // Both threads running before the clock starts.
+            if !wait_for(1) {
+                return None;
+            }
+            let start = Instant::now();
+            for trip in 0..u64::from(trips) {
+                counter.0.store(2 * trip + 2, Ordering::Release);
+                if !wait_for(2 * trip + 3) {
+                    return None;
+                }
+            }
+            Some(start.elapsed())
+        }
+        1 => {
+            counter.0.store(1, Ordering::Release);
+            for trip in 0..u64::from(trips) {
+                if !wait_for(2 * trip + 2) {
+                    return None;
+                }
+                counter.0.store(2 * trip + 3, Ordering::Release);
+            }
+            None
+        }
+        _ => None,
+    });
+    let elapsed = times.first().copied().flatten()?;
+    (abandoned.0.load(Ordering::Relaxed) == 0)
+        .then(|| elapsed.as_secs_f64() * 1e9 / f64::from(trips))
+}
+
+/// [`core_round_trip_ns`] as speed reports print it: 20 000 trips (~2–10 ms), "n/a" where it has no
+/// reading.
+pub fn core_round_trip_text() -> String {
+    match core_round_trip_ns(20_000, Duration::from_millis(200)) {
+        Some(ns) => format!("{ns:.0} ns"),
+        None => "n/a".into(),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// One thread has no partner; two threads pass the line back and forth: a positive, finite time,
+    /// below the 200 µs that would mean a wait for the scheduler rather than a cache line.
+    #[test]
+    fn core_round_trip_needs_two_threads_and_is_a_cache_line_time() {
+        let pool = |threads: usize| {
+            rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .expect("pool")
+        };
+        let one = pool(1).install(|| core_round_trip_ns(1000, Duration::from_secs(1)));
+        assert_eq!(one, None, "one thread: {one:?}, expected no reading");
+        let two = pool(2).install(|| core_round_trip_ns(1000, Duration::from_secs(1)));
+        let ns = two.expect("two threads: a reading within the 1 s timeout");
+        assert!(
+            ns.is_finite() && ns > 0.0 && ns < 200_000.0,
+            "round trip {ns} ns, expected 0 < t < 200 µs"
+        );
+    }
 
     #[test]
     fn steal_is_the_eighth_field_of_the_cpu_line() {

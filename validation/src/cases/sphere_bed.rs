@@ -23,7 +23,7 @@ use std::ops::ControlFlow;
 use std::path::Path;
 use std::time::Instant;
 
-use polydem::host::{load_average, thread_cpu_time, CpuTicks};
+use polydem::host::{core_round_trip_text, load_average, thread_cpu_time, CpuTicks};
 use polydem::math::Real;
 use polydem::scene::{load_scene, Simulation};
 use polydem::world::{SphereSim, StepFlatError};
@@ -238,7 +238,10 @@ fn run_polydem(
         .map_err(|e| fail(format!("pool of {threads} thread(s): {e}")))?;
     let progress = ctx.progress();
     let ticks = CpuTicks::now();
-    let (max_overlap_ratio, wall_time_s, cpu_time_s) = pool.install(|| {
+    let (max_overlap_ratio, wall_time_s, cpu_time_s, round_trips) = pool.install(|| {
+        // On two threads: the state of the host's cores just before and after the run
+        // (`host::core_round_trip_ns`), read outside the timed loop.
+        let before = (threads > 1).then(core_round_trip_text);
         let cpu_start = thread_cpu_time();
         let start = Instant::now();
         let max_overlap = run_steps(&mut sim, projectile, &mut history, &mut |n| {
@@ -251,7 +254,8 @@ fn run_polydem(
             (Some(a), Some(b)) if b > a => Some(b - a),
             _ => None,
         };
-        (max_overlap, wall, cpu)
+        let after = before.is_some().then(core_round_trip_text);
+        (max_overlap, wall, cpu, before.zip(after))
     });
     // A busy host slows a run on two threads more than one on one: each step waits for both.
     let load = match CpuTicks::now()
@@ -259,6 +263,10 @@ fn run_polydem(
         .and_then(|(now, then)| now.steal_since(&then))
     {
         Some(steal) => format!("{load}; host steal {:.1} %", 100.0 * steal),
+        None => load,
+    };
+    let load = match round_trips {
+        Some((before, after)) => format!("{load}; core round trip {before} / {after}"),
         None => load,
     };
     let max_overlap_ratio =
@@ -994,7 +1002,13 @@ impl Case for SphereBed {
              ratios is checked against issue 7's 1.8×. Beside each polydem run's load average: the share \
              of the machine's CPU time that the hypervisor gave to other machines during the run \
              (**host steal**, `/proc/stat`); a run on two threads loses more to it than a run on one, \
-             since each step waits for both threads.",
+             since each step waits for both threads. Beside each two-thread run: the time a cache line \
+             takes from one of the pool's threads to the other and back, read just before and after the run \
+             (**core round trip**, `polydem::host::core_round_trip_ns`). The host places the machine's two \
+             virtual CPUs on one die of its processor for a while (~100 ns) and on two dies at other times \
+             (~450 ns); a two-thread step passes a few hundred cache lines between the cores, and on \
+             2026-11-27 the same 3000 steps of bed a took 0.33–0.35 s on two threads in the first state \
+             and 0.42–0.44 s in the second (one thread: 0.61–0.65 s in both).",
         );
         ctx.table(
             Some("speed"),
