@@ -1004,11 +1004,12 @@ impl Case for SphereBed {
              (**host steal**, `/proc/stat`); a run on two threads loses more to it than a run on one, \
              since each step waits for both threads. Beside each two-thread run: the time a cache line \
              takes from one of the pool's threads to the other and back, read just before and after the run \
-             (**core round trip**, `polydem::host::core_round_trip_ns`). The host places the machine's two \
-             virtual CPUs on one die of its processor for a while (~100 ns) and on two dies at other times \
-             (~450 ns); a two-thread step passes a few hundred cache lines between the cores, and on \
-             2026-11-27 the same 3000 steps of bed a took 0.33–0.35 s on two threads in the first state \
-             and 0.42–0.44 s in the second (one thread: 0.61–0.65 s in both).",
+             (**core round trip**, `polydem::host::core_round_trip_ns`). The host moves the machine's two \
+             virtual CPUs every few minutes: round trips of 41–60, 94–160 and 419–499 ns were seen on \
+             2026-11-27, the last with the two on different dies of the host's processor. A two-thread step \
+             passes a few hundred cache lines between the cores: that day the same 3000 steps of bed a took \
+             0.33–0.35 s on two threads at 96–113 ns and 0.42–0.44 s at 419–486 ns (one thread: 0.61–0.65 s \
+             throughout), so the two-thread rows hold for the state the run met.",
         );
         ctx.table(
             Some("speed"),
