@@ -10,8 +10,8 @@
 //! stretch: each variant's steps back to back).
 //! Printed per variant and round: wall time, process CPU time (all threads), the share of the machine's
 //! CPU time the hypervisor stole during the round (a busy host), on several threads the core-to-core
-//! round trip right after the round (`polydem::host::core_round_trip_ns`: 41–160 ns when the host keeps
-//! both virtual CPUs on one die, 419–499 ns when not, 2026-11-27), particle-steps/s (wall), the load
+//! round trip right after the round (`polydem::host::core_round_trip_ns`: 41–160 ns or 419–499 ns on
+//! 2026-11-27, as the host placed the two virtual CPUs), particle-steps/s (wall), the load
 //! average, the wall time per step of each stage (the step's counters: kick and drift, lists, pair
 //! loop, walls and ledger) and whether the final state is bit-identical to the first variant's; then
 //! the median and range over the rounds of each variant's speed-up over the first.

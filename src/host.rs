@@ -86,14 +86,15 @@ const YIELD_AFTER: Duration = Duration::from_micros(20);
 /// times. `None` on a pool of one thread, or when one wait outlasts `timeout` (a busy host left a
 /// thread unrun).
 ///
-/// Why: on the 2-core virtual machine this project runs on, the two virtual CPUs lie on one die of the
-/// host for a while and on two dies at other times. Measured between whole runs of sphere bed a
+/// Why: on the 2-core virtual machine this project runs on, the reading takes different levels for
+/// minutes at a time (41–60, 94–160 and 419–499 ns on 2026-11-27; by their size, the last is two dies of
+/// the host's processor apart, which the guest cannot see directly). Measured between whole runs of sphere bed a
 /// (2026-11-27, 3000 steps, each run of two threads beside the round trip just before and after it):
 /// round trips of 96–113 ns went with two-thread runs of 0.334–0.353 s, of 419–486 ns with 0.419–0.442
 /// s, while one-thread runs took 0.605–0.647 s throughout and two independent one-thread runs at once
-/// lost at most 5 % in either state. A run on two threads passes a few hundred cache lines between
-/// the cores every step (barriers, the spheres at the split, the gathered loads), so its speed-up
-/// depends on which of the two states the host is in; speed reports print this reading beside it.
+/// lost at most 5 % in either state. A run on two threads passes cache lines between the cores every
+/// step (its barriers, the spheres at the split, the gathered loads), so its speed-up depends on the
+/// state the host is in; speed reports print this reading beside it.
 pub fn core_round_trip_ns(trips: u32, timeout: Duration) -> Option<f64> {
     if rayon::current_num_threads() < 2 || trips == 0 {
         return None;
@@ -109,13 +110,14 @@ pub fn core_round_trip_ns(trips: u32, timeout: Duration) -> Option<f64> {
             std::hint::spin_loop();
             spins = spins.wrapping_add(1);
             if spins.is_multiple_of(1024) {
-                if abandoned.0.load(Ordering::Relaxed) != 0 || start.elapsed() > timeout {
+                let waited = start.elapsed();
+                if abandoned.0.load(Ordering::Relaxed) != 0 || waited > timeout {
                     abandoned.0.store(1, Ordering::Relaxed);
                     return false;
                 }
                 // A wait this long is for the scheduler, not for a cache line (more runnable threads
                 // than cores): give the core to the other thread instead of spinning out the time slice.
-                if start.elapsed() > YIELD_AFTER {
+                if waited > YIELD_AFTER {
                     std::thread::yield_now();
                 }
             }
@@ -149,9 +151,9 @@ pub fn core_round_trip_ns(trips: u32, timeout: Duration) -> Option<f64> {
         }
         _ => None,
     });
+    // Thread 0 timed every trip only if thread 1 answered every one: no other check is needed.
     let elapsed = times.first().copied().flatten()?;
-    (abandoned.0.load(Ordering::Relaxed) == 0)
-        .then(|| elapsed.as_secs_f64() * 1e9 / f64::from(trips))
+    Some(elapsed.as_secs_f64() * 1e9 / f64::from(trips))
 }
 
 /// [`core_round_trip_ns`] as speed reports print it: 20 000 trips (~2–10 ms), "n/a" where it has no

@@ -2,13 +2,13 @@
 # Two-thread scaling of polydem beside two-process scaling of LIGGGHTS on one sphere-bed variant, in
 # alternating rounds, each round with the core-to-core round trip just before and after it (see
 # polydem::host::core_round_trip_ns: the host moves the two virtual CPUs between one die and two).
-# Usage: sh scaling.sh [ROUNDS] [VARIANT]   (defaults: 6 rounds, a_hertz_5ms); the recorded run:
-#   sh scaling.sh 10 > out/scaling_a_hertz_5ms.txt
+# Usage: sh scaling.sh [ROUNDS] [VARIANT]   (defaults: 6 rounds, a_hertz_5ms). The recorded file
+# out/scaling_a_hertz_5ms.txt holds two runs one after the other: `sh scaling.sh 10`, then `sh scaling.sh 30`.
 # Per round, one line: UTC time, round trips before/after (ns), polydem wall times (s) on 1 and 2 threads
 # and their ratio (examples/sphere_bed_speed: SphereSim::run_steps, the suite's driver), LIGGGHTS loop
 # times (s) on 1 and 2 MPI processes and their ratio. LIGGGHTS runs in.penetration with `processors * 1 1`
 # added, so that two processes split the box across x into halves of the bed (its default split cuts the
-# tall box, z from -0.2 to 0.3 m, at z = 0.05 m, inside the bed: 1.17x on two processes, 2026-11-27).
+# tall box, z from -0.2 to 0.3 m, at z = 0.05 m, inside the bed: 1.17x on two processes in one run, 2026-11-27).
 # Needs: cargo, liggghts, mpirun (Debian: apt-get install -y liggghts, which brings Open MPI).
 set -eu
 HERE=$(cd "$(dirname "$0")" && pwd)

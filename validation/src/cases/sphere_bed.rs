@@ -1006,8 +1006,8 @@ impl Case for SphereBed {
              takes from one of the pool's threads to the other and back, read just before and after the run \
              (**core round trip**, `polydem::host::core_round_trip_ns`). The host moves the machine's two \
              virtual CPUs every few minutes: round trips of 41–60, 94–160 and 419–499 ns were seen on \
-             2026-11-27, the last with the two on different dies of the host's processor. A two-thread step \
-             passes a few hundred cache lines between the cores: that day the same 3000 steps of bed a took \
+             2026-11-27, the last of the size of two dies of the host's processor apart. A two-thread step \
+             passes cache lines between the cores at each synchronisation: that day the same 3000 steps of bed a took \
              0.33–0.35 s on two threads at 96–113 ns and 0.42–0.44 s at 419–486 ns (one thread: 0.61–0.65 s \
              throughout), so the two-thread rows hold for the state the run met.",
         );
