@@ -106,6 +106,8 @@ pub enum Outcome {
     Stopped,
     /// `max_time` was reached first.
     TimeLimit,
+    /// [`PenetrationOptions::max_steps`] steps were run first.
+    StepLimit,
 }
 
 /// Options of a penetration run beyond the experiment file.
@@ -117,6 +119,9 @@ pub struct PenetrationOptions {
     /// Tip positions x (m): at the first step at which the tip is at or past each, every body's pose is
     /// recorded ([`Snapshot`]); when the list is not empty, the state at the end of the run is recorded too.
     pub snapshot_tip_x: Vec<Real>,
+    /// Stop after this many steps, whatever the projectile does (benchmarks and regression pins run a
+    /// fixed stretch of the impact); `None` runs to the experiment's own end.
+    pub max_steps: Option<u64>,
 }
 
 impl Default for PenetrationOptions {
@@ -124,6 +129,7 @@ impl Default for PenetrationOptions {
         Self {
             dt_divisor: 1.0,
             snapshot_tip_x: Vec::new(),
+            max_steps: None,
         }
     }
 }
@@ -402,6 +408,9 @@ pub fn penetrate_with(
         }
         if world.time - t0 >= imp.max_time {
             break Outcome::TimeLimit;
+        }
+        if options.max_steps.is_some_and(|max| steps >= max) {
+            break Outcome::StepLimit;
         }
     };
     let last = *rows.last().expect("at least one step");
