@@ -11,11 +11,13 @@
 //! - [`contact`]: support mapping, GJK, EPA, the exact SAT oracle, fast paths per shape pair, dispatch.
 //! - [`dynamics`]: body state, leapfrog translation, the symplectic splitting rotation (paper eqs. 18–25).
 //! - [`law`]: contact laws as pure functions (normal power law, restitution damping, tangential spring).
+//! - [`fixed_hash`]: hash maps with a fixed seed (runs and instruction counts that repeat exactly).
 //! - [`special_functions`]: elliptic integrals and Jacobi elliptic functions for the analytic references.
 //! - [`world`]: the many-body engine: broad phase, contact store, step pipeline.
 
 pub mod contact;
 pub mod dynamics;
+pub mod fixed_hash;
 pub mod host;
 pub mod io;
 pub mod law;

@@ -4,7 +4,7 @@
 //! form `FILE:LINE: FIELD: what is wrong`, e.g. `scenes/drop.toml:14: interaction[0].normal_stiffness:
 //! must be finite and positive, got -1`.
 
-use std::collections::HashMap;
+use crate::fixed_hash::FixedHashMap;
 use std::ops::Range;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -165,7 +165,7 @@ fn build(ctx: &Ctx, file: &SceneFile) -> Result<Simulation, SceneError> {
 
     // Materials.
     let mut materials = MaterialTable::default();
-    let mut material_ids: HashMap<&str, u32> = HashMap::new();
+    let mut material_ids: FixedHashMap<&str, u32> = FixedHashMap::default();
     let mut densities = Vec::new();
     let mut elastic: Vec<Option<ElasticMaterial>> = Vec::new();
     for (k, m) in file.materials.iter().enumerate() {
@@ -413,7 +413,7 @@ fn build(ctx: &Ctx, file: &SceneFile) -> Result<Simulation, SceneError> {
     }
 
     // Shapes.
-    let mut shape_ids: HashMap<&str, usize> = HashMap::new();
+    let mut shape_ids: FixedHashMap<&str, usize> = FixedHashMap::default();
     let mut shapes: Vec<(Shape, Pose)> = Vec::new();
     for (k, s) in file.shapes.iter().enumerate() {
         let f = |x: &str| format!("shape[{k}].{x}");
@@ -537,7 +537,7 @@ fn build(ctx: &Ctx, file: &SceneFile) -> Result<Simulation, SceneError> {
     let mut world_bodies = Vec::new();
     // Where each body was given: the span and field an error about it names.
     let mut origins: Vec<(Range<usize>, String)> = Vec::new();
-    let mut names: HashMap<String, ()> = HashMap::new();
+    let mut names: FixedHashMap<String, ()> = FixedHashMap::default();
     for (k, b) in file.bodies.iter().enumerate() {
         let f = |x: &str| format!("body[{k}].{x}");
         let name = b.name.get_ref().as_str();

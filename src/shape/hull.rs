@@ -27,7 +27,7 @@
 //!
 //! Duplicate and interior points never become vertices.
 
-use std::collections::HashMap;
+use crate::fixed_hash::FixedHashMap;
 
 use crate::math::glam::{glam_to_point, point_to_glam};
 use crate::math::{Point, Real, Rotation, Vector};
@@ -207,7 +207,8 @@ fn triangulated_hull(
     transformed: &[Point],
 ) -> Result<(Vec<Point>, Vec<[u32; 3]>), ShapeError> {
     let key = |p: &Point| [p.x.to_bits(), p.y.to_bits(), p.z.to_bits()];
-    let mut original: HashMap<[u64; 3], usize> = HashMap::with_capacity(transformed.len());
+    let mut original: FixedHashMap<[u64; 3], usize> =
+        FixedHashMap::with_capacity_and_hasher(transformed.len(), Default::default());
     let mut input = Vec::with_capacity(transformed.len());
     for (i, w) in transformed.iter().enumerate() {
         if let std::collections::hash_map::Entry::Vacant(slot) = original.entry(key(w)) {
@@ -309,7 +310,8 @@ fn merge_coplanar(
     tol: Real,
 ) -> Result<Vec<Vec<u32>>, ShapeError> {
     // Half-edge (a, b) → triangle owning it.
-    let mut owner: HashMap<(u32, u32), usize> = HashMap::with_capacity(3 * triangles.len());
+    let mut owner: FixedHashMap<(u32, u32), usize> =
+        FixedHashMap::with_capacity_and_hasher(3 * triangles.len(), Default::default());
     for (t, tri) in triangles.iter().enumerate() {
         for k in 0..3 {
             if owner.insert((tri[k], tri[(k + 1) % 3]), t).is_some() {
@@ -386,7 +388,7 @@ fn boundary_loop(
     region: usize,
     twin: &impl Fn(u32, u32) -> Option<usize>,
 ) -> Result<Vec<u32>, ShapeError> {
-    let mut next: HashMap<u32, u32> = HashMap::new();
+    let mut next: FixedHashMap<u32, u32> = FixedHashMap::default();
     for &t in members {
         let tri = triangles[t];
         for k in 0..3 {
@@ -470,7 +472,7 @@ fn drop_non_corner_vertices(
 /// The faces must form a closed, consistently wound surface of sphere topology: every half-edge used
 /// once, each with its twin, and V − E + F = 2.
 fn check_closed(num_vertices: usize, faces: &[Vec<u32>]) -> Result<(), ShapeError> {
-    let mut half_edges = std::collections::HashSet::new();
+    let mut half_edges = crate::fixed_hash::FixedHashSet::default();
     for face in faces {
         for k in 0..face.len() {
             if !half_edges.insert((face[k], face[(k + 1) % face.len()])) {

@@ -411,7 +411,7 @@ fn validate_topology(num_vertices: usize, faces: &[Vec<u32>]) -> Result<(), Shap
             reason: format!("{} faces, a solid needs at least 4", faces.len()),
         });
     }
-    let mut half_edges = std::collections::HashSet::new();
+    let mut half_edges = crate::fixed_hash::FixedHashSet::default();
     let mut used = vec![false; num_vertices];
     for (f, face) in faces.iter().enumerate() {
         if face.len() < 3 {

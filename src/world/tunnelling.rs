@@ -32,7 +32,7 @@
 //! another at the first observation is not reported (nothing crossed). The cost is O(N²) segment tests per
 //! step with a bounding-sphere reject; it is a verification tool, not part of the step.
 
-use std::collections::HashSet;
+use crate::fixed_hash::FixedHashSet;
 
 use crate::contact::ContactKind;
 use crate::math::{Point, Pose, Real, Vector};
@@ -106,10 +106,10 @@ impl CrossingCounts {
 pub struct TunnellingMonitor {
     poses: Vec<Pose>,
     wall_poses: Vec<Pose>,
-    overlapping: HashSet<ContactKey>,
+    overlapping: FixedHashSet<ContactKey>,
 }
 
-fn overlapping_pairs(world: &World) -> HashSet<ContactKey> {
+fn overlapping_pairs(world: &World) -> FixedHashSet<ContactKey> {
     world
         .contacts
         .keys()

@@ -33,6 +33,13 @@ pub enum SuiteError {
         #[source]
         source: csv::Error,
     },
+    /// A file of the report or of its inputs that does not parse (the message says what is wrong).
+    #[error("{}:{line}: {message}", path.display())]
+    Parse {
+        path: PathBuf,
+        line: usize,
+        message: String,
+    },
     /// Rendering a plot.
     #[error("plot `{name}`: {msg}")]
     Plot { name: String, msg: String },

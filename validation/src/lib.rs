@@ -5,6 +5,7 @@
 //! - [`context`], [`plot`], [`progress`], [`report`], [`provenance`], [`runner`]: the machinery that runs
 //!   cases and writes `reports/`.
 //! - [`pairsets`]: seeded contact pair sets; [`peers`]: adapters to peer codes (parry3d).
+//! - [`perf`]: instruction counts per commit, the regression gate and the dashboard (`cargo perf`).
 
 pub mod case;
 pub mod cases;
@@ -13,6 +14,7 @@ pub mod error;
 pub mod gate;
 pub mod pairsets;
 pub mod peers;
+pub mod perf;
 pub mod plot;
 pub mod progress;
 pub mod provenance;

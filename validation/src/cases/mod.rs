@@ -6,7 +6,6 @@ use crate::case::Case;
 pub mod chung_ooi;
 pub mod contact;
 pub mod friction;
-pub mod perf;
 pub mod polyhedra_bed;
 pub mod polyhedra_box;
 pub mod precession;
@@ -38,6 +37,5 @@ pub fn registry() -> Vec<&'static dyn Case> {
         &stress_impact::StressImpact,
         &stress_shapes::StressShapes,
         &stress_time_step::StressTimeStep,
-        &perf::Perf,
     ]
 }
