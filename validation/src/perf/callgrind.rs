@@ -46,32 +46,46 @@ pub enum CountError {
     },
 }
 
-/// Counts the figures of benchmark `bench` by running `binary exec BENCH --prepared DIR [extra_args]` under
-/// callgrind.
-/// Dump files go to `scratch` (created; removed on success).
-pub fn count(
-    binary: &Path,
-    bench: &str,
-    prepared: &Path,
-    scratch: &Path,
-    extra_args: &[String],
-) -> Result<Vec<Count>, CountError> {
+/// The program a count runs, as the counted process sees it: `./perf` (a copy of the binary) in `run_dir`,
+/// started as `./perf exec BENCH --prepared prepared [extra_args]` with a fixed environment. Everything on
+/// the process's initial stack is then the same whichever checkout, target directory or shell it comes
+/// from: the environment's size alone moved some counts by up to ~50 instructions.
+pub struct Program<'a> {
+    pub run_dir: &'a Path,
+    pub extra_args: &'a [String],
+}
+
+/// The name of the copy of the binary inside the run directory, and of the prepared inputs' directory.
+pub const PROGRAM: &str = "perf";
+pub const PREPARED: &str = "prepared";
+
+/// Counts the figures of benchmark `bench` under callgrind. Dump files go to `scratch` (created; removed on
+/// success).
+pub fn count(program: &Program, bench: &str, scratch: &Path) -> Result<Vec<Count>, CountError> {
     let io = |path: &Path| {
         let path = path.to_owned();
         move |source| CountError::Io { path, source }
     };
     std::fs::create_dir_all(scratch).map_err(io(scratch))?;
     let out_file = scratch.join(format!("callgrind.{bench}"));
-    let output = Command::new("valgrind")
+    let valgrind = find_valgrind().ok_or_else(|| {
+        CountError::NoValgrind(std::io::Error::new(
+            std::io::ErrorKind::NotFound,
+            "not on PATH",
+        ))
+    })?;
+    let output = Command::new(valgrind)
         .arg("--tool=callgrind")
         .arg("--collect-atstart=no")
         .arg(format!("--toggle-collect={REGION}"))
         .arg(format!("--dump-after={REGION}"))
         .arg(format!("--callgrind-out-file={}", out_file.display()))
-        .arg(binary)
-        .args(["exec", bench, "--prepared"])
-        .arg(prepared)
-        .args(extra_args)
+        .arg(format!("./{PROGRAM}"))
+        .args(["exec", bench, "--prepared", PREPARED])
+        .args(program.extra_args)
+        .current_dir(program.run_dir)
+        .env_clear()
+        .env("PATH", "/usr/bin:/bin")
         .env("RAYON_NUM_THREADS", "1")
         .output()
         .map_err(CountError::NoValgrind)?;
@@ -147,9 +161,20 @@ fn tail(text: &str, lines: usize) -> String {
     all[all.len().saturating_sub(lines)..].join("\n")
 }
 
+/// valgrind's path on this process's `PATH`.
+fn find_valgrind() -> Option<PathBuf> {
+    let path = std::env::var_os("PATH")?;
+    std::env::split_paths(&path)
+        .map(|dir| dir.join("valgrind"))
+        .find(|p| p.is_file())
+}
+
 /// valgrind's version (`valgrind-3.19.0`), or `None` when it is not installed.
 pub fn valgrind_version() -> Option<String> {
-    let out = Command::new("valgrind").arg("--version").output().ok()?;
+    let out = Command::new(find_valgrind()?)
+        .arg("--version")
+        .output()
+        .ok()?;
     out.status
         .success()
         .then(|| String::from_utf8_lossy(&out.stdout).trim().to_string())

@@ -60,7 +60,8 @@ pub fn count_all(
     work: &Path,
     options: &CountOptions,
 ) -> Result<Vec<Count>, PerfError> {
-    let prepared = work.join("prepared");
+    let run_dir = run_dir(work)?;
+    let prepared = run_dir.join(callgrind::PREPARED);
     let status = Command::new(binary)
         .arg("prepare")
         .arg("--prepared")
@@ -73,6 +74,10 @@ pub fn count_all(
             binary.display()
         )));
     }
+    let copy = run_dir.join(callgrind::PROGRAM);
+    std::fs::copy(binary, &copy).map_err(|e| {
+        PerfError::Prepare(format!("{} -> {}: {e}", binary.display(), copy.display()))
+    })?;
     let names = if options.benches.is_empty() {
         bench_names(binary)?
     } else {
@@ -82,6 +87,10 @@ pub fn count_all(
     if options.plant_regression {
         extra.push("--plant-regression".to_string());
     }
+    let program = callgrind::Program {
+        run_dir: &run_dir,
+        extra_args: &extra,
+    };
     let lanes = std::thread::available_parallelism().map_or(1, |n| n.get());
     let next = std::sync::atomic::AtomicUsize::new(0);
     let results: Vec<_> = std::thread::scope(|scope| {
@@ -94,10 +103,7 @@ pub fn count_all(
                         let Some(name) = names.get(i) else { break };
                         let scratch = work.join("callgrind").join(name);
                         eprintln!("perf: counting {name} ({})", binary.display());
-                        done.push((
-                            i,
-                            callgrind::count(binary, name, &prepared, &scratch, &extra),
-                        ));
+                        done.push((i, callgrind::count(&program, name, &scratch)));
                     }
                     done
                 })
@@ -114,7 +120,22 @@ pub fn count_all(
     for (_, result) in ordered {
         counts.extend(result?);
     }
+    std::fs::remove_dir_all(&run_dir)
+        .map_err(|e| PerfError::Prepare(format!("{}: {e}", run_dir.display())))?;
     Ok(counts)
+}
+
+/// A fresh run directory whose path has the same length on every machine and for every commit counted
+/// (`/tmp/polydem-perf-` and the process id in ten digits): the counted process starts in it, and the
+/// length of its working directory and executable path shifts its initial stack, which moved some counts
+/// by up to ~100 instructions. `work` is where the directory's creation is reported on error only.
+fn run_dir(work: &Path) -> Result<PathBuf, PerfError> {
+    let dir = PathBuf::from(format!("/tmp/polydem-perf-{:010}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).map_err(|e| {
+        PerfError::Prepare(format!("{} (for {}): {e}", dir.display(), work.display()))
+    })?;
+    Ok(dir)
 }
 
 /// The benchmark names of a `perf` binary (`perf list --names`).
