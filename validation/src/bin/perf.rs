@@ -71,6 +71,9 @@ enum Command {
         bench: String,
         #[arg(long)]
         prepared: PathBuf,
+        /// The repository whose scenes and saved states the benchmark reads (default: this build's).
+        #[arg(long)]
+        root: Option<PathBuf>,
         #[arg(long)]
         plant_regression: bool,
     },
@@ -79,6 +82,8 @@ enum Command {
     Prepare {
         #[arg(long)]
         prepared: PathBuf,
+        #[arg(long)]
+        root: Option<PathBuf>,
     },
 }
 
@@ -120,17 +125,26 @@ fn run(cli: Cli) -> anyhow::Result<bool> {
         Command::Exec {
             bench,
             prepared,
+            root,
             plant_regression,
         } => {
-            let inputs = benches::default_inputs(prepared, plant_regression);
+            let inputs = benches::Inputs {
+                root: root.unwrap_or_else(workspace_root),
+                prepared,
+                plant_regression,
+            };
             for (figure, work) in benches::run(&bench, &inputs).map_err(anyhow::Error::msg)? {
                 println!("figure {figure} {work}");
             }
             Ok(true)
         }
-        Command::Prepare { prepared } => {
-            benches::prepare(&benches::default_inputs(prepared, false))
-                .map_err(anyhow::Error::msg)?;
+        Command::Prepare { prepared, root } => {
+            let inputs = benches::Inputs {
+                root: root.unwrap_or_else(workspace_root),
+                prepared,
+                plant_regression: false,
+            };
+            benches::prepare(&inputs).map_err(anyhow::Error::msg)?;
             Ok(true)
         }
         Command::List { names } => {
@@ -184,7 +198,12 @@ fn count_here(p: &Paths, sel: &Selection) -> anyhow::Result<Vec<callgrind::Count
         benches: sel.benches.clone(),
         plant_regression: sel.plant_regression,
     };
-    Ok(count_all(&exe, &work_dir(&p.root).join("head"), &options)?)
+    Ok(count_all(
+        &exe,
+        &p.root,
+        &work_dir(&p.root).join("head"),
+        &options,
+    )?)
 }
 
 /// The counts a run is compared with.
@@ -233,15 +252,10 @@ fn baseline_counts(
             key.differences(&theirs).join("; ")
         );
     }
-    let binary = baseline::build_at(&p.root, &commit, &work_dir(&p.root))?;
-    let options = CountOptions {
-        benches: benches.to_vec(),
-        plant_regression: false,
-    };
-    let counts = count_all(&binary, &work_dir(&p.root).join("baseline"), &options)?;
+    let counts = baseline::count_at(&p.root, &commit, &work_dir(&p.root), benches)?;
     Ok(Some(Baseline {
         commit,
-        counts: by_figure(&counts),
+        counts,
         measured_now: true,
     }))
 }

@@ -29,7 +29,6 @@ use polydem::world::{step, StepScratch};
 
 use crate::cases::contact::random_set;
 use crate::pairsets::{Intent, RandomSetSpec};
-use crate::provenance::workspace_root;
 
 /// A benchmark of the set: its name and the figures it produces (in the order it measures them).
 pub struct Bench {
@@ -420,13 +419,4 @@ fn io(inputs: &Inputs, regions: &mut Regions) -> Result<(), String> {
     regions.figures.last_mut().expect("just measured").1 =
         payload.simulation.world.bodies.len() as u64;
     Ok(())
-}
-
-/// The inputs of this build: its own workspace, and the prepared states in `prepared`.
-pub fn default_inputs(prepared: PathBuf, plant_regression: bool) -> Inputs {
-    Inputs {
-        root: workspace_root(),
-        prepared,
-        plant_regression,
-    }
 }

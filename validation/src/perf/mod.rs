@@ -52,11 +52,12 @@ pub struct CountOptions {
     pub plant_regression: bool,
 }
 
-/// Counts the figures of the `perf` binary `binary`: prepares its inputs natively in `work`, then runs
-/// each benchmark under callgrind, as many at a time as there are cores. Figures come back in the order of
-/// the benchmark set.
+/// Counts the figures of the `perf` binary `binary` built from the repository at `root`: prepares its
+/// inputs natively, then runs each benchmark under callgrind, as many at a time as there are cores.
+/// Figures come back in the order of the benchmark set. `work` names the run in error messages.
 pub fn count_all(
     binary: &Path,
+    root: &Path,
     work: &Path,
     options: &CountOptions,
 ) -> Result<Vec<Count>, PerfError> {
@@ -66,6 +67,8 @@ pub fn count_all(
         .arg("prepare")
         .arg("--prepared")
         .arg(&prepared)
+        .arg("--root")
+        .arg(root)
         .status()
         .map_err(|e| PerfError::Prepare(format!("{}: {e}", binary.display())))?;
     if !status.success() {
@@ -77,6 +80,10 @@ pub fn count_all(
     let copy = run_dir.join(callgrind::PROGRAM);
     std::fs::copy(binary, &copy).map_err(|e| {
         PerfError::Prepare(format!("{} -> {}: {e}", binary.display(), copy.display()))
+    })?;
+    let link = run_dir.join(callgrind::ROOT);
+    std::os::unix::fs::symlink(root, &link).map_err(|e| {
+        PerfError::Prepare(format!("{} -> {}: {e}", link.display(), root.display()))
     })?;
     let names = if options.benches.is_empty() {
         bench_names(binary)?
