@@ -224,6 +224,13 @@ impl Plot {
             y0 = y0.min(*y);
             y1 = y1.max(*y);
         }
+        // A run index or a count on x: one tick per whole number (up to 20), none in between.
+        let whole_x = !self.x_log && data.iter().flatten().all(|(x, _)| x.fract() == 0.0);
+        let x_ticks = if whole_x && x1 - x0 <= 20.0 {
+            (x1 - x0) as usize + 1
+        } else {
+            10
+        };
         let (x0, x1) = padded_range(x0, x1, self.x_log);
         let (y0, y1) = padded_range(y0, y1, self.y_log);
         {
@@ -245,6 +252,7 @@ impl Plot {
                 .y_desc(self.y_label.as_str())
                 .axis_desc_style(("sans-serif", 16))
                 .label_style(("sans-serif", 13))
+                .x_labels(x_ticks)
                 .x_label_formatter(&x_fmt)
                 .y_label_formatter(&y_fmt)
                 .light_line_style(RGBColor(235, 235, 235))

@@ -59,6 +59,15 @@ const GROUP_TITLES: [(&str, &str); 8] = [
     ),
 ];
 
+/// A figure's name in its plot's legend: without the group's name where the figure starts with it
+/// (`contact_overlap_cold/tet` → `tet`), whole otherwise (`vtk_frame/polyhedra_box`).
+fn legend_label(figure: &str) -> String {
+    match figure.split_once('/') {
+        Some((head, tail)) if head == group(figure) => tail.to_string(),
+        _ => figure.to_string(),
+    }
+}
+
 fn title(group: &str) -> &'static str {
     GROUP_TITLES
         .iter()
@@ -140,7 +149,7 @@ pub fn write(out: &Path, history: &[Row], threshold: f64) -> Result<(), SuiteErr
         None => {
             let _ = writeln!(md, "No instruction counts recorded yet.\n");
         }
-        Some(latest) => counts_section(&mut md, out, &counts, &latest.key.clone())?,
+        Some(latest) => counts_section(&mut md, out, &counts, &latest.key.clone(), threshold)?,
     }
     let walls: Vec<&Row> = history
         .iter()
@@ -171,6 +180,7 @@ fn counts_section(
     out: &Path,
     counts: &[&Row],
     key: &MachineKey,
+    threshold: f64,
 ) -> Result<(), SuiteError> {
     let mine: Vec<&Row> = counts.iter().copied().filter(|r| &r.key == key).collect();
     let others = counts.len() - mine.len();
@@ -233,23 +243,28 @@ fn counts_section(
             );
             let first = values[0];
             series.push(Series {
-                label: figure
-                    .split_once('/')
-                    .map_or(figure.as_str(), |(_, s)| s)
-                    .to_string(),
+                label: legend_label(figure),
                 style: SeriesStyle::LinePoints,
                 points: track
                     .points
                     .iter()
-                    .map(|&(x, v)| (x as f64, v / first))
+                    .map(|&(x, v)| (x as f64, 100.0 * (v / first - 1.0)))
                     .collect(),
             });
         }
+        series.push(Series {
+            label: format!("+{:.0} % (gate, per step)", threshold * 100.0),
+            style: SeriesStyle::Line,
+            points: vec![
+                (1.0, 100.0 * threshold),
+                (commits.len() as f64, 100.0 * threshold),
+            ],
+        });
         let plot = Plot {
             name: g.to_string(),
             title: title(g).to_string(),
             x_label: "recorded commit (oldest to newest)".into(),
-            y_label: "instructions / first recorded".into(),
+            y_label: "instructions: change since the first record (%)".into(),
             x_log: false,
             y_log: false,
             series,
@@ -315,7 +330,7 @@ fn wall_section(
             .iter()
             .filter(|(f, _)| group(f) == g)
             .map(|(f, t)| Series {
-                label: f.split_once('/').map_or(f.as_str(), |(_, s)| s).to_string(),
+                label: legend_label(f),
                 style: SeriesStyle::LinePoints,
                 points: t.points.iter().map(|&(x, v)| (x as f64, v)).collect(),
             })
