@@ -22,7 +22,6 @@ pub mod host;
 pub mod io;
 pub mod law;
 pub mod math;
-pub mod rockfill;
 pub mod scene;
 pub mod shape;
 pub mod special_functions;

@@ -54,12 +54,12 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use polydem::math::{Point, Rotation, Vector};
-use polydem::rockfill::config::ExperimentConfig;
-use polydem::rockfill::experiment::{run_experiment_with, BedSource};
-use polydem::rockfill::penetration::{Outcome, PenetrationOptions};
 use polydem::scene::{load_scene, Simulation};
 use polydem::shape::Shape;
 use polydem::world::{ContactKey, ContactState, Parallelism, World};
+use polydem_rockfill::config::ExperimentConfig;
+use polydem_rockfill::experiment::{run_experiment_with, BedSource};
+use polydem_rockfill::penetration::{Outcome, PenetrationOptions};
 
 // ---------------------------------------------------------------------------------------------------------
 // The recorded values (see the module docs to regenerate).

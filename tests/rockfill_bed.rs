@@ -5,12 +5,12 @@
 //! its square.
 
 use polydem::math::{Point, Pose};
-use polydem::rockfill::bed::{has_checkpoint, load_bed_info};
-use polydem::rockfill::convergence::{run_convergence, ConvergenceParams, Sequence};
-use polydem::rockfill::experiment::{run_experiment_with, BedSource};
-use polydem::rockfill::penetration::{MonitorRow, PenetrationOptions};
-use polydem::rockfill::section::section_polygon;
-use polydem::rockfill::study::{run_study, StudyParams, StudyRun};
+use polydem_rockfill::bed::{has_checkpoint, load_bed_info};
+use polydem_rockfill::convergence::{run_convergence, ConvergenceParams, Sequence};
+use polydem_rockfill::experiment::{run_experiment_with, BedSource};
+use polydem_rockfill::penetration::{MonitorRow, PenetrationOptions};
+use polydem_rockfill::section::section_polygon;
+use polydem_rockfill::study::{run_study, StudyParams, StudyRun};
 
 #[path = "support/rockfill_small.rs"]
 mod rockfill_small;
@@ -91,7 +91,7 @@ fn penetration_from_the_saved_bed_equals_penetration_straight_after_packing() {
         "no note of the changed laws among {notes:?}"
     );
     let energy =
-        |r: &polydem::rockfill::experiment::ExperimentResult| r.penetration.projectile_energy_loss;
+        |r: &polydem_rockfill::experiment::ExperimentResult| r.penetration.projectile_energy_loss;
     assert!(
         energy(&stiff) != energy(&straight),
         "k_n x 4 from the saved bed: the projectile lost {} J, as with the bed's own laws ({} J): \
@@ -221,10 +221,10 @@ fn zy_section_of_a_cube_is_its_square() {
         .collect();
     let (cube, frame) = ConvexPolyhedron::from_points(&corners).unwrap();
     let config = small();
-    let mut world: World = polydem::rockfill::packing::empty_world(&config, 0.01).unwrap();
+    let mut world: World = polydem_rockfill::packing::empty_world(&config, 0.01).unwrap();
     // The principal frame of the hull composed with the placement, as the bed loader does.
     let pose = Pose::translation(1.0, 2.0, 3.0) * frame;
-    let body = polydem::rockfill::packing::body_for(&cube, &pose, config.rock.density).unwrap();
+    let body = polydem_rockfill::packing::body_for(&cube, &pose, config.rock.density).unwrap();
     let shape = world.add_shape(Shape::Polyhedron(std::sync::Arc::new(cube)));
     world.add_body("cube", shape, 0, body).unwrap();
     // Cut off-centre so that no vertex lies on the plane.

@@ -1,13 +1,13 @@
-//! The geometric pre-collapse of the loose rockfill sample (`src/rockfill/collapse.rs`): rocks are only
+//! The geometric pre-collapse of the loose rockfill sample (`crates/rockfill/src/collapse.rs`): rocks are only
 //! translated (shapes and orientations untouched), end inside the container, never move up, and no two rocks
 //! overlap afterwards under the exact SAT oracle; a pair generated at least the requested gap apart ends at
 //! least that gap apart.
 
 use polydem::contact::{sat_polyhedra, ContactKind};
 use polydem::math::Point;
-use polydem::rockfill::collapse::{collapse, CollapseParams};
-use polydem::rockfill::seeds::Region;
-use polydem::rockfill::{generate, GenerationParams};
+use polydem_rockfill::collapse::{collapse, CollapseParams};
+use polydem_rockfill::seeds::Region;
+use polydem_rockfill::{generate, GenerationParams};
 
 #[test]
 fn collapse_translates_rocks_down_without_any_overlap() {

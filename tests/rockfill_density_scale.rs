@@ -1,4 +1,4 @@
-//! Density (mass) scaling during packing (`[packing] packing_density_scale = s`, `src/rockfill/packing.rs`):
+//! Density (mass) scaling during packing (`[packing] packing_density_scale = s`, `crates/rockfill/src/packing.rs`):
 //! the rocks pack with density s ρ, so the packing Δt (∝ √(m/k), through both the contact time and the
 //! stability limit) grows by √s; after the hold the true masses and inertias are set again, bit for bit
 //! those of an unscaled bed, the energy change is booked in the ledger, and the penetration keeps its own
@@ -8,14 +8,12 @@
 mod support;
 
 use polydem::math::{Real, Vector};
-use polydem::rockfill::config::ExperimentConfig;
-use polydem::rockfill::experiment::generate_sample;
-use polydem::rockfill::packing::{
-    body_for, loose_world, pack, packing_time_step, set_rock_density,
-};
-use polydem::rockfill::penetration::penetration_time_step;
 use polydem::shape::Shape;
 use polydem::world::World;
+use polydem_rockfill::config::ExperimentConfig;
+use polydem_rockfill::experiment::generate_sample;
+use polydem_rockfill::packing::{body_for, loose_world, pack, packing_time_step, set_rock_density};
+use polydem_rockfill::penetration::penetration_time_step;
 use support::small;
 
 fn loose(config: &ExperimentConfig) -> World {

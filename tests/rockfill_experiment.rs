@@ -2,10 +2,10 @@
 //! closed to the measured level, the saved bed reloads to the same state, and the penetration run ends
 //! with the projectile through the layer, finite state and a closed ledger.
 
-use polydem::rockfill::experiment::{generate_sample, run_experiment, BedSource};
-use polydem::rockfill::packing::{load_bed, loose_world, pack, save_bed, KEPT_WALLS};
-use polydem::rockfill::penetration::Outcome;
 use polydem::shape::Shape;
+use polydem_rockfill::experiment::{generate_sample, run_experiment, BedSource};
+use polydem_rockfill::packing::{load_bed, loose_world, pack, save_bed, KEPT_WALLS};
+use polydem_rockfill::penetration::Outcome;
 
 #[path = "support/rockfill_small.rs"]
 mod rockfill_small;

@@ -3,13 +3,13 @@
 
 use polydem::contact::{sat_polyhedra, ContactKind};
 use polydem::math::Point;
-use polydem::rockfill::grading::{equivalent_diameter, grade_cells, SizeDistribution};
-use polydem::rockfill::seeds::{random_seeds, Region};
-use polydem::rockfill::spatial_order::morton_key;
-use polydem::rockfill::statistics::sample_statistics;
-use polydem::rockfill::voronoi::tessellate;
-use polydem::rockfill::{generate, GenerationParams};
 use polydem::shape::ConvexPolyhedron;
+use polydem_rockfill::grading::{equivalent_diameter, grade_cells, SizeDistribution};
+use polydem_rockfill::seeds::{random_seeds, Region};
+use polydem_rockfill::spatial_order::morton_key;
+use polydem_rockfill::statistics::sample_statistics;
+use polydem_rockfill::voronoi::tessellate;
+use polydem_rockfill::{generate, GenerationParams};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 
@@ -182,7 +182,7 @@ fn realised_sizes_follow_the_requested_distribution() {
 #[test]
 fn generated_rocks_are_numbered_along_the_z_order_curve() {
     // generate() numbers the rocks along the Z-order curve of their centres on a grid of the largest rock
-    // size from the region's corner (src/rockfill/spatial_order.rs): the keys never decrease.
+    // size from the region's corner (crates/rockfill/src/spatial_order.rs): the keys never decrease.
     let region = region();
     let params = GenerationParams::new(region, 0.1, 5);
     let sample = generate(&params).unwrap();

@@ -1,4 +1,4 @@
-//! The packing-procedure options of `[packing]` (`src/rockfill/packing.rs`): Cundall's local damping as a
+//! The packing-procedure options of `[packing]` (`crates/rockfill/src/packing.rs`): Cundall's local damping as a
 //! pure function and on a world (only rocks in contact are damped, the removed kinetic energy is booked in
 //! the ledger), the packing-only time step (the penetration keeps its own), and the drop speed.
 
@@ -6,13 +6,13 @@
 mod support;
 
 use polydem::math::{Real, Vector};
-use polydem::rockfill::config::{DepositionDamping, ExperimentConfig};
-use polydem::rockfill::experiment::generate_sample;
-use polydem::rockfill::packing::{
+use polydem_rockfill::config::{DepositionDamping, ExperimentConfig};
+use polydem_rockfill::experiment::generate_sample;
+use polydem_rockfill::packing::{
     apply_local_damping, local_damping, loose_world, pack, packing_time_step, rock_time_step,
     time_step_and_limit, PACKING_LIMIT_FRACTION,
 };
-use polydem::rockfill::penetration::penetration_time_step;
+use polydem_rockfill::penetration::penetration_time_step;
 use support::small;
 
 #[test]

@@ -2,8 +2,8 @@
 //! (solid − cavity) against closed forms.
 
 use polydem::math::{Point, Vector};
-use polydem::rockfill::projectile::{hollow_mass_properties, prism, Projectile, ProjectileParams};
 use polydem::shape::mass::polyhedron_mass_properties;
+use polydem_rockfill::projectile::{hollow_mass_properties, prism, Projectile, ProjectileParams};
 use std::f64::consts::PI;
 
 /// Area and polar second moment of area of a regular n-gon of circumradius r:

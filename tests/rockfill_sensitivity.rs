@@ -3,12 +3,12 @@
 //! each varied run is the run of the file with that one value changed, from the same bed, bit for bit,
 //! and the table and CSV hold one row per run.
 
-use polydem::rockfill::experiment::{run_experiment_with, BedSource};
-use polydem::rockfill::penetration::PenetrationOptions;
-use polydem::rockfill::sensitivity::{
+use polydem_rockfill::experiment::{run_experiment_with, BedSource};
+use polydem_rockfill::penetration::PenetrationOptions;
+use polydem_rockfill::sensitivity::{
     run_sensitivity, Parameter, SensitivityParams, SensitivityRun, Variation,
 };
-use polydem::rockfill::study::section_instants;
+use polydem_rockfill::study::section_instants;
 
 #[path = "support/rockfill_small.rs"]
 mod rockfill_small;
@@ -115,7 +115,7 @@ fn each_run_is_the_file_with_one_value_changed_from_the_same_bed() {
     assert_eq!(labels, ["base", "friction_0", "stiffness_factor_2"]);
 
     // The same runs made directly from the bed with the changed file.
-    let mut direct = |c: &polydem::rockfill::config::ExperimentConfig| {
+    let mut direct = |c: &polydem_rockfill::config::ExperimentConfig| {
         run_experiment_with(c, BedSource::Load(&bed), &options, &mut quiet)
             .unwrap()
             .penetration

@@ -10,8 +10,8 @@
 //! The fractions asleep and the speeds are printed; the quick variant's figures are in the docs
 //! (`docs/rockfill.md`, "Sleeping").
 
-use polydem::rockfill::experiment::{run_experiment_with, BedSource};
-use polydem::rockfill::penetration::PenetrationOptions;
+use polydem_rockfill::experiment::{run_experiment_with, BedSource};
+use polydem_rockfill::penetration::PenetrationOptions;
 
 #[path = "support/rockfill_small.rs"]
 mod rockfill_small;

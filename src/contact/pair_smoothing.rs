@@ -260,8 +260,8 @@ enum Found {
 /// the computed depths (exact value ≥ computed − ε ≥ depth(t) − ε ≥ L) and every vertex within 2h of it
 /// (exact value > max − 2h − ε ≥ L). So the collected maximum is the scan's `deepest` (and its smallest
 /// index the scan's `arg`), and the kept set is the scan's band, whatever vertex the climb stopped at:
-/// the climb only keeps the explored set small. Tested against the definition on random hulls, the
-/// ogive projectile and tied directions (`band_scan_and_walk_equal_the_definition_*`).
+/// the climb only keeps the explored set small. Tested against the definition on random hulls, a
+/// projectile-like body of revolution and tied directions (`band_scan_and_walk_equal_the_definition_*`).
 fn band_by_walk<P: Polytope + ?Sized>(
     p: &P,
     depth: &impl Fn(usize) -> Real,
@@ -766,8 +766,8 @@ mod tests {
 
     /// The shapes of the band-walk sweeps: every class of the oracle tests (boxes with exactly parallel
     /// faces, ellipsoid hulls of 8–64 points, Voronoi cells, plates, needles), hulls of points on an
-    /// integer grid (many exactly tied vertices along the axes and diagonals) and the paper's ogive
-    /// projectile (469 vertices, rings of 36 tied vertices along its axis).
+    /// integer grid (many exactly tied vertices along the axes and diagonals) and a body of revolution like
+    /// the rockfill's projectile ([`ringed_body`]: rings of 36 tied vertices along its axis).
     fn walk_shapes(rng: &mut rand_chacha::ChaCha8Rng) -> Vec<crate::shape::ConvexPolyhedron> {
         use crate::contact::tests_oracle::random_polyhedron;
         let mut shapes = Vec::new();
@@ -788,12 +788,23 @@ mod tests {
                 .collect();
             shapes.push(crate::shape::ConvexPolyhedron::from_points(&pts).unwrap().0);
         }
-        let projectile = crate::rockfill::projectile::Projectile::new(
-            crate::rockfill::projectile::ProjectileParams::paper(),
-        )
-        .unwrap();
-        shapes.push((*projectile.shape).clone());
+        shapes.push(ringed_body());
         shapes
+    }
+
+    /// A body of revolution like the rockfill's projectile: a conical nose on a cylinder, 13 rings of 36
+    /// vertices around the z axis and the tip (469 vertices; every ring's vertices tie on depth along z).
+    fn ringed_body() -> crate::shape::ConvexPolyhedron {
+        let mut pts = vec![Point::new(0.0, 0.0, 0.0)];
+        for ring in 1..=13 {
+            let z = 0.06 * ring as Real;
+            let radius = 0.075 * (ring as Real / 6.0).min(1.0);
+            for k in 0..36 {
+                let angle = std::f64::consts::TAU * k as Real / 36.0;
+                pts.push(Point::new(radius * angle.cos(), radius * angle.sin(), z));
+            }
+        }
+        crate::shape::ConvexPolyhedron::from_points(&pts).unwrap().0
     }
 
     /// The band as defined (two passes: the deepest depth, then every vertex within 2h of it, in index
@@ -909,7 +920,7 @@ mod tests {
     /// The smoothed overlap as computed in production (band walks on hulls of more than 16 vertices, early
     /// rejection of deep candidates, warm starts) equals the reference that scans every vertex of every face
     /// candidate, bit for bit, on random overlapping pairs of the shapes of [`walk_shapes`] (pairs with the
-    /// projectile included), with bands of 1e-4 and 1e-2 of the size (the larger one puts ties in the band
+    /// projectile-like body included), with bands of 1e-4 and 1e-2 of the size (the larger one puts ties in the band
     /// often), from random start vertices.
     #[test]
     fn smoothed_overlap_by_walks_and_early_rejection_equals_the_full_scan_on_random_pairs() {

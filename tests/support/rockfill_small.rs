@@ -1,8 +1,8 @@
 //! The small rockfill configuration shared by the rockfill tests (`tests/rockfill_*.rs`, included by path).
 
 use polydem::math::Real;
-use polydem::rockfill::config::ExperimentConfig;
 use polydem::world::World;
+use polydem_rockfill::config::ExperimentConfig;
 
 /// The quick variant cut to a 1.2 m × 0.6 m × 0.6 m layer (about 25 rocks of 290 mm), short hold and
 /// deposition, so that a whole experiment runs in about a second.

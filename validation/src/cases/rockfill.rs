@@ -1,4 +1,4 @@
-//! Rockfill (issue 6): the paper's experiment through `polydem::rockfill` — generation, packing, penetration.
+//! Rockfill (issue 6): the paper's experiment through `polydem_rockfill` — generation, packing, penetration.
 //!
 //! Checks that can fail: the realised size distribution against the law eq. 29 samples, the energy ledger of
 //! packing and of penetration, finite state, the projectile leaving the layer, and its residual velocity
@@ -9,11 +9,11 @@
 //! comparable). The section picture (paper Fig. 7) of the first seed goes into the case's folder.
 
 use polydem::math::Real;
-use polydem::rockfill::config::ExperimentConfig;
-use polydem::rockfill::convergence::{run_convergence, ConvergenceParams, Sequence};
-use polydem::rockfill::experiment::ExperimentResult;
-use polydem::rockfill::penetration::{MonitorRow, Outcome};
-use polydem::rockfill::study::run_one;
+use polydem_rockfill::config::ExperimentConfig;
+use polydem_rockfill::convergence::{run_convergence, ConvergenceParams, Sequence};
+use polydem_rockfill::experiment::ExperimentResult;
+use polydem_rockfill::penetration::{MonitorRow, Outcome};
+use polydem_rockfill::study::run_one;
 
 use crate::case::{Case, CaseData, Profile, Target};
 use crate::context::CaseContext;

@@ -20,12 +20,12 @@ use polydem::contact::{
 use polydem::io::checkpoint;
 use polydem::io::vtk::VtkWriter;
 use polydem::math::Pose;
-use polydem::rockfill::config::ExperimentConfig;
-use polydem::rockfill::experiment::{run_experiment_with, BedSource};
-use polydem::rockfill::penetration::PenetrationOptions;
 use polydem::scene::{load_scene, Simulation};
 use polydem::shape::ConvexPolyhedron;
 use polydem::world::{step, StepScratch};
+use polydem_rockfill::config::ExperimentConfig;
+use polydem_rockfill::experiment::{run_experiment_with, BedSource};
+use polydem_rockfill::penetration::PenetrationOptions;
 
 use crate::cases::contact::random_set;
 use crate::pairsets::{Intent, RandomSetSpec};

@@ -8,7 +8,7 @@
 //! - `box`: the ratio of the longest to the shortest edge of the principal-frame bounding box.
 
 use super::grading::Rock;
-use crate::math::Real;
+use polydem::math::Real;
 
 /// min / mean / max / standard deviation of a list of values.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -79,7 +79,7 @@ pub fn ellipsoid_aspect_ratio(rock: &Rock) -> Real {
 
 /// Longest / shortest edge of the principal-frame bounding box of a rock.
 pub fn box_aspect_ratio(rock: &Rock) -> Real {
-    let aabb = rock.shape.aabb(&crate::math::Pose::identity());
+    let aabb = rock.shape.aabb(&polydem::math::Pose::identity());
     let e = aabb.maxs - aabb.mins;
     e.max() / e.min()
 }

@@ -27,9 +27,9 @@ use rand::Rng;
 use rand_chacha::ChaCha8Rng;
 
 use super::voronoi::VoronoiCell;
-use crate::math::{Point, Pose, Real};
-use crate::shape::{ConvexPolyhedron, ShapeError};
-use crate::special_functions::gauss_legendre;
+use polydem::math::{Point, Pose, Real};
+use polydem::shape::{ConvexPolyhedron, ShapeError};
+use polydem::special_functions::gauss_legendre;
 
 /// Default σ / mean: the paper's ±10 % range taken as ±2σ.
 pub const DEFAULT_SIGMA_FRACTION: Real = 0.05;

@@ -12,7 +12,7 @@
 //!   a terminal, unless `--quiet`.
 //! - `polydem run --restart FILE --out DIR [--end-time T] ...`: continues a checkpoint bit for bit; into the
 //!   earlier run's directory it continues its CSV and VTK series (`polydem::io::csv_continue`).
-//! - `polydem rockfill [--full] [--out DIR] …`: the paper's rockfill experiment (`polydem::rockfill::cli`).
+//! - `polydem rockfill [--full] [--out DIR] …`: the paper's rockfill experiment (`polydem_rockfill::cli`).
 
 use std::fs::File;
 use std::io::{self, BufReader, BufWriter, Write};
@@ -49,14 +49,14 @@ enum Command {
     /// checkpoints, and a run summary.
     Run(RunArgs),
     /// The paper's rockfill penetration experiment (quick variant by default; see `--help`).
-    Rockfill(polydem::rockfill::cli::RockfillArgs),
+    Rockfill(polydem_rockfill::cli::RockfillArgs),
 }
 
 fn main() -> std::process::ExitCode {
     let result = match Cli::parse().command {
         Command::Contact { pairs, out } => contact(&pairs, out.as_deref()),
         Command::Run(args) => run(&args),
-        Command::Rockfill(args) => polydem::rockfill::cli::run(&args),
+        Command::Rockfill(args) => polydem_rockfill::cli::run(&args),
     };
     match result {
         Ok(()) => std::process::ExitCode::SUCCESS,

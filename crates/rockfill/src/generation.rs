@@ -13,7 +13,7 @@ use super::grading::{
 use super::seeds::{random_seeds, seed_count, Region, SeedError};
 use super::spatial_order::order_rocks_spatially;
 use super::voronoi::{tessellate, VoronoiError};
-use crate::math::Real;
+use polydem::math::Real;
 
 /// Default ratio of the mean cell's volume-equivalent diameter 2r (eq. 28) to the largest rock size.
 /// Poisson–Voronoi cell volumes follow a gamma law of shape ≈ 5.6 (coefficient of variation 0.42); with

@@ -23,7 +23,7 @@ use super::config::ExperimentConfig;
 use super::experiment::{run_experiment_with, BedSource};
 use super::penetration::PenetrationOptions;
 use super::study::{has_bed, run_one, write_monitors, StudyError};
-use crate::math::Real;
+use polydem::math::Real;
 
 /// What to run.
 #[derive(Clone, Debug)]

@@ -29,10 +29,10 @@
 
 use std::sync::Arc;
 
-use crate::dynamics::{BodyError, PrincipalInertia};
-use crate::math::{Matrix, Point, Pose, Real, Rotation, Vector};
-use crate::shape::mass::{polyhedron_mass_properties, MassProperties};
-use crate::shape::{ConvexPolyhedron, ShapeError};
+use polydem::dynamics::{BodyError, PrincipalInertia};
+use polydem::math::{Matrix, Point, Pose, Real, Rotation, Vector};
+use polydem::shape::mass::{polyhedron_mass_properties, MassProperties};
+use polydem::shape::{ConvexPolyhedron, ShapeError};
 
 /// Why a projectile could not be built.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]

@@ -19,9 +19,9 @@ use super::penetration::{
 use super::projectile::{Projectile, ProjectileError};
 use super::seeds::{Region, SeedError};
 use super::statistics::{sample_statistics, SampleStatistics};
-use crate::io::checkpoint::CheckpointError;
-use crate::math::{Point, Real};
-use crate::world::World;
+use polydem::io::checkpoint::CheckpointError;
+use polydem::math::{Point, Real};
+use polydem::world::World;
 
 /// Why the experiment failed.
 #[derive(Debug, thiserror::Error)]
@@ -123,7 +123,7 @@ fn apply_experiment_laws(
     progress: Progress,
 ) -> Result<(), ExperimentError> {
     for i in 0..world.bodies.len() {
-        if let crate::shape::Shape::Polyhedron(p) = world.shape(i) {
+        if let polydem::shape::Shape::Polyhedron(p) = world.shape(i) {
             let bed = world.bodies[i].mass / p.mass_properties().volume;
             if (bed - config.rock.density).abs() > 1e-9 * config.rock.density {
                 return Err(ExperimentError::BedDensity {

@@ -10,8 +10,8 @@
 use std::path::Path;
 
 use super::projectile::ProjectileParams;
-use crate::law::{ContactModel, DampingLaw, LawError, NormalLaw, TangentialLaw};
-use crate::math::Real;
+use polydem::law::{ContactModel, DampingLaw, LawError, NormalLaw, TangentialLaw};
+use polydem::math::Real;
 
 /// Why a configuration was refused.
 #[derive(Debug, thiserror::Error)]
@@ -158,7 +158,7 @@ pub struct ImpactParams {
     pub disturbed_threshold: Real,
 }
 
-/// Sleeping in the experiment's runs ([`crate::world::sleeping`]): a numerical device, not a physical
+/// Sleeping in the experiment's runs ([`polydem::world::sleeping`]): a numerical device, not a physical
 /// parameter, so the section and each of its keys may be left out; the defaults are the engine's thresholds
 /// and sleeping off, which reproduces the runs made before sleeping existed.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Deserialize, serde::Serialize)]
@@ -171,13 +171,13 @@ pub struct SleepingConfig {
     /// Packing: rocks at rest fall asleep during deposition and hold (the moving top wall wakes the rocks
     /// it touches, and their neighbours through their loads).
     pub packing: bool,
-    /// [`crate::world::SleepParams::rest_speed`] (fraction of √(|g| d)).
+    /// [`polydem::world::SleepParams::rest_speed`] (fraction of √(|g| d)).
     pub rest_speed: Real,
-    /// [`crate::world::SleepParams::rest_force`] (fraction of the weight).
+    /// [`polydem::world::SleepParams::rest_force`] (fraction of the weight).
     pub rest_force: Real,
-    /// [`crate::world::SleepParams::steps`].
+    /// [`polydem::world::SleepParams::steps`].
     pub steps: u32,
-    /// [`crate::world::SleepParams::wake_contact_fraction`]: in a compacted bed every contact carries many
+    /// [`polydem::world::SleepParams::wake_contact_fraction`]: in a compacted bed every contact carries many
     /// rock weights, so a threshold of a fraction of the weight is a fraction of a per mille of the contact
     /// forces, and the explicit step's one-contact-per-step precursor of any disturbance then wakes the whole
     /// bed within tens of steps.
@@ -186,7 +186,7 @@ pub struct SleepingConfig {
 
 impl Default for SleepingConfig {
     fn default() -> Self {
-        let engine = crate::world::SleepParams::default();
+        let engine = polydem::world::SleepParams::default();
         Self {
             penetration: false,
             packing: false,
@@ -200,8 +200,8 @@ impl Default for SleepingConfig {
 
 impl SleepingConfig {
     /// The engine's sleeping parameters, on when `enabled`.
-    pub fn params(&self, enabled: bool) -> crate::world::SleepParams {
-        crate::world::SleepParams {
+    pub fn params(&self, enabled: bool) -> polydem::world::SleepParams {
+        polydem::world::SleepParams {
             enabled,
             rest_speed: self.rest_speed,
             rest_force: self.rest_force,
@@ -227,9 +227,9 @@ pub struct ExperimentConfig {
 }
 
 /// The full-scale experiment (the file `scenes/rockfill/paper.toml`, compiled in).
-pub const PAPER_TOML: &str = include_str!("../../scenes/rockfill/paper.toml");
+pub const PAPER_TOML: &str = include_str!("../../../scenes/rockfill/paper.toml");
 /// The quick variant (the file `scenes/rockfill/quick.toml`, compiled in).
-pub const QUICK_TOML: &str = include_str!("../../scenes/rockfill/quick.toml");
+pub const QUICK_TOML: &str = include_str!("../../../scenes/rockfill/quick.toml");
 
 /// The contact models of the experiment.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -14,7 +14,7 @@
 //! (closed form from A's vertex box) and the rocks whose boxes meet A's box swept along the move, found in a
 //! uniform (x, y) grid. For a rock B the first contact is found by **conservative advancement**: with the gap
 //! d between A and B and the unit normal n from A to B of their closest points (GJK distance query,
-//! [`crate::contact::query_polyhedra`]), the plane normal to n through the gap separates the two bodies as long
+//! [`polydem::contact::query_polyhedra`]), the plane normal to n through the gap separates the two bodies as long
 //! as A has moved by less than d / (v·n); if v·n ≤ 0 that plane separates A from B along the whole move, so B
 //! never blocks it. Advancing by (d − gap_AB) / (v·n) at a time leaves the pair at least gap_AB apart after
 //! every advance, so no state the collapse produces overlaps (`tests/rockfill_collapse.rs` checks every pair
@@ -39,9 +39,9 @@
 use std::time::{Duration, Instant};
 
 use super::grading::Rock;
-use crate::contact::{query_polyhedra, ContactKind};
-use crate::math::{Pose, Real, Vector};
-use crate::shape::Aabb;
+use polydem::contact::{query_polyhedra, ContactKind};
+use polydem::math::{Pose, Real, Vector};
+use polydem::shape::Aabb;
 
 /// Largest number of conservative-advancement steps for one pair and move. Each step removes the part of the
 /// gap that lies along the move; a pair passing each other at a grazing angle converges slowest. A capped pair

@@ -30,7 +30,7 @@ use super::config::ExperimentConfig;
 use super::experiment::{run_experiment_with, BedSource, ExperimentError, ExperimentResult};
 use super::penetration::{MonitorRow, Outcome, PenetrationOptions};
 use super::section::{draw_sections, SectionError, SectionPicture};
-use crate::math::Real;
+use polydem::math::Real;
 
 /// Why the study failed.
 #[derive(Debug, thiserror::Error)]

@@ -47,7 +47,7 @@
 //! # Time step
 //! Δt = t_c / N with t_c = π √(m*/k_n) for the lightest rock pair (m* = m_min/2, the shortest contact of the
 //! linear law) and N = `steps_per_contact`; it is checked against the stability limit of
-//! [`crate::scene::time_step::contact_time_and_limit`]. Both are computed from the world's masses, so with
+//! [`polydem::scene::time_step::contact_time_and_limit`]. Both are computed from the world's masses, so with
 //! `packing_density_scale` = s the packing's Δt is √s times the unscaled one and the restore stage's Δt is
 //! the unscaled one.
 //!
@@ -67,11 +67,11 @@ use std::time::{Duration, Instant};
 use super::collapse::CollapseReport;
 use super::config::{ConfigError, DepositionDamping, ExperimentConfig};
 use super::grading::Rock;
-use crate::dynamics::{BodyError, PrincipalInertia, RigidBody, ViscousDamping};
-use crate::math::{Point, Pose, Real, Rotation, Vector};
-use crate::scene::time_step::{contact_time_and_limit, PairEstimate};
-use crate::shape::{ConvexPolyhedron, Plane, Shape, ShapeError};
-use crate::world::{
+use polydem::dynamics::{BodyError, PrincipalInertia, RigidBody, ViscousDamping};
+use polydem::math::{Point, Pose, Real, Rotation, Vector};
+use polydem::scene::time_step::{contact_time_and_limit, PairEstimate};
+use polydem::shape::{ConvexPolyhedron, Plane, Shape, ShapeError};
+use polydem::world::{
     step, MaterialTable, StepCounters, StepError, StepParams, StepScratch, Wall, World, WorldError,
 };
 
@@ -219,7 +219,7 @@ pub fn rock_time_step(
 }
 
 /// The packing's Δt may not exceed this fraction of the stability limit 2/ω_max (see
-/// [`crate::scene::time_step`]): the limit is a bound at the edge of stability, and the packing keeps a margin.
+/// [`polydem::scene::time_step`]): the limit is a bound at the edge of stability, and the packing keeps a margin.
 pub const PACKING_LIMIT_FRACTION: Real = 0.8;
 
 /// The packing's Δt: t_c,min / `steps_per_contact`, or, when `packing_steps_per_contact` = N is given,

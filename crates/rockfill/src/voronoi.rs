@@ -12,7 +12,7 @@
 use voro_rs::prelude::*;
 
 use super::seeds::Region;
-use crate::math::{Point, Real};
+use polydem::math::{Point, Real};
 
 /// Why a tessellation failed.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]

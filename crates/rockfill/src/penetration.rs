@@ -24,10 +24,10 @@ use std::time::{Duration, Instant};
 use super::config::ExperimentConfig;
 use super::packing::{rock_time_step, top_wall_height, PackingError, KEPT_WALLS, STEEL};
 use super::projectile::Projectile;
-use crate::dynamics::{Motion, RigidBody, ViscousDamping};
-use crate::math::{Point, Pose, Real, Vector};
-use crate::shape::Shape;
-use crate::world::{
+use polydem::dynamics::{Motion, RigidBody, ViscousDamping};
+use polydem::math::{Point, Pose, Real, Vector};
+use polydem::shape::Shape;
+use polydem::world::{
     sleeping, step, ContactKey, EnergyLedger, StepCounters, StepError, StepParams, StepScratch,
     World, WorldError,
 };
@@ -269,7 +269,7 @@ pub fn add_projectile(
     }
     if config.sleeping.penetration {
         // The packed bed is at rest: every rock falls asleep against the walls it was packed in, so that
-        // removing the left and right walls wakes the rocks they held (see `crate::world::sleeping`).
+        // removing the left and right walls wakes the rocks they held (see `polydem::world::sleeping`).
         sleeping::put_to_sleep(&config.sleeping.params(true), world, 0..world.bodies.len());
     }
     world.walls.truncate(KEPT_WALLS);

@@ -1,4 +1,4 @@
-//! The packed bed as an engine checkpoint (`bed.pdck`, format of [`crate::io::checkpoint`]), so that every
+//! The packed bed as an engine checkpoint (`bed.pdck`, format of [`polydem::io::checkpoint`]), so that every
 //! penetration run of a study starts from the same packed state.
 //!
 //! # Why the checkpoint and not only the CSV files
@@ -19,11 +19,11 @@ use std::path::Path;
 use std::time::Duration;
 
 use super::packing::PackingReport;
-use crate::io::checkpoint::{self, CheckpointError};
-use crate::math::{Pose, Real};
-use crate::scene::time_step::TimeStepInfo;
-use crate::scene::Simulation;
-use crate::world::{StepParams, World};
+use polydem::io::checkpoint::{self, CheckpointError};
+use polydem::math::{Pose, Real};
+use polydem::scene::time_step::TimeStepInfo;
+use polydem::scene::Simulation;
+use polydem::world::{StepParams, World};
 
 /// The checkpoint's file name inside a bed directory.
 pub const BED_CHECKPOINT: &str = "bed.pdck";

@@ -20,7 +20,7 @@ use std::path::PathBuf;
 
 use super::config::ExperimentConfig;
 use super::study::{csv_text, has_bed, run_one, StudyError, StudyRun};
-use crate::math::Real;
+use polydem::math::Real;
 
 /// A contact parameter the driver can vary.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -13,9 +13,9 @@ use std::path::Path;
 use plotters::prelude::*;
 
 use super::penetration::Snapshot;
-use crate::math::{Point, Pose, Real};
-use crate::shape::Shape;
-use crate::world::World;
+use polydem::math::{Point, Pose, Real};
+use polydem::shape::Shape;
+use polydem::world::World;
 
 /// Why a picture could not be drawn.
 #[derive(Debug, thiserror::Error)]

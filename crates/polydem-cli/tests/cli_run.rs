@@ -13,7 +13,8 @@ fn out_dir(case: &str) -> std::path::PathBuf {
 
 #[test]
 fn run_writes_the_documented_csv_files_and_summary() {
-    let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/two_polyhedra_elastic.toml");
+    let scene = Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../.."))
+        .join("scenes/two_polyhedra_elastic.toml");
     let out = out_dir("two_body");
     let output = Command::new(env!("CARGO_BIN_EXE_polydem"))
         .arg("run")
@@ -115,7 +116,7 @@ fn succeeds(args: &[&std::ffi::OsStr]) -> std::process::Output {
 }
 
 fn scene_path(name: &str) -> std::path::PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
+    Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../.."))
         .join("scenes")
         .join(name)
 }

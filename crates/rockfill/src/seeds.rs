@@ -9,7 +9,7 @@
 use rand::Rng;
 use rand_chacha::ChaCha8Rng;
 
-use crate::math::{Point, Real, Vector};
+use polydem::math::{Point, Real, Vector};
 
 /// Why a region or a seed count was refused.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]

@@ -13,7 +13,7 @@
 use std::sync::Arc;
 
 use super::grading::Rock;
-use crate::math::{Point, Real};
+use polydem::math::{Point, Real};
 
 /// Bits per axis of the Z-order key (2²¹ cells per axis: far beyond any sample here).
 const BITS: u32 = 21;
