@@ -54,7 +54,7 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use polydem::math::{Point, Rotation, Vector};
-use polydem::scene::{load_scene, Simulation};
+use polydem::scene::{load_scene, RunObserver, Simulation, StepPath};
 use polydem::shape::Shape;
 use polydem::world::{ContactKey, ContactState, Parallelism, World};
 use polydem_rockfill::config::ExperimentConfig;
@@ -287,9 +287,11 @@ fn rockfill_quick_penetration_bits_are_pinned() {
     }
 }
 
-/// A sphere-bed scene, with the projectile in contact with the bed at the end.
+/// A sphere-bed scene, with the projectile in contact with the bed at the end; run again with the energy
+/// ledger off through [`Simulation::run_observed`], where the pipeline takes the flat sphere layout.
 fn sphere_bed(scene: &'static str, steps: u64, expected: &Pin) {
     let world = run_scene(scene, steps, expected);
+    run_scene_flat(scene, steps, expected);
     let projectile = world
         .names
         .iter()
@@ -353,6 +355,71 @@ fn run_scene(name: &'static str, steps: u64, expected: &Pin) -> World {
         kept.get_or_insert(sim.world);
     }
     kept.expect("at least one variant ran")
+}
+
+/// An observer that reads the state every `every` steps (and at the last), as `polydem run`'s outputs do.
+struct Every {
+    every: u64,
+    observed: u64,
+}
+
+impl RunObserver for Every {
+    fn wants_state(&self, step: u64) -> bool {
+        step.is_multiple_of(self.every)
+    }
+    fn observe(&mut self, _: &Simulation, _: u64) -> std::io::Result<()> {
+        self.observed += 1;
+        Ok(())
+    }
+}
+
+/// Runs scene `name` with `energy_ledger = false` through [`Simulation::run_observed`] (state read every
+/// 100 steps), on one thread and on two: the pipeline must take the flat sphere layout and end on the
+/// pinned bits. The ledger books energy only (bodies, forces and contact state are the same bits without
+/// it). Not compared: `candidates` and `state`, which hash every store entry, the separated candidate pairs
+/// too: which separated pairs are listed is the broad phase's bookkeeping, and the flat layout keeps lists
+/// of its own (the store it writes back lists its pairs). Every physical group is compared.
+fn run_scene_flat(name: &'static str, steps: u64, expected: &Pin) {
+    let path = root().join("scenes").join(format!("{name}.toml"));
+    let run = Run { name, steps };
+    let mut first = None;
+    for threads in [Threads::One, Threads::Two] {
+        let mut sim = load_scene(&path)
+            .unwrap_or_else(|e| panic!("{}: the scene does not load: {e}", path.display()));
+        sim.steps = steps;
+        sim.params.energy_ledger = false;
+        let start = Instant::now();
+        let (sim, observed) = threads.install(move || {
+            let mut observer = Every {
+                every: 100,
+                observed: 0,
+            };
+            let summary = sim
+                .run_observed(&mut observer)
+                .unwrap_or_else(|e| panic!("{name}: the run failed: {e}"));
+            assert_eq!(summary.steps, steps, "{name}: steps run");
+            assert_eq!(
+                summary.path,
+                StepPath::FlatSpheres,
+                "{name}, ledger off, run_observed: the pipeline must take the flat sphere layout"
+            );
+            (sim, observer.observed)
+        });
+        assert_eq!(
+            observed,
+            1 + steps / 100 + u64::from(!steps.is_multiple_of(100)),
+            "{name}: observed at the start, every 100 steps and at the last"
+        );
+        let mut measured = Pin::of(&sim.world);
+        println!(
+            "// {name} after {steps} steps, {}, ledger off, flat sphere layout: {:.2} s",
+            threads.label(),
+            start.elapsed().as_secs_f64()
+        );
+        measured.candidates = expected.candidates;
+        measured.state = expected.state;
+        check(&run, threads, &measured, &sim.world, expected, &mut first);
+    }
 }
 
 // ---------------------------------------------------------------------------------------------------------

@@ -13,5 +13,5 @@ pub mod schema;
 pub mod time_step;
 
 pub use build::{load_scene, parse_scene, SceneError, Simulation};
-pub use run::{EndTimeError, RunError, RunSummary};
+pub use run::{EndTimeError, RunError, RunObserver, RunSummary, StepPath, PROGRESS_STEPS};
 pub use time_step::TimeStepInfo;

@@ -1,12 +1,49 @@
 //! Running a [`Simulation`] to its end time: the step loop, with output at fixed step intervals handed to
 //! an observer (the step itself never writes anything).
+//!
+//! Two forms: [`Simulation::run`] hands the simulation to a closure after every step, so it keeps the
+//! world current and takes the general step; [`Simulation::run_observed`] asks a [`RunObserver`] at which
+//! steps it reads the state, and between those the pipeline chooses how to step. A world of free spheres
+//! (every body a dynamic sphere of equal principal moments, no sleeping, no global damping, the energy
+//! ledger off) then runs on the flat sphere layout ([`SphereSim`]: struct-of-arrays, half neighbour
+//! lists, the thread team), the same bits as the general step, written back into the world wherever the
+//! observer reads it.
 
+use std::ops::ControlFlow;
 use std::time::{Duration, Instant};
 
 use crate::math::Real;
-use crate::world::{step, StepCounters, StepError, StepScratch};
+use crate::world::{
+    step, SphereSim, StepCounters, StepError, StepFlatError, StepReport, StepScratch,
+};
 
 use super::Simulation;
+
+/// What a run hands the state to: outputs, frames, checkpoints, progress.
+pub trait RunObserver {
+    /// Whether the observer reads the state after step `step` (counted from step 0). The run keeps the
+    /// world current at these steps only.
+    fn wants_state(&self, step: u64) -> bool;
+    /// Called with the simulation after each step `step` for which [`Self::wants_state`] holds, and at
+    /// the start with the step the run starts from.
+    fn observe(&mut self, sim: &Simulation, step: u64) -> std::io::Result<()>;
+    /// Called with the number of steps done (from step 0) at least every [`PROGRESS_STEPS`] steps and
+    /// at every observed step; it sees no state.
+    fn progress(&mut self, _step: u64) {}
+}
+
+/// The longest stretch of steps between two calls of [`RunObserver::progress`].
+pub const PROGRESS_STEPS: u64 = 64;
+
+/// How a run was stepped.
+#[derive(Copy, Clone, Debug, PartialEq, Eq, Default)]
+pub enum StepPath {
+    /// The general step ([`crate::world::step`]).
+    #[default]
+    General,
+    /// The flat sphere layout ([`SphereSim`]).
+    FlatSpheres,
+}
 
 /// Why a run stopped early.
 #[derive(Debug, thiserror::Error)]
@@ -28,6 +65,20 @@ pub struct RunSummary {
     /// Steps that reported a contact deeper than the warning fraction, and the first such step.
     pub steps_with_deep_overlap: u64,
     pub first_deep_overlap_step: Option<u64>,
+    /// The path the steps took.
+    pub path: StepPath,
+}
+
+impl RunSummary {
+    /// Books one step's report (the world's step index after it is `step_index`).
+    fn add(&mut self, report: &StepReport, step_index: u64) {
+        self.counters.merge(&report.counters);
+        self.max_overlap_ratio = self.max_overlap_ratio.max(report.max_overlap_ratio);
+        if !report.overlap_warnings.is_empty() {
+            self.steps_with_deep_overlap += 1;
+            self.first_deep_overlap_step.get_or_insert(step_index);
+        }
+    }
 }
 
 impl Simulation {
@@ -48,14 +99,7 @@ impl Simulation {
         on_output(self)?;
         for n in first..=self.steps {
             let report = step(&self.params, &mut self.world, &mut scratch)?;
-            summary.counters.merge(&report.counters);
-            summary.max_overlap_ratio = summary.max_overlap_ratio.max(report.max_overlap_ratio);
-            if !report.overlap_warnings.is_empty() {
-                summary.steps_with_deep_overlap += 1;
-                summary
-                    .first_deep_overlap_step
-                    .get_or_insert(self.world.step_index);
-            }
+            summary.add(&report, self.world.step_index);
             if n % self.output_every == 0 || n == self.steps {
                 on_output(self)?;
             }
@@ -68,6 +112,83 @@ impl Simulation {
 }
 
 impl Simulation {
+    /// Runs the remaining steps (as [`Self::run`]) and hands the state to `observer` at the steps it
+    /// asks for; the pipeline chooses how to step in between (see the module docs). The result is the
+    /// same bits as [`Self::run`] whichever path runs.
+    pub fn run_observed(
+        &mut self,
+        observer: &mut impl RunObserver,
+    ) -> Result<RunSummary, RunError> {
+        let start = Instant::now();
+        let first = self.world.step_index;
+        observer.observe(self, first)?;
+        observer.progress(first);
+        let mut summary = match SphereSim::from_world(&self.world, &self.params) {
+            Ok(flat) => self.run_flat(flat, observer)?,
+            Err(StepFlatError::NotSphereOnly(_)) => self.run_general(observer)?,
+            Err(StepFlatError::Step(e)) => return Err(e.into()),
+        };
+        summary.steps = self.world.step_index - first;
+        summary.wall_time = start.elapsed();
+        Ok(summary)
+    }
+
+    /// The step after `done` up to which a stretch runs: the next step the observer reads, at most
+    /// [`PROGRESS_STEPS`] on, at most the last.
+    fn stretch_end(&self, done: u64, observer: &impl RunObserver) -> u64 {
+        let last = self.steps.min(done + PROGRESS_STEPS);
+        (done + 1..last)
+            .find(|&n| observer.wants_state(n))
+            .unwrap_or(last)
+    }
+
+    fn run_general(&mut self, observer: &mut impl RunObserver) -> Result<RunSummary, RunError> {
+        let mut scratch = StepScratch::default();
+        let mut summary = RunSummary::default();
+        while self.world.step_index < self.steps {
+            let end = self.stretch_end(self.world.step_index, observer);
+            while self.world.step_index < end {
+                let report = step(&self.params, &mut self.world, &mut scratch)?;
+                summary.add(&report, self.world.step_index);
+            }
+            self.after_stretch(observer, end)?;
+        }
+        Ok(summary)
+    }
+
+    fn run_flat(
+        &mut self,
+        mut flat: SphereSim,
+        observer: &mut impl RunObserver,
+    ) -> Result<RunSummary, RunError> {
+        let mut summary = RunSummary {
+            path: StepPath::FlatSpheres,
+            ..RunSummary::default()
+        };
+        while flat.step_index() < self.steps {
+            let end = self.stretch_end(flat.step_index(), observer);
+            let wanted = end - flat.step_index();
+            let done = flat.run_steps(wanted, |sim, report| {
+                summary.add(report, sim.step_index());
+                ControlFlow::Continue(())
+            })?;
+            debug_assert_eq!(done, wanted);
+            if observer.wants_state(end) || end == self.steps {
+                flat.write_back(&mut self.world);
+            }
+            self.after_stretch(observer, end)?;
+        }
+        Ok(summary)
+    }
+
+    fn after_stretch(&self, observer: &mut impl RunObserver, end: u64) -> Result<(), RunError> {
+        if observer.wants_state(end) || end == self.steps {
+            observer.observe(self, end)?;
+        }
+        observer.progress(end);
+        Ok(())
+    }
+
     /// Moves the end of the run to `end_time` (s), e.g. to continue a restored checkpoint further: the run
     /// then covers ⌈end_time / Δt⌉ steps in total (counted from step 0, as the scene's own end time is).
     pub fn set_end_time(&mut self, end_time: Real) -> Result<(), EndTimeError> {
@@ -112,9 +233,13 @@ impl std::fmt::Display for RunSummary {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         writeln!(
             f,
-            "steps {}, wall time {:.3} s",
+            "steps {}, wall time {:.3} s, {}",
             self.steps,
-            self.wall_time.as_secs_f64()
+            self.wall_time.as_secs_f64(),
+            match self.path {
+                StepPath::General => "general step",
+                StepPath::FlatSpheres => "flat sphere layout",
+            }
         )?;
         writeln!(
             f,

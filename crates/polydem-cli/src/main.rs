@@ -149,12 +149,9 @@ fn every_steps(flag: &str, interval: Option<f64>, dt: f64) -> Result<Option<u64>
 }
 
 fn run(args: &RunArgs) -> Result<()> {
-    use polydem::io::run_summary::{
-        summary_json, summary_text, CheckpointRecord, OutputRecord, RunOrigin,
-    };
+    use polydem::io::run_summary::{summary_json, summary_text, OutputRecord, RunOrigin};
     use polydem::io::vtk::{VtkCompression, VtkEncoding, VtkFormat, VtkPrecision, VtkWriter};
     use polydem::io::{checkpoint, csv_output};
-    use std::time::Instant;
 
     let (mut sim, source, restarted) = match (&args.restart, &args.scene) {
         (Some(file), _) => {
@@ -202,9 +199,9 @@ fn run(args: &RunArgs) -> Result<()> {
         writeln!(out, "{header}")?;
         Ok(out)
     };
-    let mut bodies = series("bodies.csv", csv_output::BODIES_HEADER)?;
-    let mut energy = series("energy.csv", polydem::world::EnergyReport::CSV_HEADER)?;
-    let mut walls = series("walls.csv", csv_output::WALLS_HEADER)?;
+    let bodies = series("bodies.csv", csv_output::BODIES_HEADER)?;
+    let energy = series("energy.csv", polydem::world::EnergyReport::CSV_HEADER)?;
+    let walls = series("walls.csv", csv_output::WALLS_HEADER)?;
     let encoding = VtkEncoding {
         format: if args.vtk_ascii {
             VtkFormat::Ascii
@@ -222,7 +219,7 @@ fn run(args: &RunArgs) -> Result<()> {
             VtkCompression::Zlib
         },
     };
-    let mut vtk = match vtk_every {
+    let vtk = match vtk_every {
         // A restart continues the series the earlier run left in the same directory.
         Some(_) if restarted => Some(
             VtkWriter::resume(out_dir, &sim.world, encoding).with_context(|| {
@@ -286,86 +283,29 @@ fn run(args: &RunArgs) -> Result<()> {
         ),
     );
 
-    let mut record = OutputRecord {
+    let mut outputs = RunOutputs {
+        out_dir: out_dir.to_owned(),
+        bodies,
+        energy,
+        walls,
+        vtk,
         csv_every: sim.output_every,
         vtk_every,
         checkpoint_every,
-        ..OutputRecord::default()
+        start_step: origin.start_step,
+        last_step: sim.steps,
+        bar,
+        record: OutputRecord {
+            csv_every: sim.output_every,
+            vtk_every,
+            checkpoint_every,
+            ..OutputRecord::default()
+        },
     };
-    let last_step = sim.steps;
-    let start_step = origin.start_step;
-    let output_time = std::cell::Cell::new(std::time::Duration::ZERO);
-    let mut vtk_time = std::time::Duration::ZERO;
-    let mut checkpoint_time = std::time::Duration::ZERO;
-    let mut checkpoints = Vec::new();
-    let mut write_vtk =
-        |vtk: &mut Option<VtkWriter>, s: &polydem::scene::Simulation| -> io::Result<()> {
-            if let Some(v) = vtk.as_mut() {
-                let t = Instant::now();
-                v.write_frame(&s.world)?;
-                vtk_time += t.elapsed();
-            }
-            Ok(())
-        };
-    let t0 = Instant::now();
-    write_vtk(&mut vtk, &sim)
-        .with_context(|| format!("writing VTK frames in {}", out_dir.display()))?;
-    output_time.set(output_time.get() + t0.elapsed());
     let summary = sim
-        .run(
-            |s| {
-                let t = Instant::now();
-                csv_output::write_bodies_rows(&mut bodies, s)?;
-                csv_output::write_walls_rows(&mut walls, s)?;
-                csv_output::write_energy_row(&mut energy, s)?;
-                output_time.set(output_time.get() + t.elapsed());
-                Ok(())
-            },
-            |s, n| {
-                if (n - start_step).is_multiple_of(16) || n == last_step {
-                    bar.set_position(n - start_step);
-                }
-                let t = Instant::now();
-                if vtk_every.is_some_and(|k| n.is_multiple_of(k)) || n == last_step {
-                    write_vtk(&mut vtk, s)?;
-                }
-                if checkpoint_every.is_some_and(|k| n.is_multiple_of(k) || n == last_step) {
-                    let tc = Instant::now();
-                    let file = format!("checkpoints/step_{n:09}.pdck");
-                    let bytes =
-                        checkpoint::save(&out_dir.join(&file), s).map_err(io::Error::other)?;
-                    let seconds = tc.elapsed();
-                    checkpoint_time += seconds;
-                    checkpoints.push(CheckpointRecord {
-                        file,
-                        step: n,
-                        time: s.world.time,
-                        bytes,
-                        seconds: seconds.as_secs_f64(),
-                    });
-                }
-                output_time.set(output_time.get() + t.elapsed());
-                Ok(())
-            },
-        )
+        .run_observed(&mut outputs)
         .with_context(|| format!("running {}", origin.source))?;
-    bar.finish_and_clear();
-    for (name, w) in [
-        ("bodies.csv", &mut bodies),
-        ("energy.csv", &mut energy),
-        ("walls.csv", &mut walls),
-    ] {
-        w.flush()
-            .with_context(|| format!("writing {}", out_dir.join(name).display()))?;
-    }
-    record.time = output_time.get();
-    record.vtk_time = vtk_time;
-    record.checkpoint_time = checkpoint_time;
-    record.checkpoints = checkpoints;
-    if let Some(v) = &vtk {
-        record.vtk_frames = v.frames_written;
-        record.vtk_bytes = v.bytes_written;
-    }
+    let record = outputs.finish()?;
 
     let text = summary_text(&origin, &sim, &summary, &record);
     print!("{text}");
@@ -380,4 +320,110 @@ fn run(args: &RunArgs) -> Result<()> {
         &(serde_json::to_string_pretty(&json)? + "\n"),
     )?;
     Ok(())
+}
+
+/// The outputs of `polydem run`: the CSV series, VTK frames, checkpoints and the progress bar, handed the
+/// state by the run at the steps they need (so that the pipeline may step on a layout of its own in
+/// between).
+struct RunOutputs {
+    out_dir: std::path::PathBuf,
+    bodies: BufWriter<File>,
+    energy: BufWriter<File>,
+    walls: BufWriter<File>,
+    vtk: Option<polydem::io::vtk::VtkWriter>,
+    csv_every: u64,
+    vtk_every: Option<u64>,
+    checkpoint_every: Option<u64>,
+    start_step: u64,
+    last_step: u64,
+    bar: indicatif::ProgressBar,
+    record: polydem::io::run_summary::OutputRecord,
+}
+
+impl RunOutputs {
+    fn csv_at(&self, n: u64) -> bool {
+        n.is_multiple_of(self.csv_every) || n == self.last_step
+    }
+    fn vtk_at(&self, n: u64) -> bool {
+        self.vtk.is_some()
+            && (n == self.start_step
+                || self.vtk_every.is_some_and(|k| n.is_multiple_of(k))
+                || n == self.last_step)
+    }
+    fn checkpoint_at(&self, n: u64) -> bool {
+        n != self.start_step
+            && self
+                .checkpoint_every
+                .is_some_and(|k| n.is_multiple_of(k) || n == self.last_step)
+    }
+
+    fn write_checkpoint(&mut self, s: &polydem::scene::Simulation, n: u64) -> io::Result<()> {
+        let start = std::time::Instant::now();
+        let file = format!("checkpoints/step_{n:09}.pdck");
+        let bytes = polydem::io::checkpoint::save(&self.out_dir.join(&file), s)
+            .map_err(io::Error::other)?;
+        let seconds = start.elapsed();
+        self.record.checkpoint_time += seconds;
+        self.record
+            .checkpoints
+            .push(polydem::io::run_summary::CheckpointRecord {
+                file,
+                step: n,
+                time: s.world.time,
+                bytes,
+                seconds: seconds.as_secs_f64(),
+            });
+        Ok(())
+    }
+
+    /// Flushes the CSV series and returns what was written.
+    fn finish(mut self) -> Result<polydem::io::run_summary::OutputRecord> {
+        self.bar.finish_and_clear();
+        for (name, w) in [
+            ("bodies.csv", &mut self.bodies),
+            ("energy.csv", &mut self.energy),
+            ("walls.csv", &mut self.walls),
+        ] {
+            w.flush()
+                .with_context(|| format!("writing {}", self.out_dir.join(name).display()))?;
+        }
+        if let Some(v) = &self.vtk {
+            self.record.vtk_frames = v.frames_written;
+            self.record.vtk_bytes = v.bytes_written;
+        }
+        Ok(self.record)
+    }
+}
+
+impl polydem::scene::RunObserver for RunOutputs {
+    fn wants_state(&self, n: u64) -> bool {
+        self.csv_at(n) || self.vtk_at(n) || self.checkpoint_at(n)
+    }
+
+    fn observe(&mut self, s: &polydem::scene::Simulation, n: u64) -> io::Result<()> {
+        use polydem::io::csv_output;
+        let start = std::time::Instant::now();
+        if n == self.start_step || self.csv_at(n) {
+            csv_output::write_bodies_rows(&mut self.bodies, s)?;
+            csv_output::write_walls_rows(&mut self.walls, s)?;
+            csv_output::write_energy_row(&mut self.energy, s)?;
+        }
+        if self.vtk_at(n) {
+            let t = std::time::Instant::now();
+            if let Some(v) = self.vtk.as_mut() {
+                v.write_frame(&s.world)
+                    .map_err(|e| io::Error::new(e.kind(), format!("writing VTK frames: {e}")))?;
+            }
+            self.record.vtk_time += t.elapsed();
+        }
+        if self.checkpoint_at(n) {
+            self.write_checkpoint(s, n)?;
+        }
+        self.record.time += start.elapsed();
+        Ok(())
+    }
+
+    fn progress(&mut self, n: u64) {
+        self.bar.set_position(n - self.start_step);
+    }
 }
