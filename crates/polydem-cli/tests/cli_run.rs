@@ -442,3 +442,60 @@ fn restart_into_the_same_directory_continues_the_csv_and_vtk_series() {
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// A world of free spheres with the energy ledger off runs on the flat sphere layout, and `polydem run`
+/// writes the same bodies and walls series as on the general step (the ledger books energy only).
+#[test]
+fn the_flat_sphere_layout_writes_the_same_series_as_the_general_step() {
+    let scene = std::fs::read_to_string(scene_path("sphere_bounce.toml")).expect("scene");
+    let flat_dir = out_dir("flat_layout");
+    std::fs::create_dir_all(&flat_dir).unwrap();
+    let flat_scene = flat_dir.join("sphere_bounce_no_ledger.toml");
+    std::fs::write(
+        &flat_scene,
+        scene.replacen("[simulation]", "[simulation]\nenergy_ledger = false", 1),
+    )
+    .unwrap();
+    let general = out_dir("general_step");
+    let flat = flat_dir.join("out");
+    for (scene, out) in [
+        (scene_path("sphere_bounce.toml"), &general),
+        (flat_scene, &flat),
+    ] {
+        succeeds(&[
+            "run".as_ref(),
+            scene.as_os_str(),
+            "--out".as_ref(),
+            out.as_os_str(),
+            "--quiet".as_ref(),
+        ]);
+    }
+    let summary = |dir: &Path| std::fs::read_to_string(dir.join("summary.txt")).unwrap();
+    assert!(
+        summary(&general).contains("general step"),
+        "{}",
+        summary(&general)
+    );
+    assert!(
+        summary(&flat).contains("flat sphere layout"),
+        "{}",
+        summary(&flat)
+    );
+    for file in ["bodies.csv", "walls.csv"] {
+        let (a, b) = (
+            std::fs::read_to_string(general.join(file)).unwrap(),
+            std::fs::read_to_string(flat.join(file)).unwrap(),
+        );
+        assert!(
+            a.lines().count() > 10,
+            "{file}: {} lines",
+            a.lines().count()
+        );
+        assert_eq!(
+            a, b,
+            "{file}: the flat layout wrote other rows than the general step"
+        );
+    }
+    let _ = std::fs::remove_dir_all(&general);
+    let _ = std::fs::remove_dir_all(&flat_dir);
+}

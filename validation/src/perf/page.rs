@@ -20,7 +20,7 @@ pub fn group(figure: &str) -> &'static str {
         "contact_overlap_warm" => "contact_overlap_warm",
         "contact_separated_cold" => "contact_separated_cold",
         "contact_separated_warm" => "contact_separated_warm",
-        "step" | "rockfill" => "steps",
+        "step" | "run" | "rockfill" => "steps",
         "wall_contact_overlap" => "wall_contact_overlap",
         "wall_contact_separated" => "wall_contact_separated",
         _ => "io",
