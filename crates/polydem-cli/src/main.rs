@@ -426,4 +426,8 @@ impl polydem::scene::RunObserver for RunOutputs {
     fn progress(&mut self, n: u64) {
         self.bar.set_position(n - self.start_step);
     }
+
+    fn reads_contacts(&self, n: u64) -> bool {
+        self.checkpoint_at(n)
+    }
 }

@@ -556,6 +556,19 @@ impl SphereSim {
     /// pair with its spring, its last forces and the geometry the general step would have stored for it
     /// at the current positions; the broad phase is reset so that the general step rebuilds its lists.
     pub fn write_back(&self, world: &mut World) {
+        self.write_back_bodies(world);
+        world.broad_phase = BroadPhase::new(world.broad_phase.skin());
+        if !self.outs_valid {
+            // Nothing evaluated here: the world's store is still the state.
+            return;
+        }
+        world.contacts = self.contact_store();
+    }
+
+    /// Puts the bodies, walls, loads, ledger, time and step index back into `world`, and nothing else: its
+    /// contact store and broad phase stay as they were (for an output that reads bodies and loads only;
+    /// [`Self::write_back`] is the whole state).
+    pub fn write_back_bodies(&self, world: &mut World) {
         for (i, body) in world.bodies.iter_mut().enumerate() {
             body.position = self.kin[i].position;
             body.velocity = self.kin[i].velocity;
@@ -576,11 +589,11 @@ impl SphereSim {
         loads.tangential_stiffness_work = 0.0;
         loads.external_power = self.external_power;
         loads.current = true;
-        world.broad_phase = BroadPhase::new(world.broad_phase.skin());
-        if !self.outs_valid {
-            // Nothing evaluated here: the world's store is still the state.
-            return;
-        }
+    }
+
+    /// The contact store the general step would hold: every listed pair with its spring, its last forces
+    /// and its geometry at the current positions.
+    fn contact_store(&self) -> ContactStore {
         let list = &self.list;
         let keys: Vec<ContactKey> = self
             .body_pairs()
@@ -671,7 +684,7 @@ impl SphereSim {
                 ..ContactState::new(since)
             };
         }
-        world.contacts = store;
+        store
     }
 }
 

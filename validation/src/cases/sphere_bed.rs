@@ -19,14 +19,12 @@
 
 use crate::provenance::workspace_root;
 use crate::stats::relative_difference;
-use std::ops::ControlFlow;
 use std::path::Path;
 use std::time::Instant;
 
 use polydem::host::{core_round_trip_text, load_average, thread_cpu_time, CpuTicks};
 use polydem::math::Real;
-use polydem::scene::{load_scene, Simulation};
-use polydem::world::{SphereSim, StepFlatError};
+use polydem::scene::{load_scene, RunObserver, Simulation, StepPath};
 use serde::Deserialize;
 
 use crate::case::{Case, CaseData, Profile, Target};
@@ -209,8 +207,8 @@ fn run_polydem(
     }
     // The case compares trajectories and speed; YADE and LIGGGHTS keep no energy ledger, so neither does
     // this run (bodies and forces are the same bits with it: `tests/world_sphere_fast_paths.rs`), which
-    // lets it take the flat sphere path (`polydem::world::SphereSim`; the same bits as the general step,
-    // `tests/sphere_flat_paths.rs`).
+    // lets the pipeline take the flat sphere layout, as `polydem run` of the scene with
+    // `energy_ledger = false` does.
     sim.params.energy_ledger = false;
     let projectile = sim
         .world
@@ -244,9 +242,11 @@ fn run_polydem(
         let before = (threads > 1).then(core_round_trip_text);
         let cpu_start = thread_cpu_time();
         let start = Instant::now();
+        let mut reported = 0;
         let max_overlap = run_steps(&mut sim, projectile, &mut history, &mut |n| {
-            if n % 500 == 0 {
-                progress.inc(500);
+            if n >= reported + 500 {
+                progress.inc(n - reported);
+                reported = n;
             }
         });
         let wall = start.elapsed().as_secs_f64();
@@ -285,73 +285,68 @@ fn run_polydem(
 }
 
 /// The steps of `sim` from its world's step to its end, sampling the projectile at the start and every
-/// output interval (and after the last step): on the flat sphere path ([`SphereSim`], the same bits as the
-/// general step, `tests/sphere_flat_paths.rs`) when the world is one of free spheres, else the general
-/// step. `on_step` gets the number of steps done. Returns the largest overlap ratio of any step.
+/// output interval (and after the last step), through the run `polydem run` uses
+/// ([`Simulation::run_observed`]): the pipeline takes the flat sphere layout for a world of free spheres
+/// with the ledger off (the same bits as the general step, `tests/pinned_bits.rs`). `on_step` gets the
+/// number of steps done. Returns the largest overlap ratio of any step.
 fn run_steps(
     sim: &mut Simulation,
     projectile: usize,
     history: &mut History,
     on_step: &mut (dyn FnMut(u64) + Send),
 ) -> Result<Real, String> {
-    let mut sample = |t: Real, z: Real, vz: Real, fz: Real| {
-        history.t.push(t);
-        history.z.push(z);
-        history.vz.push(vz);
-        history.fz.push(fz);
+    let mut samples = ProjectileSamples {
+        projectile,
+        output_every: sim.output_every,
+        last: sim.steps,
+        history,
+        on_step,
     };
-    let mut flat = match SphereSim::from_world(&sim.world, &sim.params) {
-        Ok(flat) => flat,
-        Err(StepFlatError::NotSphereOnly(reason)) => {
-            eprintln!("sphere_bed: the general step ({reason})");
-            let summary = sim
-                .run(
-                    |s| {
-                        let b = &s.world.bodies[projectile];
-                        // No loads before the first step: the projectile starts out of contact.
-                        let fz = s.world.loads.forces.get(projectile).map_or(0.0, |f| f.z);
-                        sample(s.world.time, b.position.z, b.velocity.z, fz);
-                        Ok(())
-                    },
-                    |_, n| {
-                        on_step(n);
-                        Ok(())
-                    },
-                )
-                .map_err(|e| e.to_string())?;
-            return Ok(summary.max_overlap_ratio);
-        }
-        Err(e) => return Err(e.to_string()),
-    };
-    // No output of the case reads a sphere's orientation: the flat path need not turn them (the same
-    // positions and velocities, bit for bit: `tests/sphere_flat_orientation.rs`).
-    flat.set_track_orientation(false);
-    // The first sample is the state before any step, as the general run's first output (its loads are
-    // not evaluated yet there: zero force, the projectile starts out of contact).
-    let b = &sim.world.bodies[projectile];
-    let fz = sim.world.loads.forces.get(projectile).map_or(0.0, |f| f.z);
-    sample(sim.world.time, b.position.z, b.velocity.z, fz);
-    let mut max_overlap: Real = 0.0;
-    let (last, output_every) = (sim.steps, sim.output_every);
-    // One run of the remaining steps: on two threads it holds the pool's threads throughout (the same
-    // bits as stepping one by one, `SphereSim::run_steps`).
-    flat.run_steps(last.saturating_sub(flat.step_index()), |flat, report| {
-        let n = flat.step_index();
-        max_overlap = max_overlap.max(report.max_overlap_ratio);
-        if n % output_every == 0 || n == last {
-            sample(
-                flat.time(),
-                flat.position(projectile).z,
-                flat.velocity(projectile).z,
-                flat.forces()[projectile].z,
-            );
-        }
-        on_step(n);
-        ControlFlow::Continue(())
-    })
-    .map_err(|e| e.to_string())?;
-    flat.write_back(&mut sim.world);
-    Ok(max_overlap)
+    let summary = sim.run_observed(&mut samples).map_err(|e| e.to_string())?;
+    if summary.path != StepPath::FlatSpheres {
+        eprintln!("sphere_bed: the general step");
+    }
+    Ok(summary.max_overlap_ratio)
+}
+
+/// The projectile's height, vertical velocity and vertical force at every output step of a run.
+struct ProjectileSamples<'a> {
+    projectile: usize,
+    output_every: u64,
+    last: u64,
+    history: &'a mut History,
+    on_step: &'a mut (dyn FnMut(u64) + Send),
+}
+
+impl RunObserver for ProjectileSamples<'_> {
+    fn wants_state(&self, n: u64) -> bool {
+        n.is_multiple_of(self.output_every) || n == self.last
+    }
+
+    fn observe(&mut self, s: &Simulation, _: u64) -> std::io::Result<()> {
+        let b = &s.world.bodies[self.projectile];
+        // No loads before the first step: the projectile starts out of contact.
+        let fz = s
+            .world
+            .loads
+            .forces
+            .get(self.projectile)
+            .map_or(0.0, |f| f.z);
+        let h = &mut *self.history;
+        h.t.push(s.world.time);
+        h.z.push(b.position.z);
+        h.vz.push(b.velocity.z);
+        h.fz.push(fz);
+        Ok(())
+    }
+
+    fn progress(&mut self, n: u64) {
+        (self.on_step)(n);
+    }
+
+    fn reads_contacts(&self, _: u64) -> bool {
+        false
+    }
 }
 
 /// The metrics of `code`'s history up to `t_end` (an error names the code when it has no samples).
@@ -991,8 +986,9 @@ impl Case for SphereBed {
              the speed ratios and checks use them when they exist. polydem's wall time is measured here, \
              with its thread's CPU time beside it; it runs without the per-contact energy ledger \
              (`energy_ledger = false`, the same trajectory bit for bit), as YADE and LIGGGHTS keep none, \
-             on the flat sphere path (per-sphere arrays and a half neighbour list, `SphereSim`; the same \
-             bits as the general step). \
+             through the run `polydem run` uses (`Simulation::run_observed`, the state handed out every \
+             output interval), which takes the flat sphere layout (per-sphere arrays and a half neighbour \
+             list; the same bits as the general step). \
              The machine is shared (2 cores, load averages of 6–11 were seen), so wall-time ratios between \
              runs at different moments carry an uncertainty of up to a factor of two or three; within a \
              suite run a single ratio moved by ±10–20 % (2026-11-22), so the full profile times \
