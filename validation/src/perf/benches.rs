@@ -116,6 +116,13 @@ pub struct Regions {
     pub figures: Vec<(String, u64)>,
 }
 
+impl Regions {
+    /// Sets the work of the figure measured last (for work known only once its result is checked).
+    fn set_work(&mut self, work: u64) {
+        self.figures.last_mut().expect("a figure was measured").1 = work;
+    }
+}
+
 /// Runs `f` as the measured region of `figure`: the instruction counter collects inside this function
 /// only and dumps at its end. `work` of the result tells how much the region did.
 #[inline(never)]
@@ -301,15 +308,14 @@ fn steps(
     if let Some(e) = failure {
         return Err(format!("{figure}: {e}"));
     }
-    let contacts = sim
-        .world
-        .contacts
-        .states()
-        .iter()
-        .filter(|s| s.force_on_b.norm() > 0.0)
-        .count();
-    regions.figures.last_mut().expect("just measured").1 = contacts as u64;
+    regions.set_work(loaded_contacts(sim));
     Ok(())
+}
+
+/// Contacts that carry a force: the work of the step figures.
+fn loaded_contacts(sim: &Simulation) -> u64 {
+    let states = sim.world.contacts.states();
+    states.iter().filter(|s| s.force_on_b.norm() > 0.0).count() as u64
 }
 
 fn step_polyhedra_box(inputs: &Inputs, regions: &mut Regions) -> Result<(), String> {
@@ -349,14 +355,7 @@ fn step_sphere_bed(inputs: &Inputs, regions: &mut Regions) -> Result<(), String>
     if summary.path != StepPath::FlatSpheres {
         return Err("sphere bed a without the ledger did not take the flat sphere layout".into());
     }
-    let contacts = sim
-        .world
-        .contacts
-        .states()
-        .iter()
-        .filter(|s| s.force_on_b.norm() > 0.0)
-        .count();
-    regions.figures.last_mut().expect("just measured").1 = contacts as u64;
+    regions.set_work(loaded_contacts(&sim));
     Ok(())
 }
 
@@ -396,7 +395,7 @@ fn rockfill_penetration(inputs: &Inputs, regions: &mut Regions) -> Result<(), St
     );
     let result = result.expect("measured").map_err(|e| e.to_string())?;
     let last = result.penetration.rows.last().map_or(0, |row| row.contacts);
-    regions.figures.last_mut().expect("just measured").1 = last as u64;
+    regions.set_work(last as u64);
     Ok(())
 }
 
@@ -422,7 +421,7 @@ fn io(inputs: &Inputs, regions: &mut Regions) -> Result<(), String> {
         let sim = loaded
             .expect("measured")
             .map_err(|e| format!("{relative}: {e}"))?;
-        regions.figures.last_mut().expect("just measured").1 = sim.world.bodies.len() as u64;
+        regions.set_work(sim.world.bodies.len() as u64);
     }
     let sim = settled_box(inputs)?;
     let out = inputs.prepared.join("io");
@@ -434,7 +433,7 @@ fn io(inputs: &Inputs, regions: &mut Regions) -> Result<(), String> {
         || writer.write_frame(&sim.world),
         |_| 0,
     );
-    regions.figures.last_mut().expect("just measured").1 = writer.bytes_written;
+    regions.set_work(writer.bytes_written);
     let path = out.join("box.pdck");
     let mut saved = None;
     measured(
@@ -446,7 +445,7 @@ fn io(inputs: &Inputs, regions: &mut Regions) -> Result<(), String> {
     let bytes = saved
         .expect("measured")
         .map_err(|e| format!("{}: {e}", path.display()))?;
-    regions.figures.last_mut().expect("just measured").1 = bytes;
+    regions.set_work(bytes);
     let mut read = None;
     measured(
         regions,

@@ -260,17 +260,15 @@ fn counts_section(
                 (commits.len() as f64, 100.0 * threshold),
             ],
         });
-        let plot = Plot {
-            name: g.to_string(),
-            title: title(g).to_string(),
-            x_label: "recorded commit (oldest to newest)".into(),
-            y_label: "instructions: change since the first record (%)".into(),
-            x_log: false,
-            y_log: false,
+        let y_label = "instructions: change since the first record (%)";
+        write_plot(
+            md,
+            out,
+            g,
+            "recorded commit (oldest to newest)",
+            y_label,
             series,
-            caption: String::new(),
-        };
-        write_plot(md, out, &plot)?;
+        )?;
     }
     Ok(())
 }
@@ -338,22 +336,38 @@ fn wall_section(
         if series.is_empty() {
             continue;
         }
-        let plot = Plot {
-            name: g.to_string(),
-            title: title(g).to_string(),
-            x_label: "recorded run (oldest to newest)".into(),
-            y_label: "time ours / parry (lower is faster)".into(),
-            x_log: false,
-            y_log: false,
+        let y_label = "time ours / parry (lower is faster)";
+        write_plot(
+            md,
+            out,
+            g,
+            "recorded run (oldest to newest)",
+            y_label,
             series,
-            caption: String::new(),
-        };
-        write_plot(md, out, &plot)?;
+        )?;
     }
     Ok(())
 }
 
-fn write_plot(md: &mut String, out: &Path, plot: &Plot) -> Result<(), SuiteError> {
+/// Writes the plot of group `group` (linear axes) and links it from the page.
+fn write_plot(
+    md: &mut String,
+    out: &Path,
+    group: &str,
+    x_label: &str,
+    y_label: &str,
+    series: Vec<Series>,
+) -> Result<(), SuiteError> {
+    let plot = Plot {
+        name: group.to_string(),
+        title: title(group).to_string(),
+        x_label: x_label.into(),
+        y_label: y_label.into(),
+        x_log: false,
+        y_log: false,
+        series,
+        caption: String::new(),
+    };
     let dir = out.join("perf");
     std::fs::create_dir_all(&dir).map_err(SuiteError::io(&dir))?;
     plot.write_svg(&dir.join(format!("{}.svg", plot.name)))?;
