@@ -5,10 +5,18 @@
 //! - [`vtk`]: VTK frames (`.vtu`) and `.pvd` collections of polyhedra, spheres and walls for ParaView.
 //! - [`run_summary`]: the run summary of `polydem run` as text and JSON.
 //! - [`checkpoint`]: the versioned binary checkpoint of a whole simulation, for restarts.
+//! - [`output`]: the [`output::Output`] trait a run's outputs share, and [`output::OutputSet`], the
+//!   observer that hands them the state; its implementations: [`csv_series`], [`vtk_frames`],
+//!   [`checkpoint_series`], [`contact_network`].
 
 pub mod checkpoint;
+pub mod checkpoint_series;
+pub mod contact_network;
 pub mod csv_continue;
 pub mod csv_output;
+pub mod csv_series;
+pub mod output;
 pub mod pairs_jsonl;
 pub mod run_summary;
 pub mod vtk;
+pub mod vtk_frames;

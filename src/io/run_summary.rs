@@ -30,6 +30,10 @@ pub struct OutputRecord {
     pub checkpoint_every: Option<u64>,
     pub vtk_frames: u64,
     pub vtk_bytes: u64,
+    /// Steps between contact-network frames (`None`: not written), frames and bytes of `.vtp` written.
+    pub contacts_every: Option<u64>,
+    pub contact_frames: u64,
+    pub contact_bytes: u64,
     pub checkpoints: Vec<CheckpointRecord>,
     /// Wall time of all output: CSV rows, VTK frames and checkpoints.
     pub time: Duration,
@@ -125,6 +129,9 @@ pub fn summary_json(
             "checkpoint_every_steps": output.checkpoint_every,
             "checkpoints": output.checkpoints,
             "checkpoint_seconds": secs(output.checkpoint_time),
+            "contacts_every_steps": output.contacts_every,
+            "contact_frames": output.contact_frames,
+            "contact_bytes": output.contact_bytes,
         },
     })
 }
@@ -164,6 +171,12 @@ pub fn summary_text(
         ms(output.checkpoint_time),
         output.checkpoints.len()
     ));
+    if output.contacts_every.is_some() {
+        text.push_str(&format!(
+            "contact network: {} frames, {} bytes of VTK lines\n",
+            output.contact_frames, output.contact_bytes
+        ));
+    }
     text.push_str(&format!(
         "final energy balance {:e} J (mechanical energy {:e} J)\n",
         energy.balance,

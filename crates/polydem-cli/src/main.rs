@@ -4,9 +4,10 @@
 //! - `polydem contact PAIRS.jsonl [--out FILE]`: the contact contract (format in `docs/contact-jsonl.md`):
 //!   one JSON object per input line with two point clouds, one answer (or error record) per line.
 //!   `-` reads standard input; output goes to standard output unless `--out` is given.
-//! - `polydem run SCENE --out DIR [--vtk-interval T] [--checkpoint-interval T] [--end-time T] [--quiet]`:
-//!   runs a scene file (format in `docs/scene-format.md`) and writes `DIR/bodies.csv`, `DIR/energy.csv`,
-//!   `DIR/walls.csv`, VTK frames with `.pvd` collections, checkpoints in `DIR/checkpoints/`, and the run
+//! - `polydem run SCENE --out DIR [--vtk-interval T] [--contacts-interval T] [--checkpoint-interval T]
+//!   [--end-time T] [--quiet]`: runs a scene file (format in `docs/scene-format.md`) and writes
+//!   `DIR/bodies.csv`, `DIR/energy.csv`, `DIR/walls.csv`, VTK frames with `.pvd` collections, the contact
+//!   network (`contacts.csv`, `contacts.pvd`), checkpoints in `DIR/checkpoints/`, and the run
 //!   summary `DIR/summary.txt` (also printed) and `DIR/summary.json` (formats in `docs/output-formats.md`
 //!   and `docs/checkpoint-format.md`). A progress bar with rates and ETA is drawn on standard error when it is
 //!   a terminal, unless `--quiet`.
@@ -131,6 +132,10 @@ struct RunArgs {
     /// Write the binary VTK arrays uncompressed (by default they are zlib-compressed: lossless, ~7× smaller).
     #[arg(long, conflicts_with = "vtk_ascii")]
     vtk_uncompressed: bool,
+    /// Write the contact network (every active contact's point, normal, depth and force: `contacts.csv`
+    /// and VTK lines `contacts.pvd`) every T seconds of simulated time (and at the start and the end).
+    #[arg(long, value_name = "T", allow_negative_numbers = true)]
+    contacts_interval: Option<f64>,
     /// Write a checkpoint every T seconds of simulated time (and at the end).
     #[arg(long, value_name = "T", allow_negative_numbers = true)]
     checkpoint_interval: Option<f64>,
@@ -149,13 +154,11 @@ fn every_steps(flag: &str, interval: Option<f64>, dt: f64) -> Result<Option<u64>
 }
 
 fn run(args: &RunArgs) -> Result<()> {
-    use polydem::io::run_summary::{summary_json, summary_text, OutputRecord, RunOrigin};
-    use polydem::io::vtk::{VtkCompression, VtkEncoding, VtkFormat, VtkPrecision, VtkWriter};
-    use polydem::io::{checkpoint, csv_output};
+    use polydem::io::run_summary::{summary_json, summary_text, RunOrigin};
 
     let (mut sim, source, restarted) = match (&args.restart, &args.scene) {
         (Some(file), _) => {
-            let payload = checkpoint::load(file)
+            let payload = polydem::io::checkpoint::load(file)
                 .with_context(|| format!("cannot restart from checkpoint {}", file.display()))?;
             (payload.simulation, file.display().to_string(), true)
         }
@@ -169,40 +172,110 @@ fn run(args: &RunArgs) -> Result<()> {
     if let Some(t) = args.end_time {
         sim.set_end_time(t).context("--end-time")?;
     }
-    let dt = sim.params.dt;
-    let vtk_every = every_steps("--vtk-interval", args.vtk_interval, dt)?;
-    let checkpoint_every = every_steps("--checkpoint-interval", args.checkpoint_interval, dt)?;
     let origin = RunOrigin {
         source,
         restarted,
         start_step: sim.world.step_index,
         start_time: sim.world.time,
     };
+    let out_dir = args.out.as_path();
+    let mut outputs = run_outputs(args, &sim, restarted)?;
+    if !args.quiet {
+        eprintln!("{}", run_header(&origin, &sim));
+    }
+    let bar = progress_bar(args.quiet, &origin, &sim)?;
+    let start_step = origin.start_step;
+    let shown = bar.clone();
+    outputs.on_progress(move |n| shown.set_position(n - start_step));
+    let summary = sim
+        .run_observed(&mut outputs)
+        .with_context(|| format!("running {}", origin.source))?;
+    let record = outputs.finish()?;
+    bar.finish_and_clear();
 
+    let text = summary_text(&origin, &sim, &summary, &record);
+    print!("{text}");
+    let write = |name: &str, contents: &str| -> Result<()> {
+        let path = out_dir.join(name);
+        std::fs::write(&path, contents).with_context(|| format!("cannot write {}", path.display()))
+    };
+    write("summary.txt", &text)?;
+    let json = summary_json(&origin, &sim, &summary, &record);
+    write(
+        "summary.json",
+        &(serde_json::to_string_pretty(&json)? + "\n"),
+    )?;
+    Ok(())
+}
+
+/// The outputs of `polydem run` in the order they write at a step: CSV series, VTK frames, the contact
+/// network, checkpoints (last, so that the series on disk reach each checkpoint). A restart continues the
+/// series the earlier run left in the same directory.
+fn run_outputs<'a>(
+    args: &RunArgs,
+    sim: &polydem::scene::Simulation,
+    restarted: bool,
+) -> Result<polydem::io::output::OutputSet<'a>> {
+    use polydem::io::checkpoint_series::CheckpointSeries;
+    use polydem::io::contact_network::ContactNetwork;
+    use polydem::io::csv_series::CsvSeries;
+    use polydem::io::output::{OutputSet, Schedule};
+    use polydem::io::vtk::VtkWriter;
+    use polydem::io::vtk_frames::VtkFrames;
+
+    let dt = sim.params.dt;
+    let vtk_every = every_steps("--vtk-interval", args.vtk_interval, dt)?;
+    let contacts_every = every_steps("--contacts-interval", args.contacts_interval, dt)?;
+    let checkpoint_every = every_steps("--checkpoint-interval", args.checkpoint_interval, dt)?;
     let out_dir = args.out.as_path();
     std::fs::create_dir_all(out_dir)
         .with_context(|| format!("cannot create output directory {}", out_dir.display()))?;
-    let create = |name: &str| -> Result<BufWriter<File>> {
-        let path = out_dir.join(name);
-        Ok(BufWriter::new(File::create(&path).with_context(|| {
-            format!("cannot create {}", path.display())
-        })?))
+    let schedule = |every: Option<u64>, at_start: bool| Schedule {
+        start_step: sim.world.step_index,
+        last_step: sim.steps,
+        every,
+        at_start,
+        at_end: true,
     };
-    // A restart continues the series the earlier run left in the same directory (rows before its start).
-    let series = |name: &str, header: &str| -> Result<BufWriter<File>> {
-        if restarted {
-            let path = out_dir.join(name);
-            return polydem::io::csv_continue::continue_csv(&path, header, sim.world.time)
-                .with_context(|| format!("cannot continue {}", path.display()));
-        }
-        let mut out = create(name)?;
-        writeln!(out, "{header}")?;
-        Ok(out)
-    };
-    let bodies = series("bodies.csv", csv_output::BODIES_HEADER)?;
-    let energy = series("energy.csv", polydem::world::EnergyReport::CSV_HEADER)?;
-    let walls = series("walls.csv", csv_output::WALLS_HEADER)?;
-    let encoding = VtkEncoding {
+    let mut outputs = OutputSet::new();
+    let csv = schedule(Some(sim.output_every), true);
+    outputs.push(if restarted {
+        CsvSeries::continue_at(out_dir, sim.world.time, csv)?
+    } else {
+        CsvSeries::create(out_dir, csv)?
+    });
+    if let Some(every) = vtk_every {
+        let encoding = vtk_encoding(args);
+        let writer = if restarted {
+            VtkWriter::resume(out_dir, &sim.world, encoding).with_context(|| {
+                format!("cannot continue the VTK series in {}", out_dir.display())
+            })?
+        } else {
+            VtkWriter::new(out_dir, &sim.world, encoding)
+                .with_context(|| format!("cannot create {}", out_dir.join("vtk").display()))?
+        };
+        outputs.push(VtkFrames::new(writer, schedule(Some(every), true)));
+    }
+    if let Some(every) = contacts_every {
+        let network = schedule(Some(every), true);
+        outputs.push(if restarted {
+            ContactNetwork::continue_at(out_dir, &sim.world, network)?
+        } else {
+            ContactNetwork::create(out_dir, network)?
+        });
+    }
+    if let Some(every) = checkpoint_every {
+        outputs.push(CheckpointSeries::new(
+            out_dir,
+            schedule(Some(every), false),
+        )?);
+    }
+    Ok(outputs)
+}
+
+fn vtk_encoding(args: &RunArgs) -> polydem::io::vtk::VtkEncoding {
+    use polydem::io::vtk::{VtkCompression, VtkEncoding, VtkFormat, VtkPrecision};
+    VtkEncoding {
         format: if args.vtk_ascii {
             VtkFormat::Ascii
         } else {
@@ -218,30 +291,18 @@ fn run(args: &RunArgs) -> Result<()> {
         } else {
             VtkCompression::Zlib
         },
-    };
-    let vtk = match vtk_every {
-        // A restart continues the series the earlier run left in the same directory.
-        Some(_) if restarted => Some(
-            VtkWriter::resume(out_dir, &sim.world, encoding).with_context(|| {
-                format!("cannot continue the VTK series in {}", out_dir.display())
-            })?,
-        ),
-        Some(_) => Some(
-            VtkWriter::new(out_dir, &sim.world, encoding)
-                .with_context(|| format!("cannot create {}", out_dir.join("vtk").display()))?,
-        ),
-        None => None,
-    };
-    let checkpoint_dir = out_dir.join("checkpoints");
-    if checkpoint_every.is_some() {
-        std::fs::create_dir_all(&checkpoint_dir)
-            .with_context(|| format!("cannot create {}", checkpoint_dir.display()))?;
     }
+}
 
+/// The line printed before the run: what runs, its time step and its length.
+fn run_header(
+    origin: &polydem::io::run_summary::RunOrigin,
+    sim: &polydem::scene::Simulation,
+) -> String {
     let info = sim.time_step;
-    let header = format!(
+    format!(
         "{} {}: {} bodies, {} walls, dt = {:e} s ({}), shortest contact time {:e} s, stability limit {:e} s, steps {} → {} (t = {} s)",
-        if restarted { "restart from" } else { "scene" },
+        if origin.restarted { "restart from" } else { "scene" },
         origin.source,
         sim.world.bodies.len(),
         sim.world.walls.len(),
@@ -252,13 +313,17 @@ fn run(args: &RunArgs) -> Result<()> {
         origin.start_step,
         sim.steps,
         sim.end_time
-    );
-    if !args.quiet {
-        eprintln!("{header}");
-    }
-    // indicatif draws nothing when standard error is not a terminal.
+    )
+}
+
+/// The progress bar on standard error (indicatif draws nothing when it is not a terminal).
+fn progress_bar(
+    quiet: bool,
+    origin: &polydem::io::run_summary::RunOrigin,
+    sim: &polydem::scene::Simulation,
+) -> Result<indicatif::ProgressBar> {
     let remaining = sim.steps.saturating_sub(origin.start_step);
-    let bar = if args.quiet {
+    let bar = if quiet {
         indicatif::ProgressBar::hidden()
     } else {
         indicatif::ProgressBar::new(remaining)
@@ -282,152 +347,5 @@ fn run(args: &RunArgs) -> Result<()> {
             },
         ),
     );
-
-    let mut outputs = RunOutputs {
-        out_dir: out_dir.to_owned(),
-        bodies,
-        energy,
-        walls,
-        vtk,
-        csv_every: sim.output_every,
-        vtk_every,
-        checkpoint_every,
-        start_step: origin.start_step,
-        last_step: sim.steps,
-        bar,
-        record: OutputRecord {
-            csv_every: sim.output_every,
-            vtk_every,
-            checkpoint_every,
-            ..OutputRecord::default()
-        },
-    };
-    let summary = sim
-        .run_observed(&mut outputs)
-        .with_context(|| format!("running {}", origin.source))?;
-    let record = outputs.finish()?;
-
-    let text = summary_text(&origin, &sim, &summary, &record);
-    print!("{text}");
-    let write = |name: &str, contents: &str| -> Result<()> {
-        let path = out_dir.join(name);
-        std::fs::write(&path, contents).with_context(|| format!("cannot write {}", path.display()))
-    };
-    write("summary.txt", &text)?;
-    let json = summary_json(&origin, &sim, &summary, &record);
-    write(
-        "summary.json",
-        &(serde_json::to_string_pretty(&json)? + "\n"),
-    )?;
-    Ok(())
-}
-
-/// The outputs of `polydem run`: the CSV series, VTK frames, checkpoints and the progress bar, handed the
-/// state by the run at the steps they need (so that the pipeline may step on a layout of its own in
-/// between).
-struct RunOutputs {
-    out_dir: std::path::PathBuf,
-    bodies: BufWriter<File>,
-    energy: BufWriter<File>,
-    walls: BufWriter<File>,
-    vtk: Option<polydem::io::vtk::VtkWriter>,
-    csv_every: u64,
-    vtk_every: Option<u64>,
-    checkpoint_every: Option<u64>,
-    start_step: u64,
-    last_step: u64,
-    bar: indicatif::ProgressBar,
-    record: polydem::io::run_summary::OutputRecord,
-}
-
-impl RunOutputs {
-    fn csv_at(&self, n: u64) -> bool {
-        n.is_multiple_of(self.csv_every) || n == self.last_step
-    }
-    fn vtk_at(&self, n: u64) -> bool {
-        self.vtk.is_some()
-            && (n == self.start_step
-                || self.vtk_every.is_some_and(|k| n.is_multiple_of(k))
-                || n == self.last_step)
-    }
-    fn checkpoint_at(&self, n: u64) -> bool {
-        n != self.start_step
-            && self
-                .checkpoint_every
-                .is_some_and(|k| n.is_multiple_of(k) || n == self.last_step)
-    }
-
-    fn write_checkpoint(&mut self, s: &polydem::scene::Simulation, n: u64) -> io::Result<()> {
-        let start = std::time::Instant::now();
-        let file = format!("checkpoints/step_{n:09}.pdck");
-        let bytes = polydem::io::checkpoint::save(&self.out_dir.join(&file), s)
-            .map_err(io::Error::other)?;
-        let seconds = start.elapsed();
-        self.record.checkpoint_time += seconds;
-        self.record
-            .checkpoints
-            .push(polydem::io::run_summary::CheckpointRecord {
-                file,
-                step: n,
-                time: s.world.time,
-                bytes,
-                seconds: seconds.as_secs_f64(),
-            });
-        Ok(())
-    }
-
-    /// Flushes the CSV series and returns what was written.
-    fn finish(mut self) -> Result<polydem::io::run_summary::OutputRecord> {
-        self.bar.finish_and_clear();
-        for (name, w) in [
-            ("bodies.csv", &mut self.bodies),
-            ("energy.csv", &mut self.energy),
-            ("walls.csv", &mut self.walls),
-        ] {
-            w.flush()
-                .with_context(|| format!("writing {}", self.out_dir.join(name).display()))?;
-        }
-        if let Some(v) = &self.vtk {
-            self.record.vtk_frames = v.frames_written;
-            self.record.vtk_bytes = v.bytes_written;
-        }
-        Ok(self.record)
-    }
-}
-
-impl polydem::scene::RunObserver for RunOutputs {
-    fn wants_state(&self, n: u64) -> bool {
-        self.csv_at(n) || self.vtk_at(n) || self.checkpoint_at(n)
-    }
-
-    fn observe(&mut self, s: &polydem::scene::Simulation, n: u64) -> io::Result<()> {
-        use polydem::io::csv_output;
-        let start = std::time::Instant::now();
-        if n == self.start_step || self.csv_at(n) {
-            csv_output::write_bodies_rows(&mut self.bodies, s)?;
-            csv_output::write_walls_rows(&mut self.walls, s)?;
-            csv_output::write_energy_row(&mut self.energy, s)?;
-        }
-        if self.vtk_at(n) {
-            let t = std::time::Instant::now();
-            if let Some(v) = self.vtk.as_mut() {
-                v.write_frame(&s.world)
-                    .map_err(|e| io::Error::new(e.kind(), format!("writing VTK frames: {e}")))?;
-            }
-            self.record.vtk_time += t.elapsed();
-        }
-        if self.checkpoint_at(n) {
-            self.write_checkpoint(s, n)?;
-        }
-        self.record.time += start.elapsed();
-        Ok(())
-    }
-
-    fn progress(&mut self, n: u64) {
-        self.bar.set_position(n - self.start_step);
-    }
-
-    fn reads_contacts(&self, n: u64) -> bool {
-        self.checkpoint_at(n)
-    }
+    Ok(bar)
 }
