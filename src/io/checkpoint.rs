@@ -38,6 +38,7 @@
 //! Writing goes to `FILE.tmp` first and renames it, so a crash never leaves a half-written file under the
 //! final name. The user documentation is `docs/checkpoint-format.md`.
 
+use std::io::Write;
 use std::path::{Path, PathBuf};
 
 use crate::scene::Simulation;
@@ -174,8 +175,21 @@ pub fn save(path: &Path, sim: &Simulation) -> Result<u64, CheckpointError> {
         let path = path.to_owned();
         move |source| CheckpointError::Io { path, source }
     };
-    std::fs::write(&tmp, &bytes).map_err(io(&tmp))?;
+    // Synced before the rename and the directory after it: once this returns, the checkpoint survives a
+    // crash of the machine, not only of the process.
+    let mut file = std::fs::File::create(&tmp).map_err(io(&tmp))?;
+    file.write_all(&bytes)
+        .and_then(|()| file.sync_all())
+        .map_err(io(&tmp))?;
+    drop(file);
     std::fs::rename(&tmp, path).map_err(io(path))?;
+    let dir = path
+        .parent()
+        .filter(|d| !d.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    std::fs::File::open(dir)
+        .and_then(|d| d.sync_all())
+        .map_err(io(dir))?;
     Ok(bytes.len() as u64)
 }
 

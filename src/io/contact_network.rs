@@ -271,7 +271,10 @@ impl Output for ContactNetwork {
 
     fn flush(&mut self) -> io::Result<()> {
         let path = self.out_dir.join("contacts.csv");
-        self.csv.flush().map_err(|e| in_file(&path, "writing", e))
+        self.csv
+            .flush()
+            .and_then(|()| self.csv.get_ref().sync_data())
+            .map_err(|e| in_file(&path, "writing", e))
     }
 
     fn record(&self, record: &mut OutputRecord) {

@@ -5,7 +5,7 @@ use std::fs::File;
 use std::io::{self, BufWriter, Write};
 use std::path::{Path, PathBuf};
 
-use crate::io::csv_continue::continue_csv;
+use crate::io::csv_continue::{continue_csv, rows_before};
 use crate::io::csv_output;
 use crate::io::output::{Output, Schedule};
 use crate::io::run_summary::OutputRecord;
@@ -36,8 +36,24 @@ impl CsvSeries {
     }
 
     /// Continues the series an earlier run left in `dir`: rows before `start_time` are kept, later ones
-    /// dropped (see [`continue_csv`]).
+    /// dropped (see [`continue_csv`]). Every series is checked before any is rewritten, so a refused
+    /// restart leaves the directory as it was.
     pub fn continue_at(dir: &Path, start_time: f64, schedule: Schedule) -> io::Result<Self> {
+        for (name, header) in SERIES {
+            let path = dir.join(name);
+            match std::fs::read_to_string(&path) {
+                Ok(text) => {
+                    rows_before(&text, header, start_time).map_err(|(line, what)| {
+                        io::Error::new(
+                            io::ErrorKind::InvalidData,
+                            format!("cannot continue {}:{line}: {what}", path.display()),
+                        )
+                    })?;
+                }
+                Err(e) if e.kind() == io::ErrorKind::NotFound => {}
+                Err(e) => return Err(in_file(&path, "cannot read", e)),
+            }
+        }
         Self::open(dir, schedule, |path, header| {
             continue_csv(path, header, start_time).map_err(|e| in_file(path, "cannot continue", e))
         })

@@ -7,7 +7,7 @@
 //! - [`checkpoint`]: the versioned binary checkpoint of a whole simulation, for restarts.
 //! - [`output`]: the [`output::Output`] trait a run's outputs share, and [`output::OutputSet`], the
 //!   observer that hands them the state; its implementations: [`csv_series`], [`vtk_frames`],
-//!   [`checkpoint_series`], [`contact_network`].
+//!   [`checkpoint_series`], [`contact_network`]; [`output_lock`], one run per output directory.
 
 pub mod checkpoint;
 pub mod checkpoint_series;
@@ -16,6 +16,7 @@ pub mod csv_continue;
 pub mod csv_output;
 pub mod csv_series;
 pub mod output;
+pub mod output_lock;
 pub mod pairs_jsonl;
 pub mod run_summary;
 pub mod vtk;

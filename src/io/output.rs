@@ -4,7 +4,8 @@
 //! the pipeline may step on a layout of its own in between. Each [`Output`] says when it is due, whether it
 //! reads the contact store, and how to write, flush and account for itself; the set adds the ordering rule
 //! every restartable run needs: before an output that marks a restart point (a checkpoint) writes, every
-//! other output is flushed, so the series on disk reach at least as far as the checkpoint.
+//! other output is flushed and synced, so the series on disk reach at least as far as the checkpoint
+//! whatever moment the run is killed at, and a restart from it continues them (rows after it dropped).
 //!
 //! The trait sees the whole [`Simulation`]: an implementation that gathers pieces from several processes
 //! (CSV from one rank, VTK as parallel pieces) keeps the same interface.
@@ -12,6 +13,7 @@
 use std::io;
 use std::time::Instant;
 
+use crate::io::output_lock::DirectoryLock;
 use crate::io::run_summary::OutputRecord;
 use crate::scene::{RunObserver, Simulation};
 
@@ -30,7 +32,7 @@ pub trait Output {
     }
     /// Writes the state after step `step`.
     fn write(&mut self, sim: &Simulation, step: u64) -> io::Result<()>;
-    /// Hands everything written so far to the operating system.
+    /// Makes everything written so far durable: written to its files and synced to the disk.
     fn flush(&mut self) -> io::Result<()>;
     /// Adds what it wrote (files, bytes, time) to the run's record.
     fn record(&self, record: &mut OutputRecord);
@@ -67,6 +69,7 @@ pub struct OutputSet<'a> {
     outputs: Vec<Box<dyn Output + 'a>>,
     progress: Box<dyn FnMut(u64) + 'a>,
     record: OutputRecord,
+    lock: Option<DirectoryLock>,
 }
 
 impl<'a> OutputSet<'a> {
@@ -76,7 +79,13 @@ impl<'a> OutputSet<'a> {
             outputs: Vec::new(),
             progress: Box::new(|_| {}),
             record: OutputRecord::default(),
+            lock: None,
         }
+    }
+
+    /// Keeps the lock of the output directory until the set is finished or dropped.
+    pub fn hold(&mut self, lock: DirectoryLock) {
+        self.lock = Some(lock);
     }
 
     /// Adds an output; outputs write in the order they were added.
@@ -99,6 +108,7 @@ impl<'a> OutputSet<'a> {
         for output in &self.outputs {
             output.record(&mut self.record);
         }
+        drop(self.lock.take());
         Ok(self.record)
     }
 }

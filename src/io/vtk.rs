@@ -262,10 +262,14 @@ impl VtkWriter {
             self.bytes_written += text.len() as u64;
             entries.retain(|(_, f)| *f != relative);
             entries.push((world.time, relative));
+            // Replaced whole (written aside, then renamed), so a reader or a restart never sees half of it.
             let pvd = self.out_dir.join(format!("{}.pvd", kind.name()));
-            let mut out = io::BufWriter::new(std::fs::File::create(&pvd)?);
+            let partial = self.out_dir.join(format!("{}.pvd.partial", kind.name()));
+            let mut out = io::BufWriter::new(std::fs::File::create(&partial)?);
             write_pvd(&mut out, entries)?;
             out.flush()?;
+            drop(out);
+            std::fs::rename(&partial, &pvd)?;
         }
         self.frames_written += 1;
         Ok(())

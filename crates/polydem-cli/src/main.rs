@@ -230,6 +230,8 @@ fn run_outputs<'a>(
     let out_dir = args.out.as_path();
     std::fs::create_dir_all(out_dir)
         .with_context(|| format!("cannot create output directory {}", out_dir.display()))?;
+    // Taken before any file of the directory is created or rewritten.
+    let lock = polydem::io::output_lock::DirectoryLock::acquire(out_dir)?;
     let schedule = |every: Option<u64>, at_start: bool| Schedule {
         start_step: sim.world.step_index,
         last_step: sim.steps,
@@ -238,6 +240,7 @@ fn run_outputs<'a>(
         at_end: true,
     };
     let mut outputs = OutputSet::new();
+    outputs.hold(lock);
     let csv = schedule(Some(sim.output_every), true);
     outputs.push(if restarted {
         CsvSeries::continue_at(out_dir, sim.world.time, csv)?
