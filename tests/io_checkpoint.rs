@@ -320,3 +320,35 @@ fn inconsistent_state_with_a_valid_checksum_is_refused() {
         other => panic!("body with shape 99: {other:?}"),
     }
 }
+
+/// Format version 10 added the run identity (an `Option<u64>` after the engine version); a version-9 file
+/// — the same payload without it — still reads, as the same simulation with no identity.
+#[test]
+fn a_version_9_checkpoint_reads_as_the_same_state_without_a_run_identity() {
+    let mut sim = scene();
+    run_to(&mut sim, 50);
+    let v10 = checkpoint::encode_in_run(&sim, Some(0x1234)).unwrap();
+    let back = checkpoint::decode(&v10).unwrap();
+    assert_eq!(back.run, Some(0x1234), "the run identity round-trips");
+    // Rebuild the version-9 layout: drop the identity (a postcard `None` is one zero byte) that follows the
+    // engine version (a one-byte length and its bytes).
+    let none = checkpoint::encode(&sim).unwrap();
+    let payload = &none[HEADER_LEN..];
+    let version_len = payload[0] as usize;
+    assert!(version_len < 128, "a one-byte varint length");
+    assert_eq!(payload[1 + version_len], 0, "the None of the run identity");
+    let mut v9_payload = payload[..1 + version_len].to_vec();
+    v9_payload.extend_from_slice(&payload[2 + version_len..]);
+    let mut v9 = none[..HEADER_LEN].to_vec();
+    v9[8..12].copy_from_slice(&9u32.to_le_bytes());
+    v9[16..24].copy_from_slice(&(v9_payload.len() as u64).to_le_bytes());
+    v9[24..28].copy_from_slice(&crc32fast::hash(&v9_payload).to_le_bytes());
+    v9.extend_from_slice(&v9_payload);
+    let old = checkpoint::decode(&v9).expect("a version-9 file reads");
+    assert_eq!(old.run, None);
+    assert_eq!(
+        checkpoint::encode(&old.simulation).unwrap(),
+        none,
+        "the version-9 file's state re-encodes to the same bytes"
+    );
+}

@@ -1,7 +1,7 @@
 //! Checkpoints: the complete state of a [`Simulation`] in a versioned binary file, from which a run
 //! continues bit for bit as if it had never stopped.
 //!
-//! # File layout (format version 2; all integers little-endian)
+//! # File layout (all integers little-endian)
 //! ```text
 //! offset  size  field
 //!      0     8  magic           b"PDEMCKPT"
@@ -32,8 +32,10 @@
 //!
 //! # Versions
 //! The payload is the serde layout of the engine's types: a change to any serialised type (a field added,
-//! removed or reordered) changes the layout, and must bump [`FORMAT_VERSION`]. A file of another version is
-//! refused, never guessed at. The engine version that wrote a file is recorded in the payload.
+//! removed or reordered) changes the layout, and must bump [`FORMAT_VERSION`]. Version 10 added the run
+//! identity to the payload; version 9 files (the same state without it) are still read. A file of any
+//! other version is refused, never guessed at. The engine version that wrote a file is recorded in the
+//! payload.
 //!
 //! Writing goes to `FILE.tmp` first and renames it, so a crash never leaves a half-written file under the
 //! final name. The user documentation is `docs/checkpoint-format.md`.
@@ -47,8 +49,10 @@ use crate::world::ContactKey;
 
 /// The first eight bytes of every checkpoint.
 pub const MAGIC: [u8; 8] = *b"PDEMCKPT";
-/// The format version this build writes and the only one it reads.
-pub const FORMAT_VERSION: u32 = 9;
+/// The format version this build writes.
+pub const FORMAT_VERSION: u32 = 10;
+/// The earlier version this build still reads: its payload is version 10's without the run identity.
+pub const PREVIOUS_VERSION: u32 = 9;
 /// Bytes before the payload.
 pub const HEADER_LEN: usize = 28;
 
@@ -57,7 +61,17 @@ pub const HEADER_LEN: usize = 28;
 pub struct CheckpointPayload {
     /// `CARGO_PKG_VERSION` of the polydem that wrote the file (informative).
     pub engine_version: String,
+    /// The identity of the run that wrote it ([`crate::io::run_identity`]); `None` for a file written
+    /// outside a run or by a version-9 build.
+    pub run: Option<u64>,
     pub simulation: Simulation,
+}
+
+/// The payload of a version-9 file.
+#[derive(serde::Deserialize)]
+struct PayloadV9 {
+    engine_version: String,
+    simulation: Simulation,
 }
 
 /// Why a checkpoint could not be written or read.
@@ -73,7 +87,7 @@ pub enum CheckpointError {
         "not a polydem checkpoint (the file does not start with the magic bytes \"PDEMCKPT\")"
     )]
     NotACheckpoint,
-    #[error("checkpoint format version {found} is not supported by this build (it reads version {supported} only)")]
+    #[error("checkpoint format version {found} is not supported by this build (it reads versions 9 to {supported})")]
     UnsupportedVersion { found: u32, supported: u32 },
     #[error("truncated checkpoint: {expected} bytes expected ({HEADER_LEN}-byte header + payload), the file has {actual}")]
     Truncated { expected: u64, actual: u64 },
@@ -89,10 +103,16 @@ pub enum CheckpointError {
     Encode { message: String },
 }
 
-/// Encodes `sim` into the checkpoint format (header + payload).
+/// Encodes `sim` into the checkpoint format (header + payload), with no run identity.
 pub fn encode(sim: &Simulation) -> Result<Vec<u8>, CheckpointError> {
+    encode_in_run(sim, None)
+}
+
+/// Encodes `sim` as a checkpoint of the run `run`.
+pub fn encode_in_run(sim: &Simulation, run: Option<u64>) -> Result<Vec<u8>, CheckpointError> {
     let payload = CheckpointPayload {
         engine_version: env!("CARGO_PKG_VERSION").to_owned(),
+        run,
         simulation: sim.clone(),
     };
     encode_payload(&payload)
@@ -129,7 +149,7 @@ pub fn decode(bytes: &[u8]) -> Result<CheckpointPayload, CheckpointError> {
         actual: bytes.len() as u64,
     };
     let version = u32_at(8).ok_or_else(header_short)?;
-    if version != FORMAT_VERSION {
+    if version != FORMAT_VERSION && version != PREVIOUS_VERSION {
         return Err(CheckpointError::UnsupportedVersion {
             found: version,
             supported: FORMAT_VERSION,
@@ -157,17 +177,36 @@ pub fn decode(bytes: &[u8]) -> Result<CheckpointPayload, CheckpointError> {
     if computed != stored {
         return Err(CheckpointError::Checksum { stored, computed });
     }
-    let decoded: CheckpointPayload =
-        postcard::from_bytes(payload).map_err(|e| CheckpointError::Decode {
-            message: e.to_string(),
-        })?;
+    let undecodable = |e: postcard::Error| CheckpointError::Decode {
+        message: e.to_string(),
+    };
+    let decoded = if version == PREVIOUS_VERSION {
+        let old: PayloadV9 = postcard::from_bytes(payload).map_err(undecodable)?;
+        CheckpointPayload {
+            engine_version: old.engine_version,
+            run: None,
+            simulation: old.simulation,
+        }
+    } else {
+        postcard::from_bytes::<CheckpointPayload>(payload).map_err(undecodable)?
+    };
     check_consistency(&decoded.simulation).map_err(|what| CheckpointError::Invalid { what })?;
     Ok(decoded)
 }
 
-/// Writes `sim` to `path` (through `path.tmp` and a rename); returns the number of bytes written.
+/// Writes `sim` to `path` (through `path.tmp` and a rename), with no run identity; returns the number of
+/// bytes written.
 pub fn save(path: &Path, sim: &Simulation) -> Result<u64, CheckpointError> {
-    let bytes = encode(sim)?;
+    save_in_run(path, sim, None)
+}
+
+/// [`save`] for a checkpoint of the run `run`.
+pub fn save_in_run(
+    path: &Path,
+    sim: &Simulation,
+    run: Option<u64>,
+) -> Result<u64, CheckpointError> {
+    let bytes = encode_in_run(sim, run)?;
     let mut tmp = path.as_os_str().to_owned();
     tmp.push(".tmp");
     let tmp = PathBuf::from(tmp);

@@ -13,20 +13,22 @@ use crate::scene::Simulation;
 /// Checkpoints written on a schedule into `DIR/checkpoints/`.
 pub struct CheckpointSeries {
     out_dir: PathBuf,
+    run: u64,
     schedule: Schedule,
     written: Vec<CheckpointRecord>,
     time: Duration,
 }
 
 impl CheckpointSeries {
-    /// Creates `out_dir/checkpoints/` if needed.
-    pub fn new(out_dir: &Path, schedule: Schedule) -> io::Result<Self> {
+    /// Checkpoints of run `run` ([`crate::io::run_identity`]); creates `out_dir/checkpoints/` if needed.
+    pub fn new(out_dir: &Path, run: u64, schedule: Schedule) -> io::Result<Self> {
         let dir = out_dir.join("checkpoints");
         std::fs::create_dir_all(&dir).map_err(|e| {
             io::Error::new(e.kind(), format!("cannot create {}: {e}", dir.display()))
         })?;
         Ok(Self {
             out_dir: out_dir.to_owned(),
+            run,
             schedule,
             written: Vec::new(),
             time: Duration::ZERO,
@@ -50,7 +52,8 @@ impl Output for CheckpointSeries {
     fn write(&mut self, sim: &Simulation, step: u64) -> io::Result<()> {
         let start = Instant::now();
         let file = format!("checkpoints/step_{step:09}.pdck");
-        let bytes = checkpoint::save(&self.out_dir.join(&file), sim).map_err(io::Error::other)?;
+        let bytes = checkpoint::save_in_run(&self.out_dir.join(&file), sim, Some(self.run))
+            .map_err(io::Error::other)?;
         let seconds = start.elapsed();
         self.time += seconds;
         self.written.push(CheckpointRecord {

@@ -7,7 +7,8 @@
 //! - [`checkpoint`]: the versioned binary checkpoint of a whole simulation, for restarts.
 //! - [`output`]: the [`output::Output`] trait a run's outputs share, and [`output::OutputSet`], the
 //!   observer that hands them the state; its implementations: [`csv_series`], [`vtk_frames`],
-//!   [`checkpoint_series`], [`contact_network`]; [`output_lock`], one run per output directory.
+//!   [`checkpoint_series`], [`contact_network`]; [`output_lock`], one run per output directory;
+//!   [`run_identity`], which run a directory and a checkpoint belong to.
 
 pub mod checkpoint;
 pub mod checkpoint_series;
@@ -18,6 +19,7 @@ pub mod csv_series;
 pub mod output;
 pub mod output_lock;
 pub mod pairs_jsonl;
+pub mod run_identity;
 pub mod run_summary;
 pub mod vtk;
 pub mod vtk_frames;

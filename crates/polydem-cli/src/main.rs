@@ -156,22 +156,27 @@ fn every_steps(flag: &str, interval: Option<f64>, dt: f64) -> Result<Option<u64>
 fn run(args: &RunArgs) -> Result<()> {
     use polydem::io::run_summary::{summary_json, summary_text, RunOrigin};
 
-    let (mut sim, source, restarted) = match (&args.restart, &args.scene) {
+    let (mut sim, source, run) = match (&args.restart, &args.scene) {
         (Some(file), _) => {
             let payload = polydem::io::checkpoint::load(file)
                 .with_context(|| format!("cannot restart from checkpoint {}", file.display()))?;
-            (payload.simulation, file.display().to_string(), true)
+            let run = RunStart::Restart {
+                checkpoint: file.clone(),
+                run: payload.run,
+            };
+            (payload.simulation, file.display().to_string(), run)
         }
         (None, Some(scene)) => (
             polydem::scene::load_scene(scene)?,
             scene.display().to_string(),
-            false,
+            RunStart::Fresh,
         ),
         (None, None) => bail!("give a scene file or --restart FILE"),
     };
     if let Some(t) = args.end_time {
         sim.set_end_time(t).context("--end-time")?;
     }
+    let restarted = matches!(run, RunStart::Restart { .. });
     let origin = RunOrigin {
         source,
         restarted,
@@ -179,7 +184,7 @@ fn run(args: &RunArgs) -> Result<()> {
         start_time: sim.world.time,
     };
     let out_dir = args.out.as_path();
-    let mut outputs = run_outputs(args, &sim, restarted)?;
+    let mut outputs = run_outputs(args, &sim, &run)?;
     if !args.quiet {
         eprintln!("{}", run_header(&origin, &sim));
     }
@@ -208,18 +213,28 @@ fn run(args: &RunArgs) -> Result<()> {
     Ok(())
 }
 
+/// How a run starts: from its scene, or from a checkpoint (with the identity of the run that wrote it).
+enum RunStart {
+    Fresh,
+    Restart {
+        checkpoint: PathBuf,
+        run: Option<u64>,
+    },
+}
+
 /// The outputs of `polydem run` in the order they write at a step: CSV series, VTK frames, the contact
 /// network, checkpoints (last, so that the series on disk reach each checkpoint). A restart continues the
 /// series the earlier run left in the same directory.
 fn run_outputs<'a>(
     args: &RunArgs,
     sim: &polydem::scene::Simulation,
-    restarted: bool,
+    start: &RunStart,
 ) -> Result<polydem::io::output::OutputSet<'a>> {
     use polydem::io::checkpoint_series::CheckpointSeries;
     use polydem::io::contact_network::ContactNetwork;
     use polydem::io::csv_series::CsvSeries;
     use polydem::io::output::{OutputSet, Schedule};
+    use polydem::io::run_identity;
     use polydem::io::vtk::VtkWriter;
     use polydem::io::vtk_frames::VtkFrames;
 
@@ -232,6 +247,16 @@ fn run_outputs<'a>(
         .with_context(|| format!("cannot create output directory {}", out_dir.display()))?;
     // Taken before any file of the directory is created or rewritten.
     let lock = polydem::io::output_lock::DirectoryLock::acquire(out_dir)?;
+    let (run, restarted) = match start {
+        RunStart::Fresh => {
+            let run = run_identity::new_run();
+            run_identity::record(out_dir, run)?;
+            (run, false)
+        }
+        RunStart::Restart { checkpoint, run } => {
+            (run_identity::continue_in(out_dir, *run, checkpoint)?, true)
+        }
+    };
     let schedule = |every: Option<u64>, at_start: bool| Schedule {
         start_step: sim.world.step_index,
         last_step: sim.steps,
@@ -270,6 +295,7 @@ fn run_outputs<'a>(
     if let Some(every) = checkpoint_every {
         outputs.push(CheckpointSeries::new(
             out_dir,
+            run,
             schedule(Some(every), false),
         )?);
     }

@@ -168,3 +168,66 @@ fn a_second_run_into_a_directory_being_written_is_refused() {
     );
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn a_restart_into_another_runs_directory_is_refused_and_leaves_it_as_it_was() {
+    let dir = out_dir("splice");
+    let os = |s: &str| OsString::from(s);
+    let (first, second) = (dir.join("first"), dir.join("second"));
+    let two = Path::new(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../scenes/two_polyhedra_elastic.toml"
+    ));
+    for (scene, out) in [(scene(), &first), (two.to_owned(), &second)] {
+        succeeds(&[
+            os("run"),
+            scene.into(),
+            os("--out"),
+            out.into(),
+            os("--end-time"),
+            os("0.05"),
+            os("--checkpoint-interval"),
+            os("0.02"),
+            os("--quiet"),
+        ]);
+    }
+    let checkpoint = std::fs::read_dir(first.join("checkpoints"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .min()
+        .expect("checkpoints");
+    let before = read(&second.join("bodies.csv"));
+    let o = command(&[
+        os("run"),
+        os("--restart"),
+        checkpoint.clone().into(),
+        os("--out"),
+        second.clone().into(),
+        os("--quiet"),
+    ])
+    .output()
+    .expect("polydem runs");
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        !o.status.success() && stderr.contains("holds the outputs of run"),
+        "restart of {} into {}: status {:?}, stderr: {stderr}",
+        checkpoint.display(),
+        second.display(),
+        o.status
+    );
+    assert_eq!(
+        read(&second.join("bodies.csv")),
+        before,
+        "the refused restart rewrote bodies.csv"
+    );
+    // Into its own directory it continues.
+    succeeds(&[
+        os("run"),
+        os("--restart"),
+        checkpoint.into(),
+        os("--out"),
+        first.into(),
+        os("--quiet"),
+    ]);
+    let _ = std::fs::remove_dir_all(&dir);
+}
