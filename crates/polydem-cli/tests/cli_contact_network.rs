@@ -11,6 +11,15 @@ use std::ffi::OsString;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
+/// 200 steps of sphere bed a with the network every 50 steps.
+const BED_RUN: [&str; 5] = [
+    "run",
+    "--end-time",
+    "0.0004",
+    "--contacts-interval",
+    "0.0001",
+];
+
 fn out_dir(case: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!(
         "polydem-cli-contacts-{}-{case}",
@@ -68,16 +77,7 @@ fn num(field: &str) -> f64 {
 fn the_contact_network_sums_to_the_wall_forces_and_each_frame_draws_its_rows() {
     let out = out_dir("bed");
     let scene = scene_path("sphere_bed_a_hertz_5ms.toml");
-    run(
-        &[
-            "run",
-            "--end-time",
-            "0.0004",
-            "--contacts-interval",
-            "0.0001",
-        ],
-        &[("", &scene), ("--out", &out)],
-    );
+    run(&BED_RUN, &[("", &scene), ("--out", &out)]);
     let contacts = rows(
         &out.join("contacts.csv"),
         "t,kind,a,b,px,py,pz,nx,ny,nz,depth,fx,fy,fz",
@@ -250,16 +250,7 @@ fn the_flat_sphere_layout_writes_the_same_contact_network_as_the_general_step() 
     .unwrap();
     let (general, flat) = (dir.join("general"), dir.join("flat"));
     for (scene, out) in [(bed, &general), (flat_scene, &flat)] {
-        run(
-            &[
-                "run",
-                "--end-time",
-                "0.0004",
-                "--contacts-interval",
-                "0.0001",
-            ],
-            &[("", &scene), ("--out", out)],
-        );
+        run(&BED_RUN, &[("", &scene), ("--out", out)]);
     }
     assert!(
         read(&flat.join("summary.txt")).contains("flat sphere layout"),
