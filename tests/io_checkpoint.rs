@@ -352,3 +352,35 @@ fn a_version_9_checkpoint_reads_as_the_same_state_without_a_run_identity() {
         "the version-9 file's state re-encodes to the same bytes"
     );
 }
+
+/// A checkpoint whose stored state is not finite (a NaN quaternion, an infinite velocity) is refused
+/// naming the body and the quantity, instead of being stepped into NaN output.
+#[test]
+fn a_checkpoint_with_a_non_finite_body_state_is_refused() {
+    let mut sim = scene();
+    run_to(&mut sim, 10);
+    let good = sim.clone();
+    let cases: [(&str, fn(&mut Simulation)); 3] = [
+        ("orientation", |s| {
+            let q = s.world.bodies[2].orientation.quaternion().coords;
+            s.world.bodies[2].orientation = nalgebra::UnitQuaternion::new_unchecked(
+                nalgebra::Quaternion::new(f64::NAN, q.x, q.y, q.z),
+            );
+        }),
+        ("velocity", |s| s.world.bodies[2].velocity.y = f64::INFINITY),
+        ("position", |s| s.world.bodies[2].position.z = f64::NAN),
+    ];
+    for (what, damage) in cases {
+        let mut bad = good.clone();
+        damage(&mut bad);
+        let bytes = checkpoint::encode(&bad).unwrap();
+        match checkpoint::decode(&bytes) {
+            Err(CheckpointError::Invalid { what: message }) => assert!(
+                message.contains("body 2") && message.contains(what),
+                "{what}: {message}"
+            ),
+            other => panic!("{what} damaged: {other:?}"),
+        }
+    }
+    checkpoint::decode(&checkpoint::encode(&good).unwrap()).expect("the undamaged state reads");
+}

@@ -43,6 +43,7 @@
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
+use crate::dynamics::RigidBody;
 use crate::scene::Simulation;
 use crate::shape::Shape;
 use crate::world::ContactKey;
@@ -242,6 +243,33 @@ pub fn load(path: &Path) -> Result<CheckpointPayload, CheckpointError> {
 }
 
 /// Every length and index of a decoded simulation that a step relies on; the first problem found.
+/// A body's state is finite, its mass positive and its orientation a unit quaternion (to rounding of the
+/// products that built it: 1e-9 is far above the drift of a long run and far below any damage).
+fn check_body_state(body: &RigidBody) -> Result<(), String> {
+    let finite = |v: &crate::math::Vector| v.iter().all(|x| x.is_finite());
+    let q = body.orientation.quaternion();
+    let checks = [
+        (finite(&body.position.coords), "position"),
+        (finite(&body.velocity), "velocity"),
+        (finite(&body.angular_momentum), "angular momentum"),
+        (
+            q.coords.iter().all(|x| x.is_finite()) && (q.norm() - 1.0).abs() <= 1e-9,
+            "orientation",
+        ),
+        (body.mass.is_finite() && body.mass > 0.0, "mass"),
+    ];
+    match checks.iter().find(|(ok, _)| !ok) {
+        Some((_, what)) => Err(format!(
+            "{what} is not finite or not valid (position {:?}, velocity {:?}, orientation {:?}, mass {})",
+            body.position.coords.as_slice(),
+            body.velocity.as_slice(),
+            q.coords.as_slice(),
+            body.mass
+        )),
+        None => Ok(()),
+    }
+}
+
 fn check_consistency(sim: &Simulation) -> Result<(), String> {
     let w = &sim.world;
     let n = w.bodies.len();
@@ -288,6 +316,10 @@ fn check_consistency(sim: &Simulation) -> Result<(), String> {
                 w.radii[i]
             ));
         }
+        check_body_state(&w.bodies[i]).map_err(|what| format!("body {i} ('{name}'): {what}"))?;
+    }
+    if !(w.time.is_finite() && sim.params.dt.is_finite() && sim.params.dt > 0.0) {
+        return Err(format!("time {} s, time step {} s", w.time, sim.params.dt));
     }
     for (k, wall) in w.walls.iter().enumerate() {
         if wall.material as usize >= w.materials.len() {
