@@ -360,7 +360,8 @@ fn a_checkpoint_with_a_non_finite_body_state_is_refused() {
     let mut sim = scene();
     run_to(&mut sim, 10);
     let good = sim.clone();
-    let cases: [(&str, fn(&mut Simulation)); 3] = [
+    type Damage = fn(&mut Simulation);
+    let cases: [(&str, Damage); 3] = [
         ("orientation", |s| {
             let q = s.world.bodies[2].orientation.quaternion().coords;
             s.world.bodies[2].orientation = nalgebra::UnitQuaternion::new_unchecked(
