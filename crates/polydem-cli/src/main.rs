@@ -94,7 +94,10 @@ fn contact(pairs: &std::path::Path, out: Option<&std::path::Path>) -> Result<()>
                 format!("cannot create output file {}", path.display())
             })?))
         }
-        None => Box::new(BufWriter::new(io::stdout().lock())),
+        // Answers reach a reader line by line (an interactive session or a driving program on a pipe)
+        // unless standard output is a regular file, where one buffer is cheaper.
+        None if stdout_is_regular_file() => Box::new(BufWriter::new(io::stdout().lock())),
+        None => Box::new(io::LineWriter::new(io::stdout().lock())),
     };
     let summary = answer_stream(input, output, &query_polyhedra)
         .context("reading pairs or writing answers")?;
@@ -103,6 +106,17 @@ fn contact(pairs: &std::path::Path, out: Option<&std::path::Path>) -> Result<()>
         summary.answered, summary.errors, summary.blank
     );
     Ok(())
+}
+
+/// Whether standard output is redirected to a regular file.
+fn stdout_is_regular_file() -> bool {
+    use std::os::fd::AsFd;
+    io::stdout()
+        .as_fd()
+        .try_clone_to_owned()
+        .map(File::from)
+        .and_then(|f| f.metadata())
+        .is_ok_and(|m| m.file_type().is_file())
 }
 
 /// Options of `polydem run`.

@@ -220,3 +220,33 @@ fn contact_fails_cleanly_on_a_missing_file() {
         "stderr: {stderr}"
     );
 }
+
+/// A program driving `polydem contact -` over pipes gets each answer as soon as it sends the pair, before
+/// it closes standard input (answers are not held in a block buffer when standard output is not a file).
+#[test]
+fn contact_on_a_pipe_answers_each_line_before_the_input_ends() {
+    use std::io::BufRead;
+    let mut child = Command::new(env!("CARGO_BIN_EXE_polydem"))
+        .args(["contact", "-"])
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::null())
+        .spawn()
+        .expect("polydem starts");
+    let mut stdin = child.stdin.take().unwrap();
+    let first_line = input(0.1, 0.2).lines().next().unwrap().to_owned();
+    writeln!(stdin, "{first_line}").unwrap();
+    stdin.flush().unwrap();
+    let (tx, rx) = std::sync::mpsc::channel();
+    let stdout = child.stdout.take().unwrap();
+    std::thread::spawn(move || {
+        let mut line = String::new();
+        let _ = std::io::BufReader::new(stdout).read_line(&mut line);
+        let _ = tx.send(line);
+    });
+    let answer = rx.recv_timeout(std::time::Duration::from_secs(20));
+    drop(stdin);
+    let _ = child.wait();
+    let answer = answer.expect("no answer within 20 s while standard input stayed open");
+    assert!(answer.contains("\"apart\""), "answer: {answer}");
+}
