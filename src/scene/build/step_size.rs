@@ -5,7 +5,6 @@
 use std::ops::Range;
 
 use crate::law::pair::contact_radius;
-use crate::law::RadiusScaling;
 use crate::math::Real;
 use crate::world::{MaterialTable, Wall};
 
@@ -114,12 +113,8 @@ fn pair_estimates(table: &MaterialTable, l: &Lightest) -> Vec<PairEstimate> {
                 candidates.push((mb, rb));
             }
             for (m, r) in candidates {
-                let model = match model.normal.radius_scaling {
-                    RadiusScaling::Constant => *model,
-                    RadiusScaling::SqrtEffectiveRadius => model.with_root_radius(r.sqrt()),
-                };
                 estimates.push(PairEstimate {
-                    model,
+                    model: model.for_root_radius(r.sqrt()),
                     effective_mass: m,
                 });
             }
