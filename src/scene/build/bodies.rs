@@ -8,6 +8,7 @@ use crate::fixed_hash::FixedHashMap;
 use crate::math::{Point, Pose, Real, Rotation, Vector};
 use crate::shape::Shape;
 
+use super::super::orientation::unit_quaternion;
 use super::super::schema::{BodySection, SceneFile};
 use super::materials::Materials;
 use super::shapes::{volume_and_moments, Shapes};
@@ -114,7 +115,7 @@ fn read_body(
     })
 }
 
-/// `orientation` (a unit quaternion, |q| within 1e-6 of 1, normalised) or `axis_angle`; absent = identity.
+/// `orientation` (a unit quaternion, see [`unit_quaternion`]) or `axis_angle`; absent = identity.
 fn orientation(ctx: &Ctx, k: usize, b: &BodySection) -> Result<Rotation, SceneError> {
     let f = |x: &str| format!("body[{k}].{x}");
     match (&b.orientation, &b.axis_angle) {
@@ -135,22 +136,6 @@ fn orientation(ctx: &Ctx, k: usize, b: &BodySection) -> Result<Rotation, SceneEr
         )),
         (None, None) => Ok(Rotation::identity()),
     }
-}
-
-/// How far from 1 the norm of a given orientation quaternion may be: it is normalised within this, and a
-/// farther one is refused as a typing error rather than silently rescaled.
-pub(super) const QUATERNION_NORM_TOLERANCE: Real = 1e-6;
-
-/// The rotation of `[w, x, y, z]`, normalised, or the norm when it is not within
-/// [`QUATERNION_NORM_TOLERANCE`] of 1 (or not finite).
-pub(super) fn unit_quaternion([w, x, y, z]: [Real; 4]) -> Result<Rotation, Real> {
-    let norm = (w * w + x * x + y * y + z * z).sqrt();
-    if !norm.is_finite() || (norm - 1.0).abs() > QUATERNION_NORM_TOLERANCE {
-        return Err(norm);
-    }
-    Ok(Rotation::from_quaternion(nalgebra::Quaternion::new(
-        w, x, y, z,
-    )))
 }
 
 /// `motion`: `"dynamic"` (absent), `"fixed"` or `"prescribed"` (with the body's velocities).

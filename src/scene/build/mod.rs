@@ -1,8 +1,8 @@
 //! Validation of a parsed scene and construction of the [`Simulation`] it describes, one file per table of
-//! the scene file: [`materials`], [`interactions`] (the contact laws), [`shapes`], [`bodies`],
-//! [`body_files`], [`walls`] (`[[wall]]` and `[[box]]`), [`step_size`] (the time step) and
-//! [`simulation`] (the rest of `[simulation]`); [`assemble`] puts the checked parts into a [`World`].
-//! [`build`] reads as the list of tables, in the order their errors are reported.
+//! the scene file: `materials`, `interactions` (the contact laws), `shapes`, `bodies`, `body_files`,
+//! `walls` (`[[wall]]` and `[[box]]`), `step_size` (the time step) and `simulation` (the rest of
+//! `[simulation]`); `assemble` puts the checked parts into a [`World`]. `build` reads as the list of
+//! tables, in the order their errors are reported.
 //!
 //! Every check names the file, the line (from the span toml keeps for each value) and the field, in the
 //! form `FILE:LINE: FIELD: what is wrong`, e.g. `scenes/drop.toml:14: interaction[0].normal_stiffness:
