@@ -1,8 +1,8 @@
 //! `[[shape]]`: one builder per shape kind, and the few facts of a built [`Shape`] the other tables need
 //! (mass properties, bounding radius).
 //!
-//! A new kind is a scene key in [`KINDS`] with its own field (added to `ShapeSection` and to
-//! [`kind_fields`]), a builder called from [`build_kind`], and its arms in [`volume_and_moments`] and
+//! A new kind is one row of [`KINDS`] (its scene key, the `ShapeSection` field that describes it, its
+//! builder), that field in [`kind_fields`], and its arms in [`volume_and_moments`] and
 //! [`bounding_radius`].
 
 use std::sync::Arc;
@@ -14,11 +14,15 @@ use crate::shape::{ConvexPolyhedron, Shape, Sphere};
 use super::super::schema::{SceneFile, ShapeSection};
 use super::{Ctx, SceneError};
 
-/// The shape kinds of the scene format, each with the one field that describes it.
-const KINDS: [(&str, &str); 3] = [
-    ("box", "half_extents"),
-    ("sphere", "radius"),
-    ("polyhedron", "points"),
+/// Builds the shape of one `[[shape]]` of a kind.
+type Builder = fn(&Named) -> Result<(Shape, Pose), SceneError>;
+
+/// The shape kinds of the scene format: the scene key, the one field that describes the kind, its
+/// builder.
+const KINDS: [(&str, &str, Builder); 3] = [
+    ("box", "half_extents", box_shape),
+    ("sphere", "radius", sphere_shape),
+    ("polyhedron", "points", polyhedron_shape),
 ];
 
 /// Which kind-specific fields a `[[shape]]` gives, in the order a misplaced one is reported.
@@ -73,7 +77,7 @@ fn build_shape(
     s: &ShapeSection,
 ) -> Result<(Shape, Pose), SceneError> {
     let kind = s.kind.get_ref().as_str();
-    let Some((_, own)) = KINDS.iter().find(|(key, _)| *key == kind) else {
+    let Some((_, own, builder)) = KINDS.iter().find(|(key, _, _)| *key == kind) else {
         return Err(ctx.invalid(
             s.kind.span(),
             format!("shape[{k}].kind"),
@@ -109,12 +113,15 @@ fn build_shape(
         s,
         used_by: &used_by,
     };
-    build_kind(&named, kind)
+    builder(&named)
 }
 
 /// `"box", "sphere" or "polyhedron"`.
 fn expected_kinds() -> String {
-    let quoted: Vec<String> = KINDS.iter().map(|(key, _)| format!("\"{key}\"")).collect();
+    let quoted: Vec<String> = KINDS
+        .iter()
+        .map(|(key, _, _)| format!("\"{key}\""))
+        .collect();
     let (last, rest) = quoted.split_last().expect("at least one kind");
     format!("{} or {last}", rest.join(", "))
 }
@@ -154,15 +161,6 @@ impl Named<'_> {
             )
         })?;
         Ok((Shape::Polyhedron(Arc::new(p)), frame))
-    }
-}
-
-/// The builder of each kind of [`KINDS`].
-fn build_kind(named: &Named, kind: &str) -> Result<(Shape, Pose), SceneError> {
-    match kind {
-        "box" => box_shape(named),
-        "sphere" => sphere_shape(named),
-        _ => polyhedron_shape(named),
     }
 }
 
