@@ -70,6 +70,24 @@ impl DampingLaw {
         })
     }
 
+    /// The dimensionless coefficient ζ̂ of a viscous law; 0 for the others.
+    pub fn viscous_coefficient(&self) -> Real {
+        match *self {
+            Self::Viscous { coefficient } => coefficient,
+            Self::None | Self::Dashpot { .. } => 0.0,
+        }
+    }
+
+    /// Whether the law is a viscous law or dashpot of coefficient 0, which adds no force: the
+    /// `undamped_contacts` skip may replace it by [`DampingLaw::None`] (`crate::world::skips`). False for
+    /// `None` itself, which has nothing to skip.
+    pub fn has_zero_coefficient(&self) -> bool {
+        match *self {
+            Self::None => false,
+            Self::Viscous { coefficient } | Self::Dashpot { coefficient } => coefficient == 0.0,
+        }
+    }
+
     /// The damping force (N, along n on B) at overlap δ, overlap rate δ̇, for the normal law (k_n, n) and
     /// effective mass m*.
     #[inline]
@@ -237,6 +255,13 @@ mod tests {
             "ζ̂ = {coefficient}, 2ζ = {}",
             2.0 * zeta
         );
+        assert_eq!(
+            DampingLaw::from_restitution(1.0, e)
+                .unwrap()
+                .viscous_coefficient(),
+            coefficient
+        );
+        assert_eq!(DampingLaw::None.viscous_coefficient(), 0.0);
         assert_eq!(damping_for_restitution(1.5, 1.0).unwrap(), 0.0);
         assert_eq!(
             restitution_for_damping(1.0, 2.5),

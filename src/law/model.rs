@@ -73,6 +73,20 @@ pub struct ContactResponse {
 }
 
 impl ContactModel {
+    /// The model with the slots the step's skips make free (`crate::world::skips`): no tangential spring
+    /// when `frictionless_history` and μ = 0, no damping term when `undamped_contacts` and its coefficient
+    /// is 0. The forces are the same up to the sign of zero.
+    pub fn with_skips(&self, frictionless_history: bool, undamped_contacts: bool) -> ContactModel {
+        let mut m = *self;
+        if frictionless_history && m.tangential.is_frictionless() {
+            m.tangential = TangentialLaw::None;
+        }
+        if undamped_contacts && m.damping.has_zero_coefficient() {
+            m.damping = DampingLaw::None;
+        }
+        m
+    }
+
     /// Evaluates the model on one contact. `history` is the pair's tangential state (stored by the caller);
     /// it is reset when the shapes do not overlap.
     #[inline]
@@ -115,6 +129,42 @@ impl ContactModel {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The skips drop a spring only when μ = 0 and a damping term only when its coefficient is 0; every
+    /// other slot is kept as it is.
+    #[test]
+    fn skips_free_only_the_slots_that_carry_no_force() {
+        let normal = NormalLaw::linear(1e6).unwrap();
+        let frictionless = TangentialLaw::Spring {
+            stiffness: 1e5,
+            friction: 0.0,
+            rotation: Default::default(),
+        };
+        let model = ContactModel {
+            normal,
+            damping: DampingLaw::Viscous { coefficient: 0.0 },
+            tangential: frictionless,
+        };
+        let free = model.with_skips(true, true);
+        assert_eq!(free.tangential, TangentialLaw::None, "model {model:?}");
+        assert_eq!(free.damping, DampingLaw::None, "model {model:?}");
+        assert_eq!(model.with_skips(false, false), model);
+        let kept = ContactModel {
+            normal,
+            damping: DampingLaw::Dashpot { coefficient: 3.0 },
+            tangential: TangentialLaw::spring(1e5, 0.4).unwrap(),
+        };
+        assert_eq!(kept.with_skips(true, true), kept);
+        let zero_dashpot = ContactModel {
+            damping: DampingLaw::Dashpot { coefficient: 0.0 },
+            ..kept
+        };
+        assert_eq!(
+            zero_dashpot.with_skips(false, true).damping,
+            DampingLaw::None
+        );
+        assert_eq!(zero_dashpot.with_skips(true, false), zero_dashpot);
+    }
     use crate::contact::SolverStatus;
     use crate::law::{DampingLaw, NormalLaw};
 

@@ -132,6 +132,47 @@ impl NormalLaw {
         power_law_potential(self.stiffness, self.exponent, overlap)
     }
 
+    /// Whether the stiffnesses of a model with this normal slot follow R* of each contact
+    /// ([`RadiusScaling::SqrtEffectiveRadius`]).
+    #[inline]
+    pub fn scales_with_radius(&self) -> bool {
+        match self.radius_scaling {
+            RadiusScaling::Constant => false,
+            RadiusScaling::SqrtEffectiveRadius => true,
+        }
+    }
+
+    /// Whether the law's contact time and stiffest point depend on the impact speed (n ≠ 1), so that the
+    /// time-step guard needs a characteristic speed.
+    pub fn needs_impact_speed(&self) -> bool {
+        self.exponent != 1.0
+    }
+
+    /// What the time-step guard needs of the normal law for a head-on elastic impact of effective mass
+    /// `mass` (kg) at speed `speed` (m/s): the contact time (s) and the stiffness (N/m) of the stiffest
+    /// point. Linear law: π√(m/k_n) and k_n, whatever the speed. Power law: [`Self::elastic_contact_time`]
+    /// and the tangent stiffness n k_n δ_max^(n−1) at the peak overlap δ_max = ((n+1) m v²/(2k_n))^(1/(n+1));
+    /// `None` without a speed.
+    pub fn impact_time_and_stiffness(
+        &self,
+        mass: Real,
+        speed: Option<Real>,
+    ) -> Option<(Real, Real)> {
+        if !self.needs_impact_speed() {
+            return Some((
+                std::f64::consts::PI * (mass / self.stiffness).sqrt(),
+                self.stiffness,
+            ));
+        }
+        let v = speed?;
+        let n = self.exponent;
+        let max_overlap = ((n + 1.0) * mass * v * v / (2.0 * self.stiffness)).powf(1.0 / (n + 1.0));
+        Some((
+            self.elastic_contact_time(mass, v),
+            n * self.stiffness * max_overlap.powf(n - 1.0),
+        ))
+    }
+
     /// Duration of an elastic (undamped) impact at approach speed `speed` with effective mass `mass`:
     /// t_c = 2 (δ_max/v) ∫₀¹ dx/√(1 − x^(n+1)), δ_max = ((n+1) m v²/(2k))^(1/(n+1)). For n = 1 this is π√(m/k).
     pub fn elastic_contact_time(&self, mass: Real, speed: Real) -> Real {
@@ -224,6 +265,33 @@ mod tests {
         assert!(
             (measured - expected).abs() <= 1e-8 * expected,
             "Hertz t_c = {measured}, quadrature {expected}"
+        );
+    }
+
+    /// The guard's facts: π√(m/k) and k for the linear law at any speed; for a power law, the elastic
+    /// contact time and the tangent stiffness n k δ^(n−1) at the peak overlap of the energy balance
+    /// m v²/2 = k δ^(n+1)/(n+1), and nothing without a speed.
+    #[test]
+    fn impact_time_and_stiffness_are_the_guard_quantities() {
+        let (m, v) = (0.3, 2.0);
+        let linear = NormalLaw::linear(4e6).unwrap();
+        let (tc, k) = linear.impact_time_and_stiffness(m, None).unwrap();
+        let expected = std::f64::consts::PI * (m / 4e6 as Real).sqrt();
+        assert!(
+            (tc - expected).abs() <= 1e-15 * expected && k == 4e6,
+            "linear: t_c {tc} (expected {expected}), k {k} (expected 4e6)"
+        );
+        assert!(!linear.needs_impact_speed());
+        let hertz = NormalLaw::hertz(1e9).unwrap();
+        assert!(hertz.needs_impact_speed());
+        assert_eq!(hertz.impact_time_and_stiffness(m, None), None);
+        let (tc, k) = hertz.impact_time_and_stiffness(m, Some(v)).unwrap();
+        let peak = (2.5 * 0.5 * m * v * v / 1e9 as Real).powf(1.0 / 2.5);
+        let k_expected = power_law_tangent_stiffness(1e9, 1.5, peak);
+        let t_expected = hertz.elastic_contact_time(m, v);
+        assert!(
+            (k - k_expected).abs() <= 1e-12 * k_expected && tc == t_expected,
+            "Hertz: k {k} (expected {k_expected}, tolerance 1e-12 relative), t_c {tc} (expected {t_expected})"
         );
     }
 

@@ -73,6 +73,17 @@ impl ContactModel {
         }
     }
 
+    /// The model of one contact whose √R* is `root_radius`: the model itself when its stiffnesses are
+    /// constants, otherwise [`ContactModel::with_root_radius`].
+    #[inline]
+    pub fn for_root_radius(&self, root_radius: Real) -> ContactModel {
+        if self.normal.scales_with_radius() {
+            self.with_root_radius(root_radius)
+        } else {
+            *self
+        }
+    }
+
     /// k_n and the tangential stiffness multiplied by `root_radius` = √R*; the result has constant
     /// stiffnesses.
     #[inline]
@@ -171,6 +182,33 @@ mod tests {
             on_wall.normal.stiffness
         );
         assert_eq!(per_root.for_shapes(None, &a), on_wall);
+    }
+
+    /// The model for a √R* is the one for the two radii, bit for bit, whether or not the law scales.
+    #[test]
+    fn model_for_a_root_radius_is_the_model_for_the_radii() {
+        let bed = ElasticMaterial::new(1e9, 0.2).unwrap();
+        let options = HertzMindlinOptions {
+            tangential_damping: true,
+            limit_force: false,
+        };
+        let scaling = material_hertz_mindlin(&bed, &bed, 0.4, 0.2, options).unwrap();
+        let constant = ContactModel {
+            normal: crate::law::NormalLaw::hertz(1e8).unwrap(),
+            damping: crate::law::DampingLaw::None,
+            tangential: TangentialLaw::spring(1e5, 0.3).unwrap(),
+        };
+        for model in [scaling, constant] {
+            for (ra, rb) in [(Some(2.1e-3), Some(5e-3)), (None, Some(1e-3))] {
+                let root = effective_contact_radius(ra, rb).sqrt();
+                assert_eq!(
+                    model.for_root_radius(root),
+                    model.for_contact_radii(ra, rb),
+                    "model {model:?}, radii {ra:?} {rb:?}"
+                );
+            }
+        }
+        assert_eq!(constant.for_root_radius(0.5), constant);
     }
 
     #[test]

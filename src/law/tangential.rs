@@ -178,6 +178,23 @@ impl TangentialLaw {
         self
     }
 
+    /// The tangential stiffness (N/m) the time-step guard bounds: k_t of a constant spring; zero without a
+    /// spring, and for the Mindlin springs, which the guard bounds through the normal law: their
+    /// k_t = 8 G* √(R* δ) is 4G*/E* times the Hertz tangent stiffness 2 E* √(R* δ), a ratio
+    /// 2(1 − ν)/(2 − ν) ≤ 1 for two bodies of one material with ν ≥ 0.
+    pub fn stability_stiffness(&self) -> Real {
+        match *self {
+            Self::Spring { stiffness, .. } => stiffness,
+            Self::None | Self::Mindlin { .. } | Self::DampedMindlin { .. } => 0.0,
+        }
+    }
+
+    /// Whether the spring can carry no force (μ = 0): the `frictionless_history` skip may drop it
+    /// (`crate::world::skips`).
+    pub fn is_frictionless(&self) -> bool {
+        self.stiffness_and_friction(0.0).1 == 0.0
+    }
+
     /// The tangential stiffness (N/m) at overlap δ, and μ.
     pub fn stiffness_and_friction(&self, overlap: Real) -> (Real, Real) {
         match *self {
@@ -386,6 +403,26 @@ pub fn release_spring(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The guard bounds a constant spring by its k_t and leaves the Mindlin springs to the normal law.
+    #[test]
+    fn stability_stiffness_is_the_constant_spring_only() {
+        assert_eq!(
+            TangentialLaw::spring(2e5, 0.3)
+                .unwrap()
+                .stability_stiffness(),
+            2e5
+        );
+        let mindlin = TangentialLaw::Mindlin {
+            coefficient: 1e9,
+            friction: 0.3,
+            rotation: SpringRotation::Exact,
+        };
+        assert_eq!(mindlin.stability_stiffness(), 0.0);
+        assert_eq!(TangentialLaw::None.stability_stiffness(), 0.0);
+        assert!(TangentialLaw::spring(2e5, 0.0).unwrap().is_frictionless());
+        assert!(!mindlin.is_frictionless());
+    }
     use crate::math::Rotation;
 
     /// The cap without a branch gives what the branch on |F| > μ F_n gave: a sticking spring keeps its

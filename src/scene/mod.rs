@@ -8,6 +8,7 @@
 
 pub mod body_file;
 pub mod build;
+pub mod orientation;
 pub mod run;
 pub mod schema;
 pub mod time_step;

@@ -45,7 +45,7 @@ pub const PROGRESS_STEPS: u64 = 64;
 /// How a run was stepped.
 #[derive(Copy, Clone, Debug, PartialEq, Eq, Default)]
 pub enum StepPath {
-    /// The general step ([`crate::world::step`]).
+    /// The general step ([`crate::world::step()`]).
     #[default]
     General,
     /// The flat sphere layout ([`SphereSim`]).

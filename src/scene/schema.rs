@@ -181,7 +181,8 @@ pub struct BoxSection {
     pub velocity: Option<Spanned<Vec3>>,
 }
 
-/// `[[body_file]]`: spherical bodies from a CSV file.
+/// `[[body_file]]`: bodies from a CSV file: spheres (a `radius` column) or the scene's `[[shape]]`s placed
+/// by a pose (a `shape` column); see [`crate::scene::body_file`].
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct BodyFileSection {
@@ -190,7 +191,8 @@ pub struct BodyFileSection {
     pub material: Spanned<String>,
     /// Body names are this prefix followed by the `id` column (or the row number).
     pub name_prefix: Spanned<String>,
-    /// `"file"` (the vx, vy, vz columns) or `"zero"`; absent = `"file"` when the columns exist.
+    /// `"file"` (the vx, vy, vz columns, and wx, wy, wz of a shape table) or `"zero"`; absent = `"file"`
+    /// when the columns exist.
     pub velocities: Option<Spanned<String>>,
     /// Write these bodies to `bodies.csv`; absent = false.
     pub track: Option<bool>,

@@ -12,7 +12,8 @@
 //! - Stability: velocity Verlet on an oscillator of angular frequency ω is stable for ω Δt < 2. The stiffest
 //!   mode of a contact is bounded by ω² = κ k_eff / m*, with k_eff the larger of the normal tangent stiffness
 //!   at the largest overlap of an impact at V (n k_n δ_max^(n−1); k_n for the linear law) and the tangential
-//!   stiffness k_t, and κ = max over dynamic bodies of (1 + m r_b²/J_min) (r_b the bounding radius, J_min
+//!   stiffness k_t (the laws state both: [`crate::law::NormalLaw::impact_time_and_stiffness`],
+//!   [`crate::law::TangentialLaw::stability_stiffness`]), and κ = max over dynamic bodies of (1 + m r_b²/J_min) (r_b the bounding radius, J_min
 //!   the smallest principal moment): a force at a lever arm r_b also turns the body, which lowers the
 //!   effective mass of the contact point by up to that factor (2.5 + 1 for a solid sphere). The limit is
 //!   Δt_max = 2/ω for the linear law and the tangential spring; a given step above it is refused with an
@@ -39,9 +40,8 @@
 //!   k_n δ^n / h at lever arms up to r_b; it stays within the bound above while the band h is at least the
 //!   overlap (its documented rule). A band far below the overlaps of a scene needs a smaller step.
 
-use crate::law::{ContactModel, TangentialLaw};
+use crate::law::ContactModel;
 use crate::math::Real;
-use std::f64::consts::PI;
 
 /// How the time step was chosen.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -85,21 +85,10 @@ pub fn contact_time_and_limit(
     for p in pairs {
         let law = p.model.normal;
         let m = p.effective_mass;
-        let (tc, k_normal) = if law.exponent == 1.0 {
-            (PI * (m / law.stiffness).sqrt(), law.stiffness)
-        } else {
-            let v = speed.ok_or(TimeStepIssue::NeedsSpeed)?;
-            let n = law.exponent;
-            let max_overlap = ((n + 1.0) * m * v * v / (2.0 * law.stiffness)).powf(1.0 / (n + 1.0));
-            (
-                law.elastic_contact_time(m, v),
-                n * law.stiffness * max_overlap.powf(n - 1.0),
-            )
-        };
-        let k_tangential = match p.model.tangential {
-            TangentialLaw::Spring { stiffness, .. } => stiffness,
-            _ => 0.0,
-        };
+        let (tc, k_normal) = law
+            .impact_time_and_stiffness(m, speed)
+            .ok_or(TimeStepIssue::NeedsSpeed)?;
+        let k_tangential = p.model.tangential.stability_stiffness();
         let omega_normal = (kappa * k_normal / m).sqrt();
         let omega_tangential = (kappa * k_tangential / m).sqrt();
         t_c = t_c.min(tc);
@@ -123,7 +112,8 @@ pub fn overshoot_factor(exponent: Real) -> Real {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::law::{DampingLaw, NormalLaw};
+    use crate::law::{DampingLaw, NormalLaw, TangentialLaw};
+    use std::f64::consts::PI;
 
     #[test]
     fn linear_contact_time_and_limit_follow_the_oscillator() {

@@ -193,10 +193,8 @@ pub fn first_order_bound(
     if law.exponent != 1.0 {
         return hertz_factor * dt_fraction;
     }
-    let coefficient = match DampingLaw::from_restitution(1.0, restitution) {
-        Ok(DampingLaw::Viscous { coefficient }) => coefficient,
-        _ => 0.0,
-    };
+    let coefficient =
+        DampingLaw::from_restitution(1.0, restitution).map_or(0.0, |d| d.viscous_coefficient());
     coefficient * std::f64::consts::PI * dt_fraction * (1.0 + restitution) / restitution
 }
 

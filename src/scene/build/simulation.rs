@@ -1,0 +1,138 @@
+//! The `[simulation]` table apart from the time step ([`super::step_size`]): gravity and the run's length,
+//! the global viscous damping, the Verlet skin, and the tolerances of the step.
+
+use crate::contact::pair_smoothing::PairSmoothing;
+use crate::contact::wall_depth::WallDepth;
+use crate::dynamics::ViscousDamping;
+use crate::math::{Real, Vector};
+use crate::world::StepParams;
+
+use super::super::schema::SimulationSection;
+use super::shapes::Shapes;
+use super::{Ctx, SceneError};
+
+/// `simulation.gravity`, `end_time` and `output_interval`.
+pub(super) struct RunLength {
+    pub gravity: Vector,
+    pub end_time: Real,
+    pub output_interval: Real,
+}
+
+impl RunLength {
+    pub fn read(ctx: &Ctx, sim: &SimulationSection) -> Result<Self, SceneError> {
+        Ok(Self {
+            gravity: ctx.vector(&sim.gravity, "simulation.gravity")?,
+            end_time: ctx.positive(&sim.end_time, "simulation.end_time")?,
+            output_interval: ctx.positive(&sim.output_interval, "simulation.output_interval")?,
+        })
+    }
+}
+
+/// `simulation.viscous_damping_rate`: absent = none.
+pub(super) fn viscous_damping(
+    ctx: &Ctx,
+    sim: &SimulationSection,
+) -> Result<ViscousDamping, SceneError> {
+    let Some(rate) = &sim.viscous_damping_rate else {
+        return Ok(ViscousDamping::None);
+    };
+    let r = *rate.get_ref();
+    if !(r.is_finite() && r >= 0.0) {
+        return Err(ctx.invalid(
+            rate.span(),
+            "simulation.viscous_damping_rate",
+            format!("must be finite and ≥ 0, got {r}"),
+        ));
+    }
+    Ok(ViscousDamping::MassProportional(r))
+}
+
+/// `simulation.skin`: absent = 0.2 × the smallest bounding radius of the scene's shapes (0 without one).
+pub(super) fn skin(
+    ctx: &Ctx,
+    sim: &SimulationSection,
+    shapes: &Shapes,
+) -> Result<Real, SceneError> {
+    let min_radius = shapes
+        .list
+        .iter()
+        .filter_map(|(s, _)| s.length_scale())
+        .fold(Real::INFINITY, Real::min)
+        * 0.5;
+    Ok(match &sim.skin {
+        Some(s) => ctx.positive(s, "simulation.skin")?,
+        None if min_radius.is_finite() => 0.2 * min_radius,
+        None => 0.0,
+    })
+}
+
+/// The step parameters: the time step `dt`, the global damping, and the tolerances the table sets.
+pub(super) fn step_params(
+    ctx: &Ctx,
+    sim: &SimulationSection,
+    dt: Real,
+    damping: ViscousDamping,
+) -> Result<StepParams, SceneError> {
+    let mut params = StepParams::new(dt);
+    params.damping = damping;
+    params.tolerances.wall_depth = wall_depth(ctx, sim)?;
+    params.tolerances.pair_smoothing = pair_smoothing(ctx, sim)?;
+    params.energy_ledger = sim.energy_ledger.as_ref().is_none_or(|l| *l.get_ref());
+    Ok(params)
+}
+
+/// `simulation.wall_depth` and `simulation.wall_depth_band`: how a polyhedron–wall contact turns the vertex
+/// depths into the law's overlap. A band given with the deepest-vertex rule is refused (it would be ignored).
+fn wall_depth(ctx: &Ctx, sim: &SimulationSection) -> Result<WallDepth, SceneError> {
+    let band = match &sim.wall_depth_band {
+        Some(b) => Some((ctx.positive(b, "simulation.wall_depth_band")?, b.span())),
+        None => None,
+    };
+    let rule = sim
+        .wall_depth
+        .as_ref()
+        .map(|r| (r.get_ref().as_str(), r.span()));
+    match (rule, band) {
+        (None | Some(("smoothed", _)), None) => Ok(WallDepth::default()),
+        (None | Some(("smoothed", _)), Some((band, _))) => Ok(WallDepth::Smoothed { band }),
+        (Some(("deepest_vertex", _)), None) => Ok(WallDepth::DeepestVertex),
+        (Some(("deepest_vertex", _)), Some((_, span))) => Err(ctx.invalid(
+            span,
+            "simulation.wall_depth_band",
+            "a band applies to wall_depth = \"smoothed\" only, not to \"deepest_vertex\"",
+        )),
+        (Some((other, span)), _) => Err(ctx.invalid(
+            span,
+            "simulation.wall_depth",
+            format!("must be \"smoothed\" or \"deepest_vertex\", got \"{other}\""),
+        )),
+    }
+}
+
+/// `simulation.pair_smoothing` and `simulation.pair_smoothing_band`: the overlap a polyhedron–polyhedron
+/// contact hands to the law. A band given with the exact overlap is refused (it would be ignored).
+fn pair_smoothing(ctx: &Ctx, sim: &SimulationSection) -> Result<PairSmoothing, SceneError> {
+    let band = match &sim.pair_smoothing_band {
+        Some(b) => Some((ctx.positive(b, "simulation.pair_smoothing_band")?, b.span())),
+        None => None,
+    };
+    let rule = sim
+        .pair_smoothing
+        .as_ref()
+        .map(|r| (r.get_ref().as_str(), r.span()));
+    match (rule, band) {
+        (None | Some(("smoothed", _)), None) => Ok(PairSmoothing::default()),
+        (None | Some(("smoothed", _)), Some((band, _))) => Ok(PairSmoothing::Smoothed { band }),
+        (Some(("exact", _)), None) => Ok(PairSmoothing::Exact),
+        (Some(("exact", _)), Some((_, span))) => Err(ctx.invalid(
+            span,
+            "simulation.pair_smoothing_band",
+            "a band applies to pair_smoothing = \"smoothed\" only, not to \"exact\"",
+        )),
+        (Some((other, span)), _) => Err(ctx.invalid(
+            span,
+            "simulation.pair_smoothing",
+            format!("must be \"smoothed\" or \"exact\", got \"{other}\""),
+        )),
+    }
+}
