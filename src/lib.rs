@@ -15,6 +15,8 @@
 //! - [`special_functions`]: elliptic integrals and Jacobi elliptic functions for the analytic references.
 //! - [`world`]: the many-body engine: broad phase, contact store, step pipeline.
 
+#![cfg_attr(doctest, doc = include_str!("../README.md"))] // the README's example is a doctest
+
 pub mod contact;
 pub mod dynamics;
 pub mod fixed_hash;

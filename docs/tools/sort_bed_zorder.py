@@ -1,5 +1,5 @@
 # Sort bed_rocks.csv rows along a Z-order curve of the rock centres (grid cell = 0.11 m from the origin),
-# as crates/rockfill/src/spatial_order.rs numbers freshly generated rocks. Usage: python3 docs/tools/sort_bed_zorder.py IN OUT (the A/B of docs/polyhedral-step-cost.md)
+# as crates/rockfill/src/spatial_order.rs numbers freshly generated rocks. Usage: python3 docs/tools/sort_bed_zorder.py IN OUT (the A/B of docs/speed.md)
 import sys
 def spread(v):
     out = 0
