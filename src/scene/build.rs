@@ -620,6 +620,13 @@ fn build(ctx: &Ctx, file: &SceneFile) -> Result<Simulation, SceneError> {
                 s.mass_properties().principal_moments,
             ),
             Shape::Plane(_) => unreachable!("scene shapes are never planes"),
+            other => match other.convex() {
+                Some(c) => (
+                    c.mass_properties().volume,
+                    c.mass_properties().principal_moments,
+                ),
+                None => unreachable!("scene shapes are never planes"),
+            },
         };
         let inertia = PrincipalInertia::new(moments * density)
             .map_err(|e| ctx.invalid(b.shape.span(), f("shape"), e.to_string()))?;
@@ -882,6 +889,7 @@ fn build(ctx: &Ctx, file: &SceneFile) -> Result<Simulation, SceneError> {
                 Shape::Polyhedron(p) => p.bounding_radius(),
                 Shape::Sphere(s) => s.radius(),
                 Shape::Plane(_) => 0.0,
+                other => other.convex().map_or(0.0, |c| c.bounding_radius()),
             };
             let j_min = body.inertia.0.min();
             kappa = kappa.max(1.0 + body.mass * r * r / j_min);
