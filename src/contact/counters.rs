@@ -16,14 +16,15 @@ pub struct QueryCounters {
     pub polyhedron_plane: u64,
     pub sphere_polyhedron: u64,
     /// Queries through the generic support-map arm (a pair with a curved shape other than two spheres) and
-    /// curved shapes against a plane.
-    #[serde(default)]
+    /// curved shapes against a plane. These three are not serialised, so that checkpoints and reports
+    /// keep their format.
+    #[serde(skip)]
     pub support_map: u64,
-    #[serde(default)]
+    #[serde(skip)]
     pub convex_plane: u64,
     /// Generic-arm queries whose depth bounds did not meet `curved_gap` (cap or degeneracy): answered with
     /// the best bound and a fallback status, also counted in the fallback counters.
-    #[serde(default)]
+    #[serde(skip)]
     pub support_map_unconverged: u64,
     /// Pairs rejected by the bounding spheres before any support call.
     pub bounding_sphere_rejections: u64,

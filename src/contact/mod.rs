@@ -42,6 +42,8 @@ pub(crate) mod testing;
 mod tests_degenerate;
 #[cfg(test)]
 mod tests_oracle;
+#[cfg(test)]
+mod tests_support_map;
 
 pub use contact_convex_plane::contact_plane_convex;
 pub use contact_polyhedron_plane::contact_plane_polytope;

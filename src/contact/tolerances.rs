@@ -31,7 +31,9 @@ pub struct ContactTolerances {
     /// size of EPA's polytope, about a factor 3 per refinement of the closest face. Default 1e-10: the depth
     /// error is then far below the smallest overlap a DEM step produces (≳ 1e-9 ℓ), and the normal, whose
     /// error grows like the square root of the depth's, is good to about 1e-5 rad.
-    #[serde(default = "default_curved_gap")]
+    ///
+    /// Not serialised (a checkpoint restores the default), so that checkpoints keep their format.
+    #[serde(skip, default = "default_curved_gap")]
     pub curved_gap: Real,
     /// Iteration cap of GJK (default 128; polytope pairs converge in fewer than 30). Reaching it triggers the
     /// exact fallback.
