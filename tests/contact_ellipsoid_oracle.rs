@@ -292,7 +292,7 @@ fn polytope(rng: &mut ChaCha8Rng, size: Real) -> Body {
     }
 }
 
-/// Places B along a random direction from A at `(1 + eps)` times the support distance along it.
+/// Places B against A along a random direction u, at `eps` times their support width along u.
 fn place(rng: &mut ChaCha8Rng, a: &mut Body, b: &mut Body, eps: Real) {
     let u = random_unit(rng);
     a.pose.translation.vector = Vector::new(
@@ -302,7 +302,10 @@ fn place(rng: &mut ChaCha8Rng, a: &mut Body, b: &mut Body, eps: Real) {
     ) * a.length_scale();
     b.pose.translation.vector = a.pose.translation.vector;
     let t0 = gap_function(a, b, &u);
-    b.pose.translation.vector += u * t0 * (1.0 + eps);
+    // Touching at one point with the common normal u (B's support point along −u moved onto A's along u),
+    // then moved along u by eps·t0: apart by exactly that for eps > 0, overlapping by about it otherwise.
+    let touching = a.support(&u).0 - b.support(&-u).0;
+    b.pose.translation.vector += touching + u * t0 * eps;
 }
 
 #[derive(Default)]
@@ -314,6 +317,8 @@ struct Worst {
     distance_oracles: Real,
     unconverged: usize,
     pairs: usize,
+    overlapping: usize,
+    counters: QueryCounters,
 }
 
 /// Runs the engine and both oracles on one pair and checks them; records the worst relative errors.
@@ -331,6 +336,7 @@ fn check_pair(label: &str, a: &Body, b: &Body, samples: &[Vector], worst: &mut W
         &mut counters,
     );
     worst.pairs += 1;
+    worst.counters.merge(&counters);
     let g = r.geometry;
     let ell = a.length_scale().min(b.length_scale());
     let f = |n: &Vector| gap_function(a, b, n);
@@ -340,6 +346,7 @@ fn check_pair(label: &str, a: &Body, b: &Body, samples: &[Vector], worst: &mut W
         + (b.pose.translation.vector - a.pose.translation.vector).norm();
     let tol_s = tol.curved_gap * ell + 1e-13 * big;
     let measured = g.depth - g.distance;
+    worst.overlapping += usize::from(s > 0.0);
     let pair = format!("{label}: A {}, B {}", a.describe(), b.describe());
     if !r.converged {
         worst.unconverged += 1;
@@ -411,7 +418,8 @@ fn run(
         let (mut a, mut b) = make(&mut rng, size);
         let eps = match k % 4 {
             0 => rng.random_range(-1e-6..1e-6),
-            1 => rng.random_range(-0.03..0.0),
+            1 => rng.random_range(-0.1..-0.01),
+            2 => rng.random_range(-0.01..0.0),
             _ => rng.random_range(0.0..0.1),
         };
         place(&mut rng, &mut a, &mut b, eps);
@@ -428,6 +436,16 @@ fn run(
          worst point error/tol {:.3e}, worst oracle disagreement/ℓ {:.3e}, unconverged {}",
         worst.pairs, worst.overlap, worst.normal_attains, worst.angle, worst.point, worst.distance_oracles,
         worst.unconverged
+    );
+    eprintln!(
+        "{label}: {} overlapping by the oracle; {}",
+        worst.overlapping, worst.counters
+    );
+    assert!(
+        worst.overlapping * 4 >= worst.pairs,
+        "{label}: only {} of {} pairs overlap: EPA is not exercised",
+        worst.overlapping,
+        worst.pairs
     );
     worst
 }

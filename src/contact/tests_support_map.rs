@@ -6,7 +6,7 @@ use super::contact_support_map::contact_support_maps;
 use super::{query, query_with, ContactKind, ContactTolerances, EpaScratch, PairCache};
 use super::{QueryCounters, SolverStatus};
 use crate::math::{Point, Pose, Real, Rotation, Vector};
-use crate::shape::{ConvexPolyhedron, ConvexShape, Plane, Shape, Sphere};
+use crate::shape::{ConvexPolyhedron, Plane, Shape, Sphere};
 use std::sync::Arc;
 
 fn cuboid(half: Vector) -> ConvexPolyhedron {
