@@ -55,7 +55,7 @@ impl Shape {
             Shape::Polyhedron(p) => Some(p.length_scale()),
             Shape::Sphere(s) => Some(s.length_scale()),
             Shape::Plane(_) => None,
-            Shape::Ellipsoid(e) => Some(e.length_scale()),
+            other => other.convex().map(|c| c.length_scale()),
         }
     }
 
