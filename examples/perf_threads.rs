@@ -494,6 +494,7 @@ fn write_scenes(dir: &std::path::Path, o: &Options) -> Result<(), String> {
                     );
                 }
                 Shape::Plane(_) => return Err(format!("{name}: a plane body cannot be written")),
+                _ => return Err(format!("{name}: shape s{k} has no [[shape]] kind to write")),
             }
         }
         for (i, body) in w.bodies.iter().enumerate() {

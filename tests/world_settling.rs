@@ -30,6 +30,7 @@ fn lowest_z(sim: &Simulation, i: usize) -> Real {
             .fold(Real::INFINITY, Real::min),
         Shape::Sphere(s) => pose.translation.vector.z - s.radius(),
         Shape::Plane(_) => unreachable!(),
+        other => other.convex().expect("a body").aabb(&pose).mins.z,
     }
 }
 

@@ -15,6 +15,17 @@ pub struct QueryCounters {
     pub sphere_plane: u64,
     pub polyhedron_plane: u64,
     pub sphere_polyhedron: u64,
+    /// Queries through the generic support-map arm (a pair with a curved shape other than two spheres) and
+    /// curved shapes against a plane. These three are not serialised, so that checkpoints and reports
+    /// keep their format.
+    #[serde(skip)]
+    pub support_map: u64,
+    #[serde(skip)]
+    pub convex_plane: u64,
+    /// Generic-arm queries whose depth bounds did not meet `curved_gap` (cap or degeneracy): answered with
+    /// the best bound and a fallback status, also counted in the fallback counters.
+    #[serde(skip)]
+    pub support_map_unconverged: u64,
     /// Pairs rejected by the bounding spheres before any support call.
     pub bounding_sphere_rejections: u64,
     /// Pairs rejected by the cached separating direction (one support call per shape).
@@ -51,6 +62,9 @@ impl QueryCounters {
         self.sphere_plane += other.sphere_plane;
         self.polyhedron_plane += other.polyhedron_plane;
         self.sphere_polyhedron += other.sphere_polyhedron;
+        self.support_map += other.support_map;
+        self.convex_plane += other.convex_plane;
+        self.support_map_unconverged += other.support_map_unconverged;
         self.bounding_sphere_rejections += other.bounding_sphere_rejections;
         self.cached_axis_rejections += other.cached_axis_rejections;
         self.motion_bound_skips += other.motion_bound_skips;
@@ -123,6 +137,15 @@ impl fmt::Display for QueryCounters {
             f,
             "exact fallbacks: {} after max iterations, {} after degeneracy",
             self.fallback_max_iterations, self.fallback_degenerate
-        )
+        )?;
+        // Written only for worlds with curved shapes, so the summary of others reads as before.
+        if self.support_map + self.convex_plane > 0 {
+            write!(
+                f,
+                "\nsupport-map arm: {} queries ({} unconverged, answered with their bounds), curved-plane {}",
+                self.support_map, self.support_map_unconverged, self.convex_plane
+            )?;
+        }
+        Ok(())
     }
 }

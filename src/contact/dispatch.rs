@@ -7,10 +7,16 @@
 //! | Sphere      | mirrored                       | closed form                    | closed form      |
 //! | Plane       | support along n                | closed form                    | error            |
 //!
+//! Any other pair of bounded shapes (an ellipsoid with anything) goes through the generic support-map arm
+//! ([`super::contact_support_map`]: GJK + EPA stopped by `curved_gap`), and against a plane through the
+//! closed form of [`super::contact_convex_plane`]. A new shape reaches both through
+//! [`Shape::convex`](crate::shape::Shape::convex) without an edit here.
+//!
 //! Every path returns the same [`ContactGeometry`] features (δ_M, n_M from A to B, c1 on A, c2 on B,
 //! c_M), so a contact law never needs to know which path ran. Two walls never collide: a plane–plane
 //! query is a typed error, not a panic.
 
+use super::contact_convex_plane::contact_plane_convex;
 use super::contact_polyhedron_plane::contact_plane_polytope;
 use super::contact_polyhedron_polyhedron::{
     query_polytopes_cached, warm_overlap_polytopes, PairCache,
@@ -18,13 +24,14 @@ use super::contact_polyhedron_polyhedron::{
 use super::contact_sphere_plane::contact_plane_sphere;
 use super::contact_sphere_polyhedron::contact_polytope_sphere;
 use super::contact_sphere_sphere::contact_sphere_sphere;
+use super::contact_support_map::contact_support_maps;
 use super::counters::QueryCounters;
 use super::epa::EpaScratch;
 use super::pair_smoothing::{smooth_pair_overlap, PairSmoothing};
 use super::tolerances::ContactTolerances;
 use super::{ContactGeometry, ContactKind};
 use crate::math::{Point, Pose};
-use crate::shape::{ConvexPolyhedron, Shape};
+use crate::shape::{ConvexPolyhedron, ConvexShape, Shape};
 
 /// A query that has no meaning.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
@@ -145,8 +152,29 @@ pub fn query_with(
             swap_pair(&g)
         }
         (Shape::Plane(_), Shape::Plane(_)) => return Err(ContactError::PlanePlane),
+        (Shape::Plane(p), b) => {
+            counters.convex_plane += 1;
+            let g = contact_plane_convex(pos1, p.normal(), p.offset(), pos2, bounded(b)?, tol);
+            counters.record(&g);
+            g
+        }
+        (a, Shape::Plane(p)) => {
+            counters.convex_plane += 1;
+            let g = contact_plane_convex(pos2, p.normal(), p.offset(), pos1, bounded(a)?, tol);
+            counters.record(&g);
+            swap_pair(&g)
+        }
+        (a, b) => {
+            let (a, b) = (bounded(a)?, bounded(b)?);
+            contact_support_maps(pos1, a, pos2, b, tol, cache, scratch, counters).geometry
+        }
     };
     Ok(g)
+}
+
+/// The shape as a bounded convex solid; a plane here can only be the second of two walls.
+fn bounded(shape: &Shape) -> Result<&dyn ConvexShape, ContactError> {
+    shape.convex().ok_or(ContactError::PlanePlane)
 }
 
 /// The overlap of a polyhedron pair handed to the law, from the exact geometry `g` of its query (the

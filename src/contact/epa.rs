@@ -153,6 +153,16 @@ fn face_plane(verts: &[SupportPoint], v: [u32; 3]) -> Option<(Vector, Real)> {
 }
 
 impl EpaScratch {
+    /// The smallest plane offset among the live faces of the last run's polytope (a lower bound of the
+    /// overlap while the polytope is intact), `None` if no face is alive.
+    pub fn closest_offset(&self) -> Option<Real> {
+        self.live_offsets
+            .iter()
+            .copied()
+            .filter(|o| o.is_finite())
+            .min_by(|x, y| x.total_cmp(y))
+    }
+
     fn push_face(&mut self, v: [u32; 3]) -> Option<u32> {
         if self.faces.len() >= self.max_faces {
             return None;
@@ -381,6 +391,26 @@ pub fn epa<A: SupportMap + ?Sized, B: SupportMap + ?Sized>(
     }
 }
 
+/// After an [`epa`] run that stopped at its iteration cap (the polytope is then intact): the offset of the
+/// closest live face, a lower bound of the overlap since the polytope lies inside A ⊖ B, and the features
+/// along that face's normal as [`EpaOutcome::Converged`] reports them, whose depth h(n) is an upper bound.
+/// `None` if no face is alive.
+pub fn closest_face_bounds<A: SupportMap + ?Sized, B: SupportMap + ?Sized>(
+    pair: &mut MinkowskiPair<'_, A, B>,
+    scratch: &EpaScratch,
+) -> Option<(Real, EpaOutcome)> {
+    let (best, offset) = scratch
+        .live_offsets
+        .iter()
+        .enumerate()
+        .filter(|(i, _)| scratch.faces[*i].alive)
+        .min_by(|x, y| x.1.total_cmp(y.1))?;
+    let n = scratch.faces[best].normal;
+    let s = pair.support(&n);
+    let h = n.dot(&s.a) - n.dot(&s.b);
+    Some((*offset, finish(scratch, best as u32, h, 0.0)))
+}
+
 /// Start directions: ±axes and the eight diagonals of the frame rotated by the Euler angles (0.3, 0.7, 1.1)
 /// rad: a fixed, irregular frame, so that aligned shapes do not produce ties between start supports.
 static START_DIRECTIONS: std::sync::LazyLock<[Vector; 14]> = std::sync::LazyLock::new(|| {
@@ -404,6 +434,11 @@ static START_DIRECTIONS: std::sync::LazyLock<[Vector; 14]> = std::sync::LazyLock
     ];
     local.map(|d| r * d)
 });
+
+/// The fixed start directions of EPA (unit, frame 1), for callers that need a few well-spread probes.
+pub(crate) fn start_directions() -> impl Iterator<Item = Vector> {
+    START_DIRECTIONS.iter().copied()
+}
 
 /// Three of `pts` with maximal spread (farthest from the centroid, farthest from it, farthest from their
 /// line); `None` if all are collinear.

@@ -23,9 +23,12 @@ pub enum SolverStatus {
     Exact,
     /// GJK (and EPA when overlapping) converged within tolerance.
     Converged,
-    /// The iterative solver hit its iteration cap; the answer comes from the exact SAT fallback.
+    /// The iterative solver hit its iteration cap; the answer comes from the exact SAT fallback (polyhedra)
+    /// or, for a pair with a curved shape (no exact fallback), is the solver's best direction with the depth
+    /// its upper bound ([`contact_support_map`](super::contact_support_map)).
     FallbackAfterMaxIterations,
-    /// The iterative solver met a degenerate configuration; the answer comes from the exact SAT fallback.
+    /// The iterative solver met a degenerate configuration; the answer comes from the exact SAT fallback
+    /// (polyhedra) or, for a pair with a curved shape, the best of a few probe directions.
     FallbackAfterDegenerate,
 }
 

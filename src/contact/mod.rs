@@ -7,7 +7,9 @@
 //! Files, one job each: [`minkowski`] (support of A ⊖ B in A's frame), [`gjk`] (distance / intersection),
 //! [`epa`] (Minkowski overlap), [`sat`] (exact oracle and fallback), [`features`] (closest points of small
 //! features), one file per shape pair ([`contact_polyhedron_polyhedron`], [`contact_sphere_polyhedron`],
-//! [`contact_polyhedron_plane`], [`contact_sphere_plane`], [`contact_sphere_sphere`](mod@contact_sphere_sphere)), [`dispatch`] (over
+//! [`contact_polyhedron_plane`], [`contact_sphere_plane`], [`contact_sphere_sphere`](mod@contact_sphere_sphere)),
+//! the generic arms for any [`ConvexShape`](crate::shape::ConvexShape) ([`contact_support_map`]: GJK + EPA
+//! to a tolerance; [`contact_convex_plane`]: closed form against a wall), [`dispatch`] (over
 //! [`Shape`](crate::shape::Shape)), [`counters`], [`tolerances`].
 //!
 //! Entry points: [`query`] (any shapes, hot path), [`query_polyhedra_cached`] / [`query_polyhedra`] /
@@ -15,11 +17,13 @@
 //! (rejection test). References: Gilbert, Johnson & Keerthi (1988); van den Bergen, *Collision Detection in
 //! Interactive 3D Environments* (2001); Feng & Tan's Minkowski overlap as used by Zhao et al. (2021).
 
+pub mod contact_convex_plane;
 pub mod contact_polyhedron_plane;
 pub mod contact_polyhedron_polyhedron;
 pub mod contact_sphere_plane;
 pub mod contact_sphere_polyhedron;
 pub mod contact_sphere_sphere;
+pub mod contact_support_map;
 pub mod counters;
 pub mod dispatch;
 pub mod epa;
@@ -38,7 +42,10 @@ pub(crate) mod testing;
 mod tests_degenerate;
 #[cfg(test)]
 mod tests_oracle;
+#[cfg(test)]
+mod tests_support_map;
 
+pub use contact_convex_plane::contact_plane_convex;
 pub use contact_polyhedron_plane::contact_plane_polytope;
 pub use contact_polyhedron_polyhedron::{
     intersect_polyhedra_cached, intersect_polytopes_cached, query_polyhedra,
@@ -48,6 +55,7 @@ pub use contact_polyhedron_polyhedron::{
 pub use contact_sphere_plane::contact_plane_sphere;
 pub use contact_sphere_polyhedron::contact_polytope_sphere;
 pub use contact_sphere_sphere::contact_sphere_sphere;
+pub use contact_support_map::{contact_support_maps, SupportMapContact};
 pub use counters::QueryCounters;
 pub use dispatch::{query, query_with, swap_pair, warm_overlap_with, ContactError};
 pub use epa::EpaScratch;

@@ -24,6 +24,17 @@ pub struct ContactTolerances {
     /// that face's plane; the reported depth then exceeds the exact one by at most this much. Default 1e-13:
     /// on polytopes EPA reaches a facet of the Minkowski difference exactly, so the gap only absorbs round-off.
     pub epa_gap: Real,
+    /// Pairs with a curved shape (the generic support-map arm, [`super::contact_support_map`]): GJK and EPA
+    /// stop when their upper and lower bounds on the signed overlap agree within `curved_gap · ℓ`, with ℓ
+    /// the length scale of the *smaller* body (a small grain on a large one is measured to its own size).
+    /// On a curved surface neither terminates exactly: the bounds close like the square of the local facet
+    /// size of EPA's polytope, about a factor 3 per refinement of the closest face. Default 1e-10: the depth
+    /// error is then far below the smallest overlap a DEM step produces (≳ 1e-9 ℓ), and the normal, whose
+    /// error grows like the square root of the depth's, is good to about 1e-5 rad.
+    ///
+    /// Not serialised (a checkpoint restores the default), so that checkpoints keep their format.
+    #[serde(skip, default = "default_curved_gap")]
+    pub curved_gap: Real,
     /// Iteration cap of GJK (default 128; polytope pairs converge in fewer than 30). Reaching it triggers the
     /// exact fallback.
     pub gjk_max_iterations: u32,
@@ -45,10 +56,15 @@ impl Default for ContactTolerances {
             touching: 1e-11,
             gjk_gap: 1e-13,
             epa_gap: 1e-13,
+            curved_gap: default_curved_gap(),
             gjk_max_iterations: 128,
             epa_max_iterations: 256,
             wall_depth: Default::default(),
             pair_smoothing: Default::default(),
         }
     }
+}
+
+fn default_curved_gap() -> Real {
+    1e-10
 }

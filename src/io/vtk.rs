@@ -13,6 +13,10 @@
 //!   `contact_force`, `contact_torque`. This is the usual DEM convention (LIGGGHTS and YADE export spheres the
 //!   same way): in ParaView apply *Glyph* with glyph type *Sphere*, *Scale Array* `diameter`, scale factor 1
 //!   (the sphere glyph has radius 0.5), which draws exact spheres at any zoom instead of a fixed tessellation.
+//! - `surfaces.pvd` → `vtk/surfaces_<step>.vtu`: every body of another bounded shape (ellipsoids) as the
+//!   polygonal surface its [`ConvexShape::surface_mesh`](crate::shape::ConvexShape::surface_mesh) gives
+//!   (an ellipsoid: a UV mesh of 16 latitude bands × 32 meridians, vertices on the exact surface), with the
+//!   same cells, cell data and point data as the polyhedra.
 //! - `walls.pvd` → `vtk/walls_<step>.vtu`: every wall as one `VTK_POLYGON`: the part of its plane inside the
 //!   frame's scene box (the axis-aligned box of all bodies' bounding spheres and of the walls' reference
 //!   points, widened by 5 % of its diagonal plus the largest body radius; 1 m when there are no bodies) and
@@ -46,7 +50,7 @@ use std::io::{self, Write};
 use std::path::{Path, PathBuf};
 
 use crate::math::{Point, Real, Vector};
-use crate::shape::Shape;
+use crate::shape::{ConvexPolyhedron, Shape, SurfaceMesh};
 use crate::world::World;
 
 /// VTK cell type codes used here.
@@ -147,6 +151,7 @@ pub enum SeriesKind {
     Polyhedra,
     Spheres,
     Walls,
+    Surfaces,
 }
 
 impl SeriesKind {
@@ -155,6 +160,7 @@ impl SeriesKind {
             SeriesKind::Polyhedra => "polyhedra",
             SeriesKind::Spheres => "spheres",
             SeriesKind::Walls => "walls",
+            SeriesKind::Surfaces => "surfaces",
         }
     }
 }
@@ -191,6 +197,9 @@ impl VtkWriter {
         }
         if !world.walls.is_empty() {
             series.push((SeriesKind::Walls, Vec::new()));
+        }
+        if has(|s| surface_body(s).is_some()) {
+            series.push((SeriesKind::Surfaces, Vec::new()));
         }
         Ok(Self {
             out_dir: out_dir.to_owned(),
@@ -257,6 +266,7 @@ impl VtkWriter {
                 SeriesKind::Polyhedra => polyhedra_vtu(&mut text, world, self.encoding),
                 SeriesKind::Spheres => spheres_vtu(&mut text, world, self.encoding),
                 SeriesKind::Walls => walls_vtu(&mut text, world, self.encoding),
+                SeriesKind::Surfaces => surfaces_vtu(&mut text, world, self.encoding),
             };
             std::fs::write(self.out_dir.join(&relative), &text)?;
             self.bytes_written += text.len() as u64;
@@ -339,13 +349,75 @@ fn frame_step(series: &str, file: &str) -> Option<u64> {
 
 /// The `.vtu` text of the polyhedral bodies (see the module docs).
 pub fn polyhedra_vtu(out: &mut String, world: &World, format: VtkEncoding) -> PieceCounts {
-    let bodies: Vec<usize> = (0..world.bodies.len())
-        .filter(|&i| matches!(world.shape(i), Shape::Polyhedron(_)))
+    let items: Vec<(usize, &ConvexPolyhedron)> = (0..world.bodies.len())
+        .filter_map(|i| match world.shape(i) {
+            Shape::Polyhedron(p) => Some((i, p.as_ref())),
+            _ => None,
+        })
         .collect();
-    let poly = |i: usize| match world.shape(i) {
-        Shape::Polyhedron(p) => p,
-        _ => unreachable!("filtered to polyhedra"),
-    };
+    mesh_vtu(out, world, format, &items)
+}
+
+/// The `.vtu` text of the bodies of the other bounded shapes (ellipsoids, …) as their
+/// [`ConvexShape::surface_mesh`](crate::shape::ConvexShape::surface_mesh), written like the polyhedra.
+pub fn surfaces_vtu(out: &mut String, world: &World, format: VtkEncoding) -> PieceCounts {
+    let meshes: Vec<(usize, SurfaceMesh)> = (0..world.bodies.len())
+        .filter_map(|i| surface_body(world.shape(i)).map(|m| (i, m)))
+        .collect();
+    let items: Vec<(usize, &SurfaceMesh)> = meshes.iter().map(|(i, m)| (*i, m)).collect();
+    mesh_vtu(out, world, format, &items)
+}
+
+/// The surface of a body that belongs to the surfaces series: bounded, neither a polyhedron nor a sphere.
+fn surface_body(shape: &Shape) -> Option<SurfaceMesh> {
+    match shape {
+        Shape::Polyhedron(_) | Shape::Sphere(_) | Shape::Plane(_) => None,
+        other => other.convex().map(|c| c.surface_mesh()),
+    }
+}
+
+/// A closed polygonal surface in a body frame, as the mesh writer reads it.
+trait MeshView {
+    fn vertices(&self) -> &[Point];
+    fn num_faces(&self) -> usize;
+    fn face_vertices(&self, f: usize) -> &[u32];
+}
+
+impl MeshView for ConvexPolyhedron {
+    fn vertices(&self) -> &[Point] {
+        ConvexPolyhedron::vertices(self)
+    }
+    fn num_faces(&self) -> usize {
+        ConvexPolyhedron::num_faces(self)
+    }
+    fn face_vertices(&self, f: usize) -> &[u32] {
+        ConvexPolyhedron::face_vertices(self, f)
+    }
+}
+
+impl MeshView for SurfaceMesh {
+    fn vertices(&self) -> &[Point] {
+        &self.vertices
+    }
+    fn num_faces(&self) -> usize {
+        self.faces.len()
+    }
+    fn face_vertices(&self, f: usize) -> &[u32] {
+        &self.faces[f]
+    }
+}
+
+/// The `.vtu` text of bodies drawn as polygonal surfaces: `items` are (body index, its mesh).
+fn mesh_vtu<M: MeshView + ?Sized>(
+    out: &mut String,
+    world: &World,
+    format: VtkEncoding,
+    items: &[(usize, &M)],
+) -> PieceCounts {
+    let bodies: Vec<usize> = items.iter().map(|(i, _)| *i).collect();
+    let position: std::collections::HashMap<usize, usize> =
+        bodies.iter().enumerate().map(|(k, &i)| (i, k)).collect();
+    let poly = |i: usize| items[position[&i]].1;
     let points: usize = bodies.iter().map(|&i| poly(i).vertices().len()).sum();
     let cells: usize = bodies.iter().map(|&i| poly(i).num_faces()).sum();
     let counts = PieceCounts { points, cells };

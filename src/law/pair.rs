@@ -20,7 +20,8 @@ use super::tangential::TangentialLaw;
 use crate::math::Real;
 use crate::shape::Shape;
 
-/// The contact radius of a shape (m): a sphere's radius; the equal-volume radius of a polyhedron; `None`
+/// The contact radius of a shape (m): a sphere's radius; the equal-volume radius of a polyhedron (and of any
+/// other bounded shape); `None`
 /// for a plane (a wall: R* = R of the other body).
 pub fn contact_radius(shape: &Shape) -> Option<Real> {
     match shape {
@@ -30,6 +31,10 @@ pub fn contact_radius(shape: &Shape) -> Option<Real> {
             Some((3.0 * volume / (4.0 * std::f64::consts::PI)).cbrt())
         }
         Shape::Plane(_) => None,
+        other => other.convex().map(|c| {
+            let volume = c.mass_properties().volume;
+            (3.0 * volume / (4.0 * std::f64::consts::PI)).cbrt()
+        }),
     }
 }
 

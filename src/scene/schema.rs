@@ -115,7 +115,7 @@ pub struct InteractionSection {
 #[serde(deny_unknown_fields)]
 pub struct ShapeSection {
     pub name: Spanned<String>,
-    /// `"box"`, `"sphere"` or `"polyhedron"`.
+    /// `"box"`, `"sphere"`, `"polyhedron"` or `"ellipsoid"`.
     pub kind: Spanned<String>,
     /// Box: half extents (m).
     pub half_extents: Option<Spanned<Vec3>>,
@@ -123,6 +123,8 @@ pub struct ShapeSection {
     pub radius: Option<Spanned<f64>>,
     /// Polyhedron: points (m) whose convex hull is the shape (≥ 4, not coplanar).
     pub points: Option<Spanned<Vec<Vec3>>>,
+    /// Ellipsoid: semi-axes (a, b, c) along the shape's x, y, z (m).
+    pub semi_axes: Option<Spanned<Vec3>>,
 }
 
 /// `[[body]]`.

@@ -1,4 +1,4 @@
-//! Shapes: convex polyhedra, spheres and planes (walls).
+//! Shapes: convex polyhedra, spheres, ellipsoids and planes (walls).
 //!
 //! Every shape is described in its own local frame; a [`Pose`](crate::math::Pose) places it in the world.
 //! A polyhedron's local frame is its principal frame (origin at the centroid, axes along the principal axes of
@@ -6,9 +6,16 @@
 //!
 //! One job per file: [`error`] (construction errors), `hull` (point cloud → polygonal convex hull),
 //! `polygon` (face plane helpers), [`mass`] (exact mass properties), [`polyhedron`] (the polyhedron, its
-//! topology and support map), [`sphere`], [`plane`] (walls), [`aabb`], `support` (the support-map trait).
+//! topology and support map), [`sphere`], [`ellipsoid`], [`plane`] (walls), [`aabb`], `support` (the
+//! support-map trait), [`convex`] (the convex-shape trait every bounded shape implements).
+//!
+//! Adding a bounded shape: a file with the shape and its [`ConvexShape`] implementation, a variant here and
+//! its arm in [`Shape::convex`]. Code elsewhere reaches a new shape through [`Shape::convex`] (catch-all
+//! arms), and the narrow phase through the generic support-map arm.
 
 pub mod aabb;
+pub mod convex;
+pub mod ellipsoid;
 pub mod error;
 mod hull;
 pub mod mass;
@@ -19,6 +26,8 @@ pub mod sphere;
 mod support;
 
 pub use aabb::Aabb;
+pub use convex::{ConvexShape, SurfaceMesh};
+pub use ellipsoid::Ellipsoid;
 pub use error::ShapeError;
 pub use mass::MassProperties;
 pub use plane::Plane;
@@ -34,6 +43,7 @@ pub enum Shape {
     Polyhedron(std::sync::Arc<ConvexPolyhedron>),
     Sphere(Sphere),
     Plane(Plane),
+    Ellipsoid(Ellipsoid),
 }
 
 impl Shape {
@@ -45,6 +55,25 @@ impl Shape {
             Shape::Polyhedron(p) => Some(p.length_scale()),
             Shape::Sphere(s) => Some(s.length_scale()),
             Shape::Plane(_) => None,
+            other => other.convex().map(|c| c.length_scale()),
         }
     }
+
+    /// The shape as a bounded convex solid, `None` for a plane (a wall, unbounded).
+    pub fn convex(&self) -> Option<&dyn ConvexShape> {
+        match self {
+            Shape::Polyhedron(p) => Some(p.as_ref()),
+            Shape::Sphere(s) => Some(s),
+            Shape::Ellipsoid(e) => Some(e),
+            Shape::Plane(_) => None,
+        }
+    }
+
+    /// The ellipsoid with semi-axes `a`, `b`, `c` (m) along its body x, y, z axes (see [`Ellipsoid::new`]).
+    pub fn ellipsoid(a: Real, b: Real, c: Real) -> Result<Shape, ShapeError> {
+        Ellipsoid::new(a, b, c).map(Shape::Ellipsoid)
+    }
 }
+
+#[cfg(test)]
+mod tests_ellipsoid;

@@ -35,7 +35,8 @@
 use crate::fixed_hash::FixedHashSet;
 
 use crate::contact::ContactKind;
-use crate::math::{Point, Pose, Real, Vector};
+use crate::math::{Point, Pose, Real};
+use crate::shape::convex::segment_distance_to_origin;
 use crate::shape::Shape;
 
 use super::contact_store::ContactKey;
@@ -123,53 +124,7 @@ fn overlapping_pairs(world: &World) -> FixedHashSet<ContactKey> {
 /// Whether the segment p0 → p1 (in the shape's frame) meets the solid, and p0 is outside it. Public so that
 /// monitors with another candidate search (the validation's grid monitor for large beds) share the test.
 pub fn segment_enters(shape: &Shape, p0: &Point, p1: &Point) -> bool {
-    match shape {
-        Shape::Polyhedron(poly) => {
-            let d = p1 - p0;
-            let (mut t_in, mut t_out): (Real, Real) = (0.0, 1.0);
-            let mut start_inside = true;
-            for f in 0..poly.num_faces() {
-                let n = poly.face_normal(f);
-                let slack = poly.face_offset(f) - n.dot(&p0.coords);
-                if slack < 0.0 {
-                    start_inside = false;
-                }
-                let rate = n.dot(&d);
-                if rate == 0.0 {
-                    if slack < 0.0 {
-                        return false;
-                    }
-                } else if rate < 0.0 {
-                    t_in = t_in.max(slack / rate);
-                } else {
-                    t_out = t_out.min(slack / rate);
-                }
-                if t_in > t_out {
-                    return false;
-                }
-            }
-            !start_inside
-        }
-        Shape::Sphere(s) => {
-            let r = s.radius();
-            if p0.coords.norm() <= r {
-                return false;
-            }
-            segment_distance_to_origin(p0, p1) <= r
-        }
-        Shape::Plane(_) => false,
-    }
-}
-
-fn segment_distance_to_origin(p0: &Point, p1: &Point) -> Real {
-    let d: Vector = p1 - p0;
-    let len2 = d.norm_squared();
-    let t = if len2 > 0.0 {
-        (-p0.coords.dot(&d) / len2).clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
-    (p0.coords + t * d).norm()
+    shape.convex().is_some_and(|c| c.segment_enters(p0, p1))
 }
 
 impl TunnellingMonitor {
@@ -264,7 +219,7 @@ mod tests {
     use super::*;
     use crate::dynamics::{PrincipalInertia, RigidBody};
     use crate::law::{ContactModel, DampingLaw, NormalLaw, TangentialLaw};
-    use crate::math::Rotation;
+    use crate::math::{Rotation, Vector};
     use crate::shape::{ConvexPolyhedron, Plane};
     use crate::world::{step, MaterialTable, StepParams, StepScratch, Wall};
     use std::sync::Arc;

@@ -229,6 +229,7 @@ impl World {
             }
             Some(Shape::Polyhedron(p)) => p.bounding_radius(),
             Some(Shape::Sphere(s)) => s.radius(),
+            Some(other) => other.convex().map_or(0.0, |c| c.bounding_radius()),
         };
         self.check_material(name, material, false)?;
         self.bodies.push(body);

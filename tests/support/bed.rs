@@ -119,6 +119,13 @@ fn z_extent(shape: &Shape, orientation: &Rotation) -> (Real, Real) {
         }
         Shape::Sphere(s) => (s.radius(), s.radius()),
         Shape::Plane(_) => unreachable!("bed bodies are never planes"),
+        other => match other.convex() {
+            Some(c) => {
+                let aabb = c.aabb(&Pose::from_parts(Vector::zeros().into(), *orientation));
+                (-aabb.mins.z, aabb.maxs.z)
+            }
+            None => unreachable!("bed bodies are never planes"),
+        },
     }
 }
 

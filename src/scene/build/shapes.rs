@@ -19,18 +19,20 @@ type Builder = fn(&Named) -> Result<(Shape, Pose), SceneError>;
 
 /// The shape kinds of the scene format: the scene key, the one field that describes the kind, its
 /// builder.
-const KINDS: [(&str, &str, Builder); 3] = [
+const KINDS: [(&str, &str, Builder); 4] = [
     ("box", "half_extents", box_shape),
     ("sphere", "radius", sphere_shape),
     ("polyhedron", "points", polyhedron_shape),
+    ("ellipsoid", "semi_axes", ellipsoid_shape),
 ];
 
 /// Which kind-specific fields a `[[shape]]` gives, in the order a misplaced one is reported.
-fn kind_fields(s: &ShapeSection) -> [(&'static str, bool); 3] {
+fn kind_fields(s: &ShapeSection) -> [(&'static str, bool); 4] {
     [
         ("half_extents", s.half_extents.is_some()),
         ("radius", s.radius.is_some()),
         ("points", s.points.is_some()),
+        ("semi_axes", s.semi_axes.is_some()),
     ]
 }
 
@@ -116,7 +118,7 @@ fn build_shape(
     builder(&named)
 }
 
-/// `"box", "sphere" or "polyhedron"`.
+/// `"box", "sphere", "polyhedron" or "ellipsoid"`.
 fn expected_kinds() -> String {
     let quoted: Vec<String> = KINDS
         .iter()
@@ -199,6 +201,23 @@ fn sphere_shape(n: &Named) -> Result<(Shape, Pose), SceneError> {
     Ok((Shape::Sphere(sphere), Pose::identity()))
 }
 
+/// `kind = "ellipsoid"`: semi-axes (a, b, c) along the shape's x, y, z.
+fn ellipsoid_shape(n: &Named) -> Result<(Shape, Pose), SceneError> {
+    let axes =
+        n.s.semi_axes
+            .as_ref()
+            .ok_or_else(|| n.missing("semi_axes", "an ellipsoid needs semi_axes"))?;
+    let v = n.ctx.vector(axes, &n.field("semi_axes"))?;
+    let shape = Shape::ellipsoid(v.x, v.y, v.z).map_err(|e| {
+        n.ctx.invalid(
+            axes.span(),
+            n.field("semi_axes"),
+            format!("must be positive, got {:?}: {e}", axes.get_ref()),
+        )
+    })?;
+    Ok((shape, Pose::identity()))
+}
+
 /// `kind = "polyhedron"`: the convex hull of the points.
 fn polyhedron_shape(n: &Named) -> Result<(Shape, Pose), SceneError> {
     let pts =
@@ -225,6 +244,11 @@ pub(super) fn volume_and_moments(shape: &Shape) -> (Real, Vector) {
             s.mass_properties().principal_moments,
         ),
         Shape::Plane(_) => unreachable!("scene shapes are never planes"),
+        other => {
+            let convex = other.convex().expect("every shape but a plane is convex");
+            let m = convex.mass_properties();
+            (m.volume, m.principal_moments)
+        }
     }
 }
 
@@ -234,5 +258,6 @@ pub(super) fn bounding_radius(shape: &Shape) -> Real {
         Shape::Polyhedron(p) => p.bounding_radius(),
         Shape::Sphere(s) => s.radius(),
         Shape::Plane(_) => 0.0,
+        other => other.convex().map_or(0.0, |c| c.bounding_radius()),
     }
 }

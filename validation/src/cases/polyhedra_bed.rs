@@ -139,6 +139,9 @@ fn world_bed_top(sim: &Simulation, projectile: usize) -> Real {
                     .fold(Real::NEG_INFINITY, Real::max),
                 Shape::Sphere(s) => pose.translation.vector.z + s.radius(),
                 Shape::Plane(_) => Real::NEG_INFINITY,
+                other => other
+                    .convex()
+                    .map_or(Real::NEG_INFINITY, |c| c.aabb(&pose).maxs.z),
             }
         })
         .fold(Real::NEG_INFINITY, Real::max)

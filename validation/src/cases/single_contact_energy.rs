@@ -65,6 +65,10 @@ pub fn body_of(shape: &Shape, position: Point, orientation: Rotation) -> RigidBo
             (mass, Vector::repeat(0.4 * mass * r * r))
         }
         Shape::Plane(_) => (1.0, Vector::repeat(1.0)),
+        other => other.convex().map_or((1.0, Vector::repeat(1.0)), |c| {
+            let props = c.mass_properties();
+            (props.volume * DENSITY, props.principal_inertia(DENSITY))
+        }),
     };
     let mut body =
         RigidBody::new_dynamic(position, mass, PrincipalInertia::new(inertia).unwrap()).unwrap();
@@ -197,6 +201,14 @@ pub fn scene(setup: Setup) -> (Shape, RigidBody, Shape, RigidBody) {
         Shape::Polyhedron(p) => lowest(p, &q_b),
         Shape::Sphere(s) => -s.radius(),
         Shape::Plane(_) => unreachable!("B is never a wall"),
+        other => match other.convex() {
+            Some(c) => {
+                c.aabb(&Pose::from_parts(Vector::zeros().into(), q_b))
+                    .mins
+                    .z
+            }
+            None => unreachable!("B is never a wall"),
+        },
     };
     let a = body_of(&shape_a, Point::origin(), q_a);
     // Offset B sideways a little so the contact is not on A's axis, and start 1e-4 m apart.
