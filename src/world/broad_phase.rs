@@ -29,7 +29,7 @@
 use crate::math::{Point, Real, Vector};
 
 use super::region_profile::{self, Section};
-use super::world::Wall;
+use super::wall::Wall;
 
 /// A candidate pair of body indices, `i < j`.
 pub type Pair = (u32, u32);

@@ -70,6 +70,7 @@ use crate::math::{Point, Pose, Real, Vector};
 use crate::shape::{ConvexPolyhedron, Shape, SupportMap};
 
 use super::contact_store::ContactState;
+pub use super::contact_store::SeparationBound;
 
 /// The switches of the step's skips (see the module docs); all on by default: each is exact or changes
 /// nothing beyond the solver tolerance.
@@ -235,34 +236,6 @@ pub(super) fn polyhedron_pair(
 /// The round-off margin of a stored separation, relative to the pair's size and distance
 /// (R_A + R_B + |t₁₂|): the cached-axis test and the bound each round at ~1e-15 of that.
 pub const MOTION_BOUND_MARGIN: Real = 1e-9;
-
-/// What a polyhedron pair keeps of the last cached-axis test that proved it separated (see the module docs):
-/// the pose of B relative to A then and the gap along the cached axis. No proof (the default): `gap` = 0.
-#[derive(Copy, Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
-pub struct SeparationBound {
-    /// The pose of B in A's frame at the test.
-    pub pos12: Pose,
-    /// The gap (m) along the cached axis at the test, less the round-off margin; 0 when there is none.
-    pub gap: Real,
-}
-
-impl SeparationBound {
-    /// Drops the proof (the pair went through another query, so its cached axis may have changed).
-    #[inline]
-    pub fn clear(&mut self) {
-        self.gap = 0.0;
-    }
-}
-
-/// No proof: the check never passes.
-impl Default for SeparationBound {
-    fn default() -> Self {
-        Self {
-            pos12: Pose::identity(),
-            gap: 0.0,
-        }
-    }
-}
 
 /// The motion bound of a polyhedron pair with B at `pos12` in A's frame: whether the pair's cached-axis
 /// test is certain to reject it, from the separation the store kept (`bound`) and the relative motion

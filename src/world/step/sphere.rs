@@ -1,7 +1,7 @@
 //! The step of a world whose bodies are all free spheres: the integration stages (1–2, 7–8) without the
 //! per-body tests that only other bodies need.
 //!
-//! [`super::step::step`] hands a step to [`step_spheres`] when [`applies`] holds: the `sphere_kernel` skip
+//! [`super::step`] hands a step to [`step_spheres`] when [`applies`] holds: the `sphere_kernel` skip
 //! and the `isotropic_rotation` and `still_rotation` skips are on, the rotation scheme is the splitting,
 //! sleeping is off (no body asleep), the loads are current (not the first step), and every body is a
 //! dynamic sphere with equal principal moments. For such a body the general stages decide, per body and
@@ -10,7 +10,7 @@
 //! - 1–2: v ← v + ½Δt (F/m + g − (c/m) v), L ← L + ½Δt p, x ← x + Δt v, the orientation turned about L
 //!   ([`drift_isotropic`], or not at all for L = 0: the general path's `still_rotation` branch);
 //! - 7–8: the second half kick, then the finiteness check of its loads and state (the general step's
-//!   `non_finite_quantity` of [`super::step`]: one sum of the 22 values first, the quantities one by one
+//!   `non_finite_quantity` of [`super::checks`]: one sum of the 22 values first, the quantities one by one
 //!   only when it is not finite).
 //!
 //! Stages 3–6 are the general ones (with the sphere kernel of [`super::sphere_kernel`]), and so are the
@@ -26,17 +26,19 @@ use crate::dynamics::{Motion, RigidBody, RotationScheme, TranslationParams};
 use crate::math::{Real, Vector};
 use crate::shape::Shape;
 
-use super::body_inputs;
-use super::energy::StepPowers;
-use super::parallel::{
+use super::super::body_inputs;
+use super::super::parallel::{
     for_each_item3, for_each_item3_checked, for_each_item_checked, integration_work,
 };
-use super::region_profile::{self, Section};
-use super::step::{
-    evaluate_loads, non_finite_quantity, sum_body_loads, StepError, StepParams, StepReport,
-    StepScratch,
-};
-use super::world::World;
+use super::super::region_profile::{self, Section};
+use super::super::world::World;
+use super::accumulate::sum_body_loads;
+use super::checks::non_finite_quantity;
+use super::ledger::StepPowers;
+use super::loads;
+use super::params::StepParams;
+use super::report::{StepError, StepReport};
+use super::scratch::StepScratch;
 
 /// Whether the next step of `world` under `params` takes the free-sphere path of [`step_spheres`] (see
 /// the module docs; exported as `world::sphere_step_applies` for the tests that compare the two paths).
@@ -163,7 +165,7 @@ pub(super) fn step_spheres(
     }
 
     // 3–6. Loads at the new positions (sleeping is off: the sums of a parallel evaluation may wait).
-    evaluate_loads(params, world, scratch, &mut report, dt, true)?;
+    loads::evaluate(params, world, scratch, &mut report, dt, true)?;
 
     // 7–8. Second half kick and checks, in one pass.
     let t = Instant::now();
