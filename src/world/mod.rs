@@ -21,6 +21,7 @@ mod sleep_state;
 pub mod sleeping;
 pub mod sphere_flat;
 pub mod step;
+pub mod timing;
 pub mod tunnelling;
 mod wall;
 #[allow(clippy::module_inception)]

@@ -8,14 +8,13 @@
 //! the pass of stages 7–8 when nothing reads the loads before it: no frozen contributions to add, no
 //! prescribed body's power, no sleeping check (the caller's choice).
 
-use std::time::{Duration, Instant};
-
 use crate::math::{Real, Vector};
 
 use super::super::contact_store::{BodyAdjacency, ContactKey};
 use super::super::parallel::{for_each_item_pair, Worker};
-use super::super::region_profile::{self, Section};
+use super::super::region_profile::Section;
 use super::super::sleeping::FrozenLoads;
+use super::super::timing::{Stage, StageClock};
 use super::super::world::{Loads, World};
 use super::laws::Evaluated;
 use super::ledger::external_power;
@@ -34,8 +33,8 @@ pub(super) fn stage(
     pass: Pass,
     defer_gather: bool,
 ) {
-    let t = Instant::now();
-    let profile_sums = region_profile::serial_start();
+    let mut clock = StageClock::start();
+    let profile_sums = clock.serial_start();
     report.contacts = 0;
     report.max_overlap_ratio = 0.0;
     report.overlap_warnings.clear();
@@ -50,13 +49,11 @@ pub(super) fn stage(
     reset(loads, n, world.walls.len(), gather);
     scratch.deferred_gather =
         gather && defer_gather && !scratch.any_prescribed && world.sleep.sleeping == 0;
-    let mut gather_time = Duration::ZERO;
     if gather && !scratch.deferred_gather {
         // The rows are rebuilt (serially) after a sync that changed the keys.
         let adjacency = world.contacts.body_adjacency(n);
-        let t_gather = Instant::now();
         let evaluated = &scratch.evaluated;
-        region_profile::region(Section::Gather, || {
+        clock.region(Section::Gather, true, || {
             for_each_item_pair(
                 true,
                 &mut loads.forces,
@@ -64,7 +61,6 @@ pub(super) fn stage(
                 |i, force, torque| sum_body_loads(adjacency, evaluated, i, force, torque),
             )
         });
-        gather_time = t_gather.elapsed();
     }
     sum_picked(
         &scratch.workers,
@@ -89,10 +85,8 @@ pub(super) fn stage(
     };
     loads.external_power = external_power(loads, prescribed, &world.walls);
     loads.current = true;
-    region_profile::serial_end(Section::SerialSums, profile_sums);
-    let elapsed = t.elapsed();
-    report.counters.accumulate += elapsed;
-    report.counters.serial += elapsed.saturating_sub(gather_time);
+    clock.serial_end(Section::SerialSums, profile_sums);
+    report.counters.add(Stage::Accumulate, clock.stop());
 }
 
 /// The loads before the sums: `n` bodies, `n_walls` walls, the sums zero. The scatter adds into zeros;

@@ -2,9 +2,8 @@
 //! longer covers the moves, the candidate list (kept from the last step unless the grid was rebuilt or a
 //! dynamic flag changed), and the contact models of the step.
 
-use std::time::Instant;
-
-use super::super::region_profile::{self, Section};
+use super::super::region_profile::Section;
+use super::super::timing::{Stage, StageClock};
 use super::super::world::World;
 use super::counters::StepCounters;
 use super::laws::effective_models;
@@ -18,8 +17,8 @@ pub(super) fn stage(
     scratch: &mut StepScratch,
     counters: &mut StepCounters,
 ) {
-    let t = Instant::now();
-    let profile_inputs = region_profile::serial_start();
+    let mut clock = StageClock::start();
+    let profile_inputs = clock.serial_start();
     // Per-body inputs of the stages below (centres for the broad phase, flags: dynamic, anisotropic,
     // prescribed, moved half the skin), written by this step's drift pass, else here (the initial
     // evaluation), then folded (see [`super::super::body_inputs`]).
@@ -37,12 +36,12 @@ pub(super) fn stage(
         || broad.centres_at_build().len() != inputs.centres.len()
         || broad.walls_moved(&world.walls)
         || (summary.any_far && broad.pairs_may_be_stale(&inputs.centres, &world.walls));
-    region_profile::serial_end(Section::SerialInputs, profile_inputs);
+    clock.serial_end(Section::SerialInputs, profile_inputs);
     if rebuild {
-        broad.rebuild_with_walls(&inputs.centres, &world.radii, &world.walls);
+        broad.rebuild_with_walls_timed(&inputs.centres, &world.radii, &world.walls, &mut clock);
         counters.broad_rebuilds += 1;
     }
-    let profile_inputs = region_profile::serial_start();
+    let profile_inputs = clock.serial_start();
     // The candidate list: kept from the last step unless the grid was rebuilt or a dynamic flag changed.
     inputs.update_candidates(
         broad,
@@ -56,8 +55,6 @@ pub(super) fn stage(
     scratch.any_prescribed = summary.any_prescribed;
     // The contact models of every material pair with the skips applied, once per step.
     effective_models(&world.materials, &params.skips, &mut scratch.models);
-    region_profile::serial_end(Section::SerialInputs, profile_inputs);
-    let elapsed = t.elapsed();
-    counters.broad += elapsed;
-    counters.serial += elapsed.saturating_sub(world.broad_phase.take_parallel_search_time());
+    clock.serial_end(Section::SerialInputs, profile_inputs);
+    counters.add(Stage::Broad, clock.stop());
 }

@@ -4,6 +4,8 @@ use std::time::Duration;
 
 use crate::contact::QueryCounters;
 
+use super::super::timing::{Stage, StageTime};
+
 #[cfg(doc)]
 use super::super::parallel::Parallelism;
 
@@ -74,6 +76,19 @@ impl StepCounters {
         self.woken += other.woken;
         self.sleeping_body_steps += other.sleeping_body_steps;
         self.query.merge(&other.query);
+    }
+
+    /// Adds the time of `stage` (see [`crate::world::timing`]).
+    #[inline]
+    pub fn add(&mut self, stage: Stage, time: StageTime) {
+        let slot = match stage {
+            Stage::Broad => &mut self.broad,
+            Stage::Narrow => &mut self.narrow,
+            Stage::Accumulate => &mut self.accumulate,
+            Stage::Integrate => &mut self.integrate,
+        };
+        *slot += time.wall;
+        self.serial += time.serial;
     }
 
     /// Wall time of all stages.

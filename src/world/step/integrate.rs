@@ -1,8 +1,6 @@
 //! Stages 1–2 (first half kick, drift) and 7–8 (second half kick with the checks of the same body) of the
 //! general step: one pass over the bodies each, on the pool when the scene is large enough.
 
-use std::time::Instant;
-
 use crate::dynamics::rotation::{drift_isotropic, is_isotropic};
 use crate::dynamics::translation::drift_position;
 use crate::dynamics::{Integrator, Motion, RigidBody, RotationScheme, TranslationParams};
@@ -12,7 +10,8 @@ use super::super::body_inputs;
 use super::super::parallel::{
     for_each_item3_checked, for_each_item4, for_each_item_checked, integration_work,
 };
-use super::super::region_profile::{self, Section};
+use super::super::region_profile::Section;
+use super::super::timing::{Stage, StageClock};
 use super::super::world::World;
 use super::accumulate::sum_body_loads;
 use super::checks::non_finite_quantity;
@@ -42,7 +41,7 @@ pub(super) fn kick_and_drift(
     counters: &mut StepCounters,
 ) {
     let dt = params.dt;
-    let t = Instant::now();
+    let mut clock = StageClock::start();
     let parallel_bodies = integration_work(world.bodies.len(), scratch.inputs.summary.anisotropic)
         >= params.parallel.min_bodies;
     let (loads, asleep) = (&world.loads, &world.sleep);
@@ -85,7 +84,7 @@ pub(super) fn kick_and_drift(
         }
         integrator.drift(body, dt);
     };
-    region_profile::region(Section::KickDrift, || {
+    clock.region(Section::KickDrift, parallel_bodies, || {
         for_each_item4(
             parallel_bodies,
             &mut world.bodies,
@@ -105,11 +104,7 @@ pub(super) fn kick_and_drift(
     for wall in &mut world.walls {
         wall.pose.translation.vector += dt * wall.velocity;
     }
-    let elapsed = t.elapsed();
-    counters.integrate += elapsed;
-    if !parallel_bodies {
-        counters.serial += elapsed;
-    }
+    counters.add(Stage::Integrate, clock.stop());
 }
 
 /// Stages 7–8: the second half kick, then the checks of the same body, in one pass; the first non-finite
@@ -125,18 +120,17 @@ pub(super) fn kick_and_check(
 ) -> Result<(), StepError> {
     let dt = params.dt;
     let skip = params.skips;
-    let t = Instant::now();
+    let mut clock = StageClock::start();
     let parallel_bodies = integration_work(world.bodies.len(), scratch.inputs.summary.anisotropic)
         >= params.parallel.min_bodies;
     let non_finite = if std::mem::take(&mut scratch.deferred_gather) {
         let n_bodies = world.bodies.len();
-        let adjacency = region_profile::serial(Section::SerialStore, || {
+        let adjacency = clock.serial(Section::SerialStore, || {
             world.contacts.body_adjacency(n_bodies)
         });
-        counters.serial += t.elapsed();
         let (evaluated, asleep) = (&scratch.evaluated, &world.sleep);
         let loads = &mut world.loads;
-        region_profile::region(Section::KickChecks, || {
+        clock.region(Section::KickChecks, true, || {
             for_each_item3_checked(
                 true,
                 &mut world.bodies,
@@ -154,20 +148,16 @@ pub(super) fn kick_and_check(
         })
     } else {
         let (loads, asleep) = (&world.loads, &world.sleep);
-        let non_finite = region_profile::region(Section::KickChecks, || {
+        clock.region(Section::KickChecks, parallel_bodies, || {
             for_each_item_checked(parallel_bodies, &mut world.bodies, |i, body| {
                 if !(asleep.is_asleep(i) || (skip.non_dynamic_pairs && is_at_rest_fixed(body))) {
                     integrator.second_half_kick(body, &loads.forces[i], &loads.torques[i], dt);
                 }
                 non_finite_quantity(body, &loads.forces[i], &loads.torques[i])
             })
-        });
-        if !parallel_bodies {
-            counters.serial += t.elapsed();
-        }
-        non_finite
+        })
     };
-    counters.integrate += t.elapsed();
+    counters.add(Stage::Integrate, clock.stop());
     match non_finite {
         Some(found) => Err(StepError::non_finite(world, found)),
         None => Ok(()),

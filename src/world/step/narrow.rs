@@ -1,8 +1,6 @@
 //! Stages 4–5: the narrow phase (one contact query per candidate) fused with the laws, in one pass over
 //! the contact store synced to the candidate list.
 
-use std::time::Instant;
-
 use crate::contact::{
     contact_plane_sphere, contact_sphere_sphere, query_with, ContactError, QueryCounters,
 };
@@ -12,9 +10,10 @@ use crate::shape::Shape;
 use super::super::contact_store::{ContactKey, ContactState};
 use super::super::energy::ContactWork;
 use super::super::parallel::{for_each_chunked, Worker};
-use super::super::region_profile::{self, Section};
+use super::super::region_profile::Section;
 use super::super::skips;
 use super::super::sleeping;
+use super::super::timing::{Stage, StageClock};
 use super::super::world::World;
 use super::counters::StepCounters;
 use super::laws::{contact_law, Evaluated, PairInputs};
@@ -45,20 +44,18 @@ pub(super) fn stage(
     // 4–5. Narrow phase and laws, fused: per candidate, the contact query then (if the shapes overlap) the
     // law, in one pass over the store (in parallel, each candidate writing its own store entry and result
     // slot). Frozen candidates keep their last geometry and force (see [`super::super::sleeping`]).
-    let t = Instant::now();
+    let mut clock = StageClock::start();
     let step_index = world.step_index;
     // The store is taken out of the world for stages 4–5 so that the queries can read the bodies while
     // writing the per-pair state; it is put back before any return.
     let mut contacts = std::mem::take(&mut world.contacts);
-    let t_sync = Instant::now();
-    let sync = region_profile::serial(Section::SerialStore, || {
+    let sync = clock.serial(Section::SerialStore, || {
         contacts.sync_tagged(
             &scratch.candidates,
             scratch.inputs.candidates_tag,
             step_index,
         )
     });
-    counters.serial += t_sync.elapsed();
     counters.contacts_created += sync.created as u64;
     counters.contacts_dropped += sync.dropped as u64;
     let store_changed = sync.created + sync.dropped > 0;
@@ -69,14 +66,16 @@ pub(super) fn stage(
     let world_ref: &World = world;
     let candidates = &scratch.candidates;
     // The sphere path: its per-body inputs, gathered once (see [`super::sphere_kernel`]).
+    let parallel_bodies = world_ref.bodies.len() >= params.parallel.min_bodies;
     let spheres = (params.skips.sphere_kernel
-        && sphere_kernel::gather(
-            world_ref,
-            params.skips.isotropic_rotation,
-            world_ref.bodies.len() >= params.parallel.min_bodies
-                && rayon::current_num_threads() > 1,
-            &mut scratch.spheres,
-        ))
+        && clock.pool(parallel_bodies, || {
+            sphere_kernel::gather(
+                world_ref,
+                params.skips.isotropic_rotation,
+                parallel_bodies && rayon::current_num_threads() > 1,
+                &mut scratch.spheres,
+            )
+        }))
     .then_some(scratch.spheres.as_slice());
     let pair = PairInputs {
         world: world_ref,
@@ -88,8 +87,7 @@ pub(super) fn stage(
         step_index,
         ledger: params.energy_ledger,
     };
-    let t_parallel = Instant::now();
-    let evaluated = region_profile::region(Section::Narrow, || {
+    let evaluated = clock.region(Section::Narrow, parallel, || {
         for_each_chunked(
             parallel,
             contacts.states_mut(),
@@ -106,9 +104,6 @@ pub(super) fn stage(
             },
         )
     });
-    if !parallel {
-        counters.serial += t_parallel.elapsed();
-    }
     for worker in &mut scratch.workers {
         counters.query.merge(&worker.query);
         worker.query = QueryCounters::default();
@@ -116,7 +111,7 @@ pub(super) fn stage(
     }
     world.contacts = contacts;
     evaluated?;
-    counters.narrow += t.elapsed();
+    counters.add(Stage::Narrow, clock.stop());
 
     Ok(Pass {
         parallel,

@@ -18,8 +18,6 @@
 //! the path is exact: the same bits as the general step, for any number of threads
 //! (`tests/world_sphere_fast_paths.rs` compares the two, and one and two threads).
 
-use std::time::Instant;
-
 use crate::dynamics::rotation::{drift_isotropic, is_isotropic};
 use crate::dynamics::translation::{drift_position, first_half_kick, second_half_kick};
 use crate::dynamics::{Motion, RigidBody, RotationScheme, TranslationParams};
@@ -30,7 +28,8 @@ use super::super::body_inputs;
 use super::super::parallel::{
     for_each_item3, for_each_item3_checked, for_each_item_checked, integration_work,
 };
-use super::super::region_profile::{self, Section};
+use super::super::region_profile::Section;
+use super::super::timing::{Stage, StageClock};
 use super::super::world::World;
 use super::accumulate::sum_body_loads;
 use super::checks::non_finite_quantity;
@@ -123,7 +122,7 @@ pub(super) fn step_spheres(
     let powers = StepPowers::at_start(params.damping, world);
 
     // 1–2. First half kick with the kept loads, drift.
-    let t = Instant::now();
+    let mut clock = StageClock::start();
     let parallel_bodies = integration_work(world.bodies.len(), scratch.inputs.summary.anisotropic)
         >= params.parallel.min_bodies;
     let loads = &world.loads;
@@ -134,7 +133,7 @@ pub(super) fn step_spheres(
         world.broad_phase.centres_at_build(),
         world.broad_phase.rebuild_limit_sq(),
     );
-    region_profile::region(Section::KickDrift, || {
+    clock.region(Section::KickDrift, parallel_bodies, || {
         for_each_item3(
             parallel_bodies,
             &mut world.bodies,
@@ -158,28 +157,23 @@ pub(super) fn step_spheres(
     for wall in &mut world.walls {
         wall.pose.translation.vector += dt * wall.velocity;
     }
-    let elapsed = t.elapsed();
-    report.counters.integrate += elapsed;
-    if !parallel_bodies {
-        report.counters.serial += elapsed;
-    }
+    report.counters.add(Stage::Integrate, clock.stop());
 
     // 3–6. Loads at the new positions (sleeping is off: the sums of a parallel evaluation may wait).
     loads::evaluate(params, world, scratch, &mut report, dt, true)?;
 
     // 7–8. Second half kick and checks, in one pass.
-    let t = Instant::now();
+    let mut clock = StageClock::start();
     let parallel_bodies = integration_work(world.bodies.len(), scratch.inputs.summary.anisotropic)
         >= params.parallel.min_bodies;
     let non_finite = if std::mem::take(&mut scratch.deferred_gather) {
         let n_bodies = world.bodies.len();
-        let adjacency = region_profile::serial(Section::SerialStore, || {
+        let adjacency = clock.serial(Section::SerialStore, || {
             world.contacts.body_adjacency(n_bodies)
         });
-        report.counters.serial += t.elapsed();
         let evaluated = &scratch.evaluated;
         let loads = &mut world.loads;
-        region_profile::region(Section::KickChecks, || {
+        clock.region(Section::KickChecks, true, || {
             for_each_item3_checked(
                 true,
                 &mut world.bodies,
@@ -193,17 +187,13 @@ pub(super) fn step_spheres(
         })
     } else {
         let loads = &world.loads;
-        let non_finite = region_profile::region(Section::KickChecks, || {
+        clock.region(Section::KickChecks, parallel_bodies, || {
             for_each_item_checked(parallel_bodies, &mut world.bodies, |i, body| {
                 kick_and_check(body, &loads.forces[i], &loads.torques[i], &translation, dt)
             })
-        });
-        if !parallel_bodies {
-            report.counters.serial += t.elapsed();
-        }
-        non_finite
+        })
     };
-    report.counters.integrate += t.elapsed();
+    report.counters.add(Stage::Integrate, clock.stop());
     if let Some(found) = non_finite {
         return Err(StepError::non_finite(world, found));
     }
