@@ -35,7 +35,9 @@
 
 use crate::contact::{swap_pair, ContactGeometry, ContactKind, PairCache, SolverStatus};
 use crate::law::TangentialHistory;
-use crate::math::{Point, Pose, Real, Vector};
+use crate::math::{Point, Vector};
+
+pub use super::separation_bound::SeparationBound;
 
 /// The ordered pair a contact belongs to (see the module docs for the orientation).
 #[derive(
@@ -310,34 +312,6 @@ impl ContactStore {
 
     pub fn is_empty(&self) -> bool {
         self.keys.is_empty()
-    }
-}
-
-/// What a polyhedron pair keeps of the last cached-axis test that proved it separated (see [`super::skips`]):
-/// the pose of B relative to A then and the gap along the cached axis. No proof (the default): `gap` = 0.
-#[derive(Copy, Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
-pub struct SeparationBound {
-    /// The pose of B in A's frame at the test.
-    pub pos12: Pose,
-    /// The gap (m) along the cached axis at the test, less the round-off margin; 0 when there is none.
-    pub gap: Real,
-}
-
-impl SeparationBound {
-    /// Drops the proof (the pair went through another query, so its cached axis may have changed).
-    #[inline]
-    pub fn clear(&mut self) {
-        self.gap = 0.0;
-    }
-}
-
-/// No proof: the check never passes.
-impl Default for SeparationBound {
-    fn default() -> Self {
-        Self {
-            pos12: Pose::identity(),
-            gap: 0.0,
-        }
     }
 }
 

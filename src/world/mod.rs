@@ -16,6 +16,7 @@ pub mod contact_store;
 pub mod energy;
 pub mod parallel;
 pub mod region_profile;
+mod separation_bound;
 pub mod skips;
 mod sleep_state;
 pub mod sleeping;

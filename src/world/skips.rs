@@ -70,7 +70,7 @@ use crate::math::{Point, Pose, Real, Vector};
 use crate::shape::{ConvexPolyhedron, Shape, SupportMap};
 
 use super::contact_store::ContactState;
-pub use super::contact_store::SeparationBound;
+pub use super::separation_bound::SeparationBound;
 
 /// The switches of the step's skips (see the module docs); all on by default: each is exact or changes
 /// nothing beyond the solver tolerance.

@@ -143,45 +143,9 @@ pub(super) fn contact_law(
     out: &mut Evaluated,
 ) -> Result<(), StepError> {
     out.frozen = false;
-    let ContactState {
-        geometry: g,
-        history,
-        force_on_b,
-        damping_force,
-        ..
-    } = state;
+    let g = &state.geometry;
     if g.kind != ContactKind::Overlap {
-        out.work = ContactWork::default();
-        let previous = LastForces {
-            damping_force: *damping_force,
-            history: *history,
-        };
-        if pair.ledger && !previous.is_zero() {
-            // The pair opened in this step: its last forces acted for the first half kick.
-            let world = pair.world;
-            let (shape_a, mat_a, b) = match key {
-                ContactKey::Body { a, b } => (
-                    Some(world.shape(a as usize)),
-                    world.material_of[a as usize],
-                    b,
-                ),
-                ContactKey::Wall { body, wall } => {
-                    (None, world.walls[wall as usize].material, body)
-                }
-            };
-            let b = b as usize;
-            let model = pair
-                .model(mat_a, world.material_of[b])?
-                .for_shapes(shape_a, world.shape(b));
-            let relative_velocity = pair.relative_velocity(key, previous_point, pair.dt);
-            out.work = ContactWork::of_release(&model, &previous, &relative_velocity, pair.dt);
-        }
-        // The law resets the history of a pair that does not overlap.
-        *history = Default::default();
-        *force_on_b = Vector::zeros();
-        *damping_force = Vector::zeros();
-        out.overlapping = false;
-        return Ok(());
+        return release(pair, key, state, previous_point, out);
     }
     let world = pair.world;
     let (a_body, a_velocity_at, mat_a, b) = match key {
@@ -229,6 +193,53 @@ pub(super) fn contact_law(
         scale,
         out,
     );
+    Ok(())
+}
+
+/// Stage 5 for a candidate that does not overlap: the law resets its history and stored forces; a pair
+/// that opened in this step books the work of its last forces, which acted for the first half kick.
+#[inline]
+fn release(
+    pair: &PairInputs,
+    key: ContactKey,
+    state: &mut ContactState,
+    previous_point: &Point,
+    out: &mut Evaluated,
+) -> Result<(), StepError> {
+    let ContactState {
+        history,
+        force_on_b,
+        damping_force,
+        ..
+    } = state;
+    out.work = ContactWork::default();
+    let previous = LastForces {
+        damping_force: *damping_force,
+        history: *history,
+    };
+    if pair.ledger && !previous.is_zero() {
+        // The pair opened in this step: its last forces acted for the first half kick.
+        let world = pair.world;
+        let (shape_a, mat_a, b) = match key {
+            ContactKey::Body { a, b } => (
+                Some(world.shape(a as usize)),
+                world.material_of[a as usize],
+                b,
+            ),
+            ContactKey::Wall { body, wall } => (None, world.walls[wall as usize].material, body),
+        };
+        let b = b as usize;
+        let model = pair
+            .model(mat_a, world.material_of[b])?
+            .for_shapes(shape_a, world.shape(b));
+        let relative_velocity = pair.relative_velocity(key, previous_point, pair.dt);
+        out.work = ContactWork::of_release(&model, &previous, &relative_velocity, pair.dt);
+    }
+    // The law resets the history of a pair that does not overlap.
+    *history = Default::default();
+    *force_on_b = Vector::zeros();
+    *damping_force = Vector::zeros();
+    out.overlapping = false;
     Ok(())
 }
 

@@ -18,7 +18,7 @@
 //! the path is exact: the same bits as the general step, for any number of threads
 //! (`tests/world_sphere_fast_paths.rs` compares the two, and one and two threads).
 
-use crate::dynamics::rotation::{drift_isotropic, is_isotropic};
+use crate::dynamics::rotation::{drift_isotropic, is_isotropic, SubRotation};
 use crate::dynamics::translation::{drift_position, first_half_kick, second_half_kick};
 use crate::dynamics::{Motion, RigidBody, RotationScheme, TranslationParams};
 use crate::math::{Real, Vector};
@@ -33,6 +33,7 @@ use super::super::timing::{Stage, StageClock};
 use super::super::world::World;
 use super::accumulate::sum_body_loads;
 use super::checks::non_finite_quantity;
+use super::counters::StepCounters;
 use super::ledger::StepPowers;
 use super::loads;
 use super::params::StepParams;
@@ -68,7 +69,7 @@ fn kick_and_drift(
     force: &Vector,
     torque: &Vector,
     translation: &TranslationParams,
-    form: crate::dynamics::rotation::SubRotation,
+    form: SubRotation,
     dt: Real,
 ) {
     let h = 0.5 * dt;
@@ -122,6 +123,38 @@ pub(super) fn step_spheres(
     let powers = StepPowers::at_start(params.damping, world);
 
     // 1–2. First half kick with the kept loads, drift.
+    drift_all(
+        params,
+        &translation,
+        form,
+        world,
+        scratch,
+        &mut report.counters,
+    );
+
+    // 3–6. Loads at the new positions (sleeping is off: the sums of a parallel evaluation may wait).
+    loads::evaluate(params, world, scratch, &mut report, dt, true)?;
+
+    // 7–8. Second half kick and checks, in one pass.
+    kick_all(params, &translation, world, scratch, &mut report.counters)?;
+
+    // 9. Ledger and counters (as the general step).
+    powers.close_step(params.damping, dt, world);
+    report.counters.steps = 1;
+    Ok(report)
+}
+
+/// Stages 1–2 of every sphere, with the per-body inputs of stage 3 written in the same pass (as the
+/// general stage does), and the walls moved.
+fn drift_all(
+    params: &StepParams,
+    translation: &TranslationParams,
+    form: SubRotation,
+    world: &mut World,
+    scratch: &mut StepScratch,
+    counters: &mut StepCounters,
+) {
+    let dt = params.dt;
     let mut clock = StageClock::start();
     let parallel_bodies = integration_work(world.bodies.len(), scratch.inputs.summary.anisotropic)
         >= params.parallel.min_bodies;
@@ -144,7 +177,7 @@ pub(super) fn step_spheres(
                     body,
                     &loads.forces[i],
                     &loads.torques[i],
-                    &translation,
+                    translation,
                     form,
                     dt,
                 );
@@ -157,12 +190,19 @@ pub(super) fn step_spheres(
     for wall in &mut world.walls {
         wall.pose.translation.vector += dt * wall.velocity;
     }
-    report.counters.add(Stage::Integrate, clock.stop());
+    counters.add(Stage::Integrate, clock.stop());
+}
 
-    // 3–6. Loads at the new positions (sleeping is off: the sums of a parallel evaluation may wait).
-    loads::evaluate(params, world, scratch, &mut report, dt, true)?;
-
-    // 7–8. Second half kick and checks, in one pass.
+/// Stages 7–8 of every sphere in one pass (with stage 6's per-body sums first when it left them here);
+/// the first non-finite body in body order is the error.
+fn kick_all(
+    params: &StepParams,
+    translation: &TranslationParams,
+    world: &mut World,
+    scratch: &mut StepScratch,
+    counters: &mut StepCounters,
+) -> Result<(), StepError> {
+    let dt = params.dt;
     let mut clock = StageClock::start();
     let parallel_bodies = integration_work(world.bodies.len(), scratch.inputs.summary.anisotropic)
         >= params.parallel.min_bodies;
@@ -181,7 +221,7 @@ pub(super) fn step_spheres(
                 &mut loads.torques,
                 |i, body, force, torque| {
                     sum_body_loads(adjacency, evaluated, i, force, torque);
-                    kick_and_check(body, force, torque, &translation, dt)
+                    kick_and_check(body, force, torque, translation, dt)
                 },
             )
         })
@@ -189,17 +229,13 @@ pub(super) fn step_spheres(
         let loads = &world.loads;
         clock.region(Section::KickChecks, parallel_bodies, || {
             for_each_item_checked(parallel_bodies, &mut world.bodies, |i, body| {
-                kick_and_check(body, &loads.forces[i], &loads.torques[i], &translation, dt)
+                kick_and_check(body, &loads.forces[i], &loads.torques[i], translation, dt)
             })
         })
     };
-    report.counters.add(Stage::Integrate, clock.stop());
-    if let Some(found) = non_finite {
-        return Err(StepError::non_finite(world, found));
+    counters.add(Stage::Integrate, clock.stop());
+    match non_finite {
+        Some(found) => Err(StepError::non_finite(world, found)),
+        None => Ok(()),
     }
-
-    // 9. Ledger and counters (as the general step).
-    powers.close_step(params.damping, dt, world);
-    report.counters.steps = 1;
-    Ok(report)
 }
