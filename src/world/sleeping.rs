@@ -55,7 +55,7 @@
 //!
 //! # What a sleeping body and its contacts do
 //! A sleeping body is not integrated. A contact between two sleeping bodies, or between a sleeping body and a
-//! fixed body or a fixed wall, is *frozen* ([`is_frozen`]): neither queried nor evaluated. It keeps the
+//! fixed body or a fixed wall, is *frozen* (`is_frozen`): neither queried nor evaluated. It keeps the
 //! geometry and the force of its last evaluation, and contributes them to the loads (force, torques about
 //! the unmoved centres, elastic energy at the kept overlap; no damping or friction work since nothing
 //! moves). Keeping the last forces, rather than dropping them, is what keeps a resting pile in equilibrium
@@ -65,7 +65,7 @@
 //!
 //! # Cost
 //! The frozen contributions do not change while the set of sleeping bodies and the contact store's pairs do
-//! not: [`FrozenLoads`] sums them once, in candidate order, and the step adds the sums to the loads instead
+//! not: `FrozenLoads` sums them once, in candidate order, and the step adds the sums to the loads instead
 //! of touching every frozen pair at every step. A frozen candidate then costs the broad phase's pair, one
 //! flag test in the narrow-phase pass and one in the accumulation. The sums are rebuilt when a body falls
 //! asleep or wakes, or when the store's pairs change; they are a function of the state only (the same on

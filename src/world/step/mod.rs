@@ -28,14 +28,16 @@
 //! The candidate order is a function of the state only (the broad phase's sorted pairs, then body–wall
 //! pairs by body and wall). Stages 4 and 5 (one query and one law evaluation per candidate), the force sums
 //! of stage 6 (one body at a time, over its pairs in candidate order) and the integration (1–2, 7–8; one
-//! body at a time) run on rayon's current thread pool when the scene is large enough ([`Parallelism`]);
+//! body at a time) run on rayon's current thread pool when the scene is large enough ([`super::Parallelism`]);
 //! each computes a result per item into that item's own slot, and the sums over all candidates (energy
 //! terms, report) are taken serially in candidate order, so a run is bit-identical for any number of
 //! threads (see [`super::parallel`]; `tests/world_parallel.rs`).
 //!
-//! One file per stage: [`integrate`] (1–2, 7–8), [`broad`] (3), [`narrow`] (4), [`laws`] (5),
-//! [`accumulate`] (6), [`checks`] (8), [`ledger`] (9); [`loads`] runs 3–6 in order. A world of free spheres
-//! takes [`sphere`] for 1–2 and 7–8 and [`sphere_kernel`] inside 4–5: the same stages, the same bits.
+//! One file per stage: `integrate` (1–2, 7–8), `broad` (3), `narrow` (4), `laws` (5), `accumulate` (6),
+//! `checks` (8), `ledger` (9); `loads` runs 3–6 in order. A world of free spheres takes `sphere` for 1–2
+//! and 7–8 and `sphere_kernel` inside 4–5: the same stages, the same bits. The parameters, report, error,
+//! counters and scratch buffers are leaf files the stages share (`params`, `report`, `counters`,
+//! `scratch`), and each stage is timed by a [`super::timing::StageClock`].
 
 mod accumulate;
 mod broad;

@@ -40,7 +40,7 @@ use super::params::StepParams;
 use super::report::{StepError, StepReport};
 use super::scratch::StepScratch;
 
-/// Whether the next step of `world` under `params` takes the free-sphere path of [`step_spheres`] (see
+/// Whether the next step of `world` under `params` takes the free-sphere path of `step_spheres` (see
 /// the module docs; exported as `world::sphere_step_applies` for the tests that compare the two paths).
 pub fn applies(params: &StepParams, world: &World) -> bool {
     let skips = &params.skips;
