@@ -23,8 +23,7 @@ pub fn contact_plane_sphere(
     let n = pos1.rotation * normal1;
     let o = offset1 + n.dot(&pos1.translation.vector);
     let height = n.dot(&c2.coords) - o;
-    let point_a = c2 - n * height;
-    let point_b = c2 - n * r2;
+    let (point_a, point_b) = plane_sphere_points(c2, r2, &n, height);
     let (kind, depth, distance) = classify(r2 - height, tol.touching * 2.0 * r2);
     ContactGeometry::from_points(
         kind,
@@ -35,6 +34,15 @@ pub fn contact_plane_sphere(
         point_b,
         SolverStatus::Exact,
     )
+}
+
+/// The witness points of a sphere (centre `c2`, radius `r2`) against a plane of unit normal `n` (world)
+/// whose centre is at the signed height `height` above it: the foot c₂ − h n on the plane and the deepest
+/// point c₂ − r₂ n of the sphere. Shared by [`contact_plane_sphere`] and the flat sphere layout's wall
+/// pairs (which keep n and the plane's offset per wall).
+#[inline(always)]
+pub fn plane_sphere_points(c2: &Point, r2: Real, n: &Vector, height: Real) -> (Point, Point) {
+    (c2 - n * height, c2 - n * r2)
 }
 
 #[cfg(test)]

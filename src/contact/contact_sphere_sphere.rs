@@ -19,11 +19,8 @@ pub fn contact_sphere_sphere(
     let scale = 2.0 * r1.max(r2);
     let touch = tol.touching * scale;
     let d_vec = c2 - c1;
-    let d = d_vec.norm();
-    let normal = if d > 0.0 { d_vec / d } else { Vector::x() };
-    let point_a = c1 + normal * r1;
-    let point_b = c2 - normal * r2;
-    let signed = r1 + r2 - d;
+    let (normal, signed) = sphere_sphere_normal(&d_vec, d_vec.norm_squared(), r1 + r2);
+    let (point_a, point_b) = sphere_sphere_points(c1, r1, c2, r2, &normal);
     let (kind, depth, distance) = classify(signed, touch);
     ContactGeometry::from_points(
         kind,
@@ -34,6 +31,31 @@ pub fn contact_sphere_sphere(
         point_b,
         SolverStatus::Exact,
     )
+}
+
+/// The unit normal n (from sphere 1 to sphere 2; the world x axis for concentric spheres) and the signed
+/// overlap `reach` − d (m) of two spheres whose centres are `d_vec` = c₂ − c₁ apart, with `d_squared` =
+/// |d_vec|² and `reach` = r₁ + r₂. The closed form every path that meets two spheres takes (the general
+/// narrow phase through [`contact_sphere_sphere`], the flat sphere layout's pair loop directly, which has
+/// |d_vec|² from its cheap test); d is √|d_vec|² as `norm` forms it.
+#[inline(always)]
+pub fn sphere_sphere_normal(d_vec: &Vector, d_squared: Real, reach: Real) -> (Vector, Real) {
+    let d = d_squared.sqrt();
+    let normal = if d > 0.0 { d_vec / d } else { Vector::x() };
+    (normal, reach - d)
+}
+
+/// The surface points c₁ + r₁ n and c₂ − r₂ n of two spheres along the normal n of
+/// [`sphere_sphere_normal`] (c1 − c2 = δ n).
+#[inline(always)]
+pub fn sphere_sphere_points(
+    c1: &Point,
+    r1: Real,
+    c2: &Point,
+    r2: Real,
+    normal: &Vector,
+) -> (Point, Point) {
+    (c1 + normal * r1, c2 - normal * r2)
 }
 
 /// Kind, depth and distance from a signed overlap (positive = overlap) and the touching band.

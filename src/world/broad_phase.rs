@@ -29,7 +29,8 @@
 use crate::math::{Point, Real, Vector};
 
 use super::region_profile::{self, Section};
-use super::world::Wall;
+use super::timing::StageClock;
+use super::wall::Wall;
 
 /// A candidate pair of body indices, `i < j`.
 pub type Pair = (u32, u32);
@@ -57,12 +58,6 @@ pub struct BroadPhase {
     cell_bodies: Vec<u32>,
     #[serde(skip)]
     body_cells: Vec<CellRange>,
-    /// Time spent in the parallel pair search since the last [`take_parallel_search_time`]
-    /// (the step's serial-fraction accounting; not part of the state).
-    ///
-    /// [`take_parallel_search_time`]: BroadPhase::take_parallel_search_time
-    #[serde(skip)]
-    parallel_search_time: std::time::Duration,
     /// A number that identifies the content of `pairs` and `wall_pairs`: a fresh one at every build (unique
     /// in the process), 0 until the first call of [`generation`](BroadPhase::generation) after a
     /// deserialisation or a default construction. A clone keeps it, as it keeps the lists (not part of the
@@ -161,13 +156,6 @@ impl BroadPhase {
         0.25 * self.skin * self.skin
     }
 
-    /// The time spent in the parallelisable part of the rebuilds since the last call (the pair search from
-    /// [`PARALLEL_SEARCH_MIN_BODIES`] on, on any pool), and resets it: what the step does not count as
-    /// serial.
-    pub fn take_parallel_search_time(&mut self) -> std::time::Duration {
-        std::mem::take(&mut self.parallel_search_time)
-    }
-
     /// Whether the pair list may have become incomplete: the body count changed, or some body moved more than
     /// half the skin since the last rebuild.
     pub fn needs_rebuild(&self, centres: &[Point]) -> bool {
@@ -248,12 +236,24 @@ impl BroadPhase {
 
     /// Recomputes the body pairs and the body–wall pairs from scratch.
     pub fn rebuild_with_walls(&mut self, centres: &[Point], radii: &[Real], walls: &[Wall]) {
-        self.rebuild(centres, radii);
+        self.rebuild_with_walls_timed(centres, radii, walls, &mut StageClock::start());
+    }
+
+    /// [`BroadPhase::rebuild_with_walls`] within the stage timed by `clock` (the parallel pair search is
+    /// not serial time).
+    pub fn rebuild_with_walls_timed(
+        &mut self,
+        centres: &[Point],
+        radii: &[Real],
+        walls: &[Wall],
+        clock: &mut StageClock,
+    ) {
+        self.rebuild_timed(centres, radii, clock);
         self.walls_at_build.clear();
         self.walls_at_build
             .extend(walls.iter().map(|w| w.pose.translation.vector));
         let skin = self.skin;
-        self.wall_pairs = region_profile::serial(Section::SerialGrid, || {
+        self.wall_pairs = clock.serial(Section::SerialGrid, || {
             if centres.len() >= PARALLEL_SEARCH_MIN_BODIES && rayon::current_num_threads() > 1 {
                 // The same test per body, bodies in parallel chunks concatenated in body order: the
                 // list of the serial definition.
@@ -297,6 +297,11 @@ impl BroadPhase {
     /// `centres` and `radii` are the bounding spheres of the bodies (world frame, m), one per body; the radii
     /// must be finite and non-negative (the world checks bodies before they get here).
     pub fn rebuild(&mut self, centres: &[Point], radii: &[Real]) {
+        self.rebuild_timed(centres, radii, &mut StageClock::start());
+    }
+
+    /// [`BroadPhase::rebuild`] within the stage timed by `clock`.
+    fn rebuild_timed(&mut self, centres: &[Point], radii: &[Real], clock: &mut StageClock) {
         assert_eq!(
             centres.len(),
             radii.len(),
@@ -315,7 +320,7 @@ impl BroadPhase {
             return;
         }
         let half_skin = 0.5 * self.skin;
-        let profile_grid = region_profile::serial_start();
+        let profile_grid = clock.serial_start();
         let grid = self.grid_for(centres, radii);
 
         // Cell ranges of every body's inflated box.
@@ -363,7 +368,7 @@ impl BroadPhase {
             });
         }
 
-        region_profile::serial_end(Section::SerialGrid, profile_grid);
+        clock.serial_end(Section::SerialGrid, profile_grid);
 
         // Each pair is examined in the first cell of the overlap of both ranges only. Bodies are independent
         // here: large scenes search in parallel chunks of bodies, concatenated in body order (the same list
@@ -407,12 +412,11 @@ impl BroadPhase {
         let n = centres.len();
         if n >= PARALLEL_SEARCH_MIN_BODIES && rayon::current_num_threads() > 1 {
             use rayon::prelude::*;
-            let t = std::time::Instant::now();
             // Chunks of bodies handed out one at a time (see `parallel::for_each_chunked`): the bodies
             // of a dense region have more pairs to test.
             let chunk =
                 n.div_ceil(rayon::current_num_threads() * super::parallel::CHUNKS_PER_THREAD);
-            let found: Vec<Vec<Pair>> = region_profile::region(Section::BroadSearch, || {
+            let found: Vec<Vec<Pair>> = clock.region(Section::BroadSearch, true, || {
                 (0..n.div_ceil(chunk))
                     .into_par_iter()
                     .with_max_len(1)
@@ -426,26 +430,22 @@ impl BroadPhase {
                     })
                     .collect()
             });
-            self.parallel_search_time += t.elapsed();
             let mut pairs = std::mem::take(&mut self.pairs);
             for part in found {
                 pairs.extend_from_slice(&part);
             }
             self.pairs = pairs;
         } else {
-            let t = std::time::Instant::now();
             let mut pairs = std::mem::take(&mut self.pairs);
-            region_profile::region(Section::BroadSearch, || {
+            // Parallel from PARALLEL_SEARCH_MIN_BODIES on a pool of several threads: not serial time.
+            let on_pool = n >= PARALLEL_SEARCH_MIN_BODIES;
+            clock.region(Section::BroadSearch, on_pool, || {
                 let _timer = region_profile::chunk();
                 for i in 0..n {
                     search(i, &mut pairs);
                 }
             });
             self.pairs = pairs;
-            if n >= PARALLEL_SEARCH_MIN_BODIES {
-                // Parallel on a pool of several threads.
-                self.parallel_search_time += t.elapsed();
-            }
         }
         debug_assert!(self.pairs.windows(2).all(|w| w[0] < w[1]));
     }

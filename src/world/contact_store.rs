@@ -37,7 +37,7 @@ use crate::contact::{swap_pair, ContactGeometry, ContactKind, PairCache, SolverS
 use crate::law::TangentialHistory;
 use crate::math::{Point, Vector};
 
-use super::skips::SeparationBound;
+pub use super::separation_bound::SeparationBound;
 
 /// The ordered pair a contact belongs to (see the module docs for the orientation).
 #[derive(

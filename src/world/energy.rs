@@ -71,13 +71,10 @@
 //! implicitly in the second, and their work differs from the trapezoid by (Δt²/8) c (v_n·a_n −
 //! v_(n+1)·a_(n+1)), which telescopes (measured: fitted order 1.93, same test).
 
-use crate::dynamics::{Motion, RigidBody, ViscousDamping};
 use crate::law::tangential::{release_spring, rotate_into_tangent_plane};
 use crate::law::{ContactModel, ContactResponse, TangentialHistory};
 use crate::math::Real;
 use crate::math::Vector;
-
-use super::world::{Loads, Wall, World};
 
 /// Work accumulated since the start of the run (J).
 #[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -255,132 +252,5 @@ impl ContactWork {
             friction,
             stiffness,
         }
-    }
-}
-
-/// Mechanical terms of the current state: (T_trans, T_rot, U_gravity) over dynamic bodies.
-pub(crate) fn kinetic_and_gravity(world: &World) -> (Real, Real, Real) {
-    let (mut trans, mut rot, mut grav) = (0.0, 0.0, 0.0);
-    for body in world.bodies.iter().filter(|b| b.is_dynamic()) {
-        trans += body.translational_kinetic_energy();
-        rot += body.rotational_kinetic_energy();
-        grav -= body.mass * world.gravity.dot(&body.position.coords);
-    }
-    (trans, rot, grav)
-}
-
-/// Σ c(m)|v|² over dynamic bodies (W): the power of a global viscous damping.
-pub(crate) fn viscous_power(world: &World, coefficient: impl Fn(Real) -> Real) -> Real {
-    world
-        .bodies
-        .iter()
-        .filter(|b| b.is_dynamic())
-        .map(|b| coefficient(b.mass) * b.velocity.norm_squared())
-        .sum()
-}
-
-/// Power (W) delivered to the system through contacts by the prescribed bodies among `bodies` and by
-/// `walls`, with the contact loads `loads` and the velocities they have now: P = −Σ F·v (− Σ M·ω).
-/// `bodies` may be empty when none is prescribed (the sum skips them anyway).
-pub(super) fn external_power(loads: &Loads, bodies: &[RigidBody], walls: &[Wall]) -> Real {
-    let mut power = 0.0;
-    for (i, body) in bodies.iter().enumerate() {
-        if let Motion::Prescribed { .. } = body.motion {
-            power -= loads.forces[i].dot(&body.velocity)
-                + loads.torques[i].dot(&body.angular_velocity());
-        }
-    }
-    for (w, wall) in walls.iter().enumerate() {
-        power -= loads.wall_forces[w].dot(&wall.velocity);
-    }
-    power
-}
-
-/// The powers stage 9 integrates over a step by the trapezoid rule, as they were at its start: the
-/// external power of the moving walls and the global viscous damping's power. Both step paths (the
-/// general one and [`super::sphere_step`]) take them at the start and close the step with them.
-pub(super) struct StepPowers {
-    external: Real,
-    viscous: Real,
-}
-
-/// The global viscous damping's power at the current state; zero without damping (no pass over the
-/// bodies).
-fn damping_power(damping: ViscousDamping, world: &World) -> Real {
-    if damping != ViscousDamping::None {
-        viscous_power(world, |m| damping.coefficient(m))
-    } else {
-        0.0
-    }
-}
-
-impl StepPowers {
-    /// The powers at the start of a step. The external power is taken with the velocities the walls and
-    /// prescribed bodies have now, i.e. those this step moves them with: a caller that changed a velocity
-    /// since the last evaluation (a servo-controlled wall) would otherwise book the work of the old one.
-    /// With unchanged velocities it is the evaluation's `external_power`, bit for bit.
-    /// It costs one pass over the bodies' motion tags per step (the prescribed ones may have been changed
-    /// too, and a step after a checkpoint load has no record of which bodies are prescribed).
-    pub(super) fn at_start(damping: ViscousDamping, world: &World) -> Self {
-        Self {
-            external: external_power(&world.loads, &world.bodies, &world.walls),
-            viscous: damping_power(damping, world),
-        }
-    }
-
-    /// Stage 9: books the step's contact dissipation and work, the trapezoids of the two powers over `dt`,
-    /// and advances the time and the step index.
-    pub(super) fn close_step(self, damping: ViscousDamping, dt: Real, world: &mut World) {
-        let viscous_end = damping_power(damping, world);
-        let ledger = &mut world.ledger;
-        ledger.dissipated_damping += world.loads.damping_work;
-        ledger.dissipated_friction += world.loads.friction_dissipation;
-        ledger.tangential_stiffness_work += world.loads.tangential_stiffness_work;
-        ledger.dissipated_viscous += 0.5 * (self.viscous + viscous_end) * dt;
-        ledger.external_work += 0.5 * (self.external + world.loads.external_power) * dt;
-        world.time += dt;
-        world.step_index += 1;
-    }
-}
-
-impl World {
-    /// The ledger at the current state. Before the first step the elastic potential is that of the last
-    /// load evaluation, i.e. zero until one ran.
-    pub fn energy(&self) -> EnergyReport {
-        let (translational_kinetic, rotational_kinetic, gravitational_potential) =
-            kinetic_and_gravity(self);
-        let l = &self.ledger;
-        let mut report = EnergyReport {
-            time: self.time,
-            translational_kinetic,
-            rotational_kinetic,
-            elastic_potential: self.loads.elastic_potential,
-            gravitational_potential,
-            dissipated_damping: l.dissipated_damping,
-            dissipated_friction: l.dissipated_friction,
-            dissipated_viscous: l.dissipated_viscous,
-            external_work: l.external_work,
-            tangential_stiffness_work: l.tangential_stiffness_work,
-            balance: 0.0,
-        };
-        let initial = l.initial_total.unwrap_or_else(|| report.mechanical());
-        report.balance = report.mechanical()
-            + l.dissipated_damping
-            + l.dissipated_friction
-            + l.dissipated_viscous
-            + l.removed_by_sleeping
-            - l.external_work
-            - l.tangential_stiffness_work
-            - initial;
-        report
-    }
-
-    /// Total linear momentum of the dynamic bodies (kg·m/s).
-    pub fn linear_momentum(&self) -> Vector {
-        self.bodies
-            .iter()
-            .filter(|b| b.is_dynamic())
-            .map(|b| b.linear_momentum())
-            .sum()
     }
 }

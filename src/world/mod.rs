@@ -8,9 +8,7 @@
 //! - [`skips`]: the work a scene does not need, each skip switchable.
 //! - [`sleeping`]: freezing bodies at rest, islands, waking.
 //! - [`parallel`]: deterministic per-item parallelism of the step's stages (rayon).
-//! - `sphere_kernel`: the sphere path of the narrow phase and laws (sphere–sphere, wall–sphere).
 //! - [`sphere_flat`]: a world of free spheres stepped from flat per-sphere arrays and a half neighbour list.
-//! - `sphere_step`: the integration stages of a world of free spheres, without the per-body tests other bodies need.
 
 mod body_inputs;
 pub mod broad_phase;
@@ -18,13 +16,15 @@ pub mod contact_store;
 pub mod energy;
 pub mod parallel;
 pub mod region_profile;
+mod separation_bound;
 pub mod skips;
+mod sleep_state;
 pub mod sleeping;
 pub mod sphere_flat;
-mod sphere_kernel;
-mod sphere_step;
 pub mod step;
+pub mod timing;
 pub mod tunnelling;
+mod wall;
 #[allow(clippy::module_inception)]
 pub mod world;
 
@@ -34,6 +34,6 @@ pub use parallel::Parallelism;
 pub use skips::Skips;
 pub use sleeping::{SleepParams, SleepState};
 pub use sphere_flat::{NotSphereOnly, SphereSim, StepFlatError};
-pub use sphere_step::applies as sphere_step_applies;
+pub use step::sphere::applies as sphere_step_applies;
 pub use step::{step, StepCounters, StepError, StepParams, StepReport, StepScratch};
 pub use world::{Loads, MaterialTable, Wall, World, WorldError};

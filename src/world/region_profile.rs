@@ -1,6 +1,10 @@
 //! Opt-in profile of the step's parallel regions and serial sections: per region, the CPU time each pool
 //! thread spent in it (its load balance) and its wall time; per serial section, its CPU time.
 //!
+//! The step reaches it through its stage clocks ([`super::timing::StageClock`]), which time every stage
+//! for the step's counters whether the profile is on or not, and through the chunk timers of
+//! [`super::parallel`].
+//!
 //! Off by default (one relaxed atomic load per region, section and chunk). [`enable`] turns it on for the
 //! whole process (`examples/perf_threads.rs --profile`); [`take`] returns and clears the figures. The
 //! figures are CPU times of the threads (`CLOCK_THREAD_CPUTIME_ID`), not wall times, so that they stay

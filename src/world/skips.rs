@@ -12,7 +12,7 @@
 //! | `undamped_contacts` | the damping term of a viscous law whose coefficient is 0 (e = 1); e = 1 already maps to `DampingLaw::None`, which costs nothing | bit-identical (up to the sign of zero) |
 //! | `still_rotation` | the rotation drift of a dynamic body whose angular momentum is exactly zero | to the round-off of one quaternion renormalisation (≤ 2⁻⁵² relative) per step |
 //! | `isotropic_rotation` | the five sub-rotations of the splitting for a body whose principal moments are exactly equal (a sphere): its free rotation is one turn about the constant L by the angle Δt|L|/J, done as one quaternion product, and ω = L/J without the two frame changes | not bit-identical: the splitting is only second order for such a body (its sub-flows do not commute), the single turn is its exact flow (in the Cayley form, the same modified angle 4 atan(θ/4) as the paper's sub-steps); ω differs at round-off. Bounded in `tests/world_isotropic.rs` |
-//! | `sphere_kernel` | the general pair dispatch for candidates whose sides are spheres or a wall and a sphere: per-body inputs gathered once per step, the closed forms and the law called directly (`src/world/sphere_kernel.rs`); in a world of free spheres, also the per-body tests of the integration (`src/world/sphere_step.rs`) | exact: the same operations in the same order, bit-identical bodies, loads, ledger and contact store |
+//! | `sphere_kernel` | the general pair dispatch for candidates whose sides are spheres or a wall and a sphere: per-body inputs gathered once per step, the closed forms and the law called directly (`src/world/step/sphere_kernel.rs`); in a world of free spheres, also the per-body tests of the integration (`src/world/step/sphere.rs`) | exact: the same operations in the same order, bit-identical bodies, loads, ledger and contact store |
 //! | `non_dynamic_pairs` | queries between two non-dynamic bodies (fixed or prescribed) and the integration of fixed bodies | forces between two non-dynamic bodies are not computed: they act on nothing that moves, but the force reported on such a body omits them |
 //!
 //! Rejected pairs are stored as `Separated` with `distance` a lower bound of the true gap (the gap of the
@@ -70,6 +70,7 @@ use crate::math::{Point, Pose, Real, Vector};
 use crate::shape::{ConvexPolyhedron, Shape, SupportMap};
 
 use super::contact_store::ContactState;
+pub use super::separation_bound::SeparationBound;
 
 /// The switches of the step's skips (see the module docs); all on by default: each is exact or changes
 /// nothing beyond the solver tolerance.
@@ -235,34 +236,6 @@ pub(super) fn polyhedron_pair(
 /// The round-off margin of a stored separation, relative to the pair's size and distance
 /// (R_A + R_B + |t₁₂|): the cached-axis test and the bound each round at ~1e-15 of that.
 pub const MOTION_BOUND_MARGIN: Real = 1e-9;
-
-/// What a polyhedron pair keeps of the last cached-axis test that proved it separated (see the module docs):
-/// the pose of B relative to A then and the gap along the cached axis. No proof (the default): `gap` = 0.
-#[derive(Copy, Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
-pub struct SeparationBound {
-    /// The pose of B in A's frame at the test.
-    pub pos12: Pose,
-    /// The gap (m) along the cached axis at the test, less the round-off margin; 0 when there is none.
-    pub gap: Real,
-}
-
-impl SeparationBound {
-    /// Drops the proof (the pair went through another query, so its cached axis may have changed).
-    #[inline]
-    pub fn clear(&mut self) {
-        self.gap = 0.0;
-    }
-}
-
-/// No proof: the check never passes.
-impl Default for SeparationBound {
-    fn default() -> Self {
-        Self {
-            pos12: Pose::identity(),
-            gap: 0.0,
-        }
-    }
-}
 
 /// The motion bound of a polyhedron pair with B at `pos12` in A's frame: whether the pair's cached-axis
 /// test is certain to reject it, from the separation the store kept (`bound`) and the relative motion

@@ -15,13 +15,15 @@
 
 use crate::dynamics::RigidBody;
 use crate::law::ContactModel;
-use crate::math::{Point, Pose, Real, Vector};
-use crate::shape::{Plane, Shape};
+use crate::math::{Pose, Real, Vector};
+use crate::shape::Shape;
 
 use super::broad_phase::BroadPhase;
 use super::contact_store::ContactStore;
-use super::energy::EnergyLedger;
-use super::sleeping::SleepState;
+use super::energy::{EnergyLedger, EnergyReport};
+use super::sleep_state::SleepState;
+
+pub use super::wall::Wall;
 
 /// Why a body, wall or material could not be added.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -44,31 +46,6 @@ pub enum WorldError {
     MissingLaw { owner: String, a: String, b: String },
     #[error("wall '{wall}': {what} must be finite")]
     NonFiniteWall { wall: String, what: &'static str },
-}
-
-/// A wall: a half-space (see [`Plane`] for its convention) placed by a pose that moves with a prescribed
-/// constant velocity (zero for a fixed wall).
-#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
-pub struct Wall {
-    pub name: String,
-    pub plane: Plane,
-    /// Places the plane in the world (m).
-    pub pose: Pose,
-    /// Prescribed velocity (m/s), world frame; zero for a fixed wall.
-    pub velocity: Vector,
-    pub material: u32,
-}
-
-impl Wall {
-    /// Unit outward normal in the world frame (points to the free side).
-    pub fn normal_world(&self) -> Vector {
-        self.pose.rotation * self.plane.normal()
-    }
-
-    /// Signed distance (m) of `x` from the wall, positive on the free side.
-    pub fn signed_distance(&self, x: &Point) -> Real {
-        self.plane.signed_distance(&self.pose, x)
-    }
 }
 
 /// The symmetric table material pair → contact model.
@@ -308,4 +285,67 @@ impl World {
     pub fn length_scale(&self, i: usize) -> Real {
         self.shape(i).length_scale().unwrap_or(2.0 * self.radii[i])
     }
+}
+
+impl World {
+    /// The ledger at the current state. Before the first step the elastic potential is that of the last
+    /// load evaluation, i.e. zero until one ran.
+    pub fn energy(&self) -> EnergyReport {
+        let (translational_kinetic, rotational_kinetic, gravitational_potential) =
+            kinetic_and_gravity(self);
+        let l = &self.ledger;
+        let mut report = EnergyReport {
+            time: self.time,
+            translational_kinetic,
+            rotational_kinetic,
+            elastic_potential: self.loads.elastic_potential,
+            gravitational_potential,
+            dissipated_damping: l.dissipated_damping,
+            dissipated_friction: l.dissipated_friction,
+            dissipated_viscous: l.dissipated_viscous,
+            external_work: l.external_work,
+            tangential_stiffness_work: l.tangential_stiffness_work,
+            balance: 0.0,
+        };
+        let initial = l.initial_total.unwrap_or_else(|| report.mechanical());
+        report.balance = report.mechanical()
+            + l.dissipated_damping
+            + l.dissipated_friction
+            + l.dissipated_viscous
+            + l.removed_by_sleeping
+            - l.external_work
+            - l.tangential_stiffness_work
+            - initial;
+        report
+    }
+
+    /// Total linear momentum of the dynamic bodies (kg·m/s).
+    pub fn linear_momentum(&self) -> Vector {
+        self.bodies
+            .iter()
+            .filter(|b| b.is_dynamic())
+            .map(|b| b.linear_momentum())
+            .sum()
+    }
+}
+
+/// Mechanical terms of the current state: (T_trans, T_rot, U_gravity) over dynamic bodies.
+fn kinetic_and_gravity(world: &World) -> (Real, Real, Real) {
+    let (mut trans, mut rot, mut grav) = (0.0, 0.0, 0.0);
+    for body in world.bodies.iter().filter(|b| b.is_dynamic()) {
+        trans += body.translational_kinetic_energy();
+        rot += body.rotational_kinetic_energy();
+        grav -= body.mass * world.gravity.dot(&body.position.coords);
+    }
+    (trans, rot, grav)
+}
+
+/// Σ c(m)|v|² over dynamic bodies (W): the power of a global viscous damping.
+pub(crate) fn viscous_power(world: &World, coefficient: impl Fn(Real) -> Real) -> Real {
+    world
+        .bodies
+        .iter()
+        .filter(|b| b.is_dynamic())
+        .map(|b| coefficient(b.mass) * b.velocity.norm_squared())
+        .sum()
 }

@@ -4,9 +4,10 @@
 //! A candidate first takes the cheap test that needs no square root: two spheres whose centres are at
 //! least r_A + r_B apart, or a sphere whose centre is at least r above a wall, cannot overlap by more than
 //! the touching band, so the pair is separated (its spring is released, as the law does for a pair that
-//! does not overlap; see [`separated`] for what a pair that stays apart costs). Any other candidate takes the operations of the general narrow phase's closed forms
-//! ([`contact_sphere_sphere`], [`contact_plane_sphere`]; the distance is the square root of the squared
-//! distance of the cheap test, as `norm` forms it) and the law of the pair's model scaled by its √R*
+//! does not overlap; see [`separated`] for what a pair that stays apart costs). Any other candidate takes
+//! the general narrow phase's closed forms: a sphere pair calls the kernels of [`contact_sphere_sphere`]
+//! ([`sphere_sphere_normal`] with the squared distance of the cheap test, [`sphere_sphere_points`]), a
+//! wall pair the one of [`contact_plane_sphere`] ([`plane_sphere_points`]); then the law of the pair's model scaled by its √R*
 //! ([`ContactModel::for_contact_radii`]) with the constants of the pair formed once per list build
 //! ([`PairConstants`], [`WallConstants`]: radii, touching band, [`ContactModel::prepared`] with the
 //! pair's m*), then [`PreparedModel::respond`] — what [`ContactModel::evaluate`] does in one call — so an
@@ -14,6 +15,8 @@
 //! (`super::super::sphere_kernel`). Nothing is written for a separated pair but its flag and its cleared
 //! spring: no geometry is kept.
 
+use crate::contact::contact_sphere_plane::plane_sphere_points;
+use crate::contact::contact_sphere_sphere::{sphere_sphere_normal, sphere_sphere_points};
 use crate::contact::ContactTolerances;
 #[cfg(doc)]
 use crate::contact::{contact_plane_sphere, contact_sphere_sphere};
@@ -211,8 +214,8 @@ impl PairContext<'_> {
     /// the smaller diameter)` when it overlaps. `reach` is r_a + r_b and `c` the pair's constants;
     /// `in_contact` says whether it overlapped at the last evaluation (false: its spring is cleared).
     ///
-    /// The geometry is [`contact_sphere_sphere`]'s, by its operations (the distance's square root taken
-    /// from the squared distance of the cheap test, as `norm` forms it), and the law is the model's
+    /// The geometry is [`contact_sphere_sphere`]'s, through its kernels (the distance's square root taken
+    /// from the squared distance of the cheap test), and the law is the model's
     /// ([`PreparedModel::respond`]), so the pair gives the bits of the general step's sphere kernel.
     #[allow(clippy::too_many_arguments)]
     #[inline(always)]
@@ -234,9 +237,7 @@ impl PairContext<'_> {
             separated(history, in_contact);
             return Ok(None);
         }
-        let d = d_squared.sqrt();
-        let normal = if d > 0.0 { d_vec / d } else { Vector::x() };
-        let depth = reach - d;
+        let (normal, depth) = sphere_sphere_normal(&d_vec, d_squared, reach);
         if !(depth > c.touch && depth > 0.0) {
             separated(history, in_contact);
             return Ok(None);
@@ -244,8 +245,8 @@ impl PairContext<'_> {
         let Some(law) = &c.law else {
             return Err(self.missing_law(self.props[a].material, self.props[b].material));
         };
-        let point_a = ka.position + normal * c.radius_a;
-        let point_b = kb.position - normal * c.radius_b;
+        let (point_a, point_b) =
+            sphere_sphere_points(&ka.position, c.radius_a, &kb.position, c.radius_b, &normal);
         let point = nalgebra::center(&point_a, &point_b);
         let relative_velocity = kb.velocity_at(&point) - ka.velocity_at(&point);
         let response = law.respond(
@@ -271,7 +272,7 @@ impl PairContext<'_> {
     }
 
     /// The wall–sphere pair (A = wall `w`, B = sphere `i`) with its constants `c`: the geometry of
-    /// [`contact_plane_sphere`] by its operations, then the model (returns and flags as
+    /// [`contact_plane_sphere`] through its kernel, then the model (returns and flags as
     /// [`PairContext::body_pair`], the ratio over the sphere's diameter).
     #[inline(always)]
     pub(crate) fn wall_pair(
@@ -298,8 +299,7 @@ impl PairContext<'_> {
             return Err(self.missing_law(wall.material, p.material));
         };
         let n = wall.normal;
-        let point_a = k.position - n * height;
-        let point_b = k.position - n * p.radius;
+        let (point_a, point_b) = plane_sphere_points(&k.position, p.radius, &n, height);
         let point = nalgebra::center(&point_a, &point_b);
         let relative_velocity = k.velocity_at(&point) - wall.velocity;
         let response = law.respond(

@@ -4,6 +4,9 @@
 //! the same functions, so both give the same bits.
 
 use crate::dynamics::rotation::{drift_isotropic, SubRotation};
+use crate::dynamics::translation::{
+    drifted_position, first_half_kick_velocity, second_half_kick_velocity,
+};
 use crate::law::TangentialHistory;
 use crate::math::{Point, Real, Vector};
 
@@ -129,9 +132,16 @@ impl Drift<'_> {
         for (k, (kin, spin)) in kin.iter_mut().zip(spin.iter_mut()).enumerate() {
             let i = start + k;
             let p = &self.props[i];
-            kin.velocity += h * (self.force[i] / p.mass + self.gravity);
+            kin.velocity = first_half_kick_velocity(
+                &kin.velocity,
+                &self.force[i],
+                p.mass,
+                &self.gravity,
+                None,
+                h,
+            );
             spin.angular_momentum += h * self.torque[i];
-            kin.position += dt * kin.velocity;
+            kin.position = drifted_position(&kin.position, &kin.velocity, dt);
             if self.track_orientation && spin.angular_momentum != Vector::zeros() {
                 drift_isotropic(
                     self.form,
@@ -267,7 +277,8 @@ impl Kick<'_> {
             };
             let p = &self.props[i];
             let (kin, spin) = (&mut kin[k], &mut spin[k]);
-            kin.velocity += h * (f / p.mass + self.gravity);
+            kin.velocity =
+                second_half_kick_velocity(&kin.velocity, &f, p.mass, &self.gravity, None, h);
             spin.angular_momentum += h * t;
             let quantity = first_non_finite(
                 &f,

@@ -5,16 +5,16 @@
 //! velocity, angular velocity, radii, length scale, mass, material, whether it is a dynamic sphere) into
 //! one compact array, so that a candidate reads two small records instead of two rigid bodies, their
 //! shapes and materials; the angular velocity (L/J for a body with equal principal moments when the
-//! `isotropic_rotation` skip is on, R J̄⁻¹ Rᵀ L otherwise, as [`super::step`] takes it) is formed once per
+//! `isotropic_rotation` skip is on, R J̄⁻¹ Rᵀ L otherwise, as [`super::laws`] takes it) is formed once per
 //! body instead of once per contact side. A candidate then takes:
 //! - the bounding-sphere rejection (when the skip is on) and the closed forms
 //!   [`contact_sphere_sphere`] / [`contact_plane_sphere`], with the same arguments as the general
 //!   narrow phase;
 //! - for an overlapping pair, the kinematics (v_B − v_A at the contact point, m*, centres) and the model
 //!   scaled by √R* from the two radii ([`crate::law::ContactModel::for_contact_radii`]), then the same end of stage 5
-//!   as every other pair ([`super::step::overlap_law`]), the ledger's velocity at the last contact point
+//!   as every other pair ([`super::laws::overlap_law`]), the ledger's velocity at the last contact point
 //!   also from the gathered records;
-//! - for a pair that does not overlap, the general stage 5 ([`super::step::contact_law`]).
+//! - for a pair that does not overlap, the general stage 5 ([`super::laws::contact_law`]).
 //!
 //! Every value is computed by the same operations in the same order as the general path, so the path is
 //! exact: bodies, loads, ledger and contact store are the same bits with the `sphere_kernel` skip on or off
@@ -30,11 +30,13 @@ use crate::math::{Point, Real, Vector};
 use crate::shape::Shape;
 use rayon::prelude::*;
 
-use super::contact_store::{ContactKey, ContactState};
-use super::parallel::Worker;
-use super::skips;
-use super::step::{contact_law, overlap_law, Evaluated, PairInputs, StepError, StepParams};
-use super::world::World;
+use super::super::contact_store::{ContactKey, ContactState};
+use super::super::parallel::Worker;
+use super::super::skips;
+use super::super::world::World;
+use super::laws::{contact_law, overlap_law, Evaluated, PairInputs};
+use super::params::StepParams;
+use super::report::StepError;
 
 /// What a sphere contact reads of one body (gathered once per step by [`gather`]).
 #[derive(Clone, Copy, Debug, Default)]

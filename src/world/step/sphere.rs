@@ -1,7 +1,7 @@
 //! The step of a world whose bodies are all free spheres: the integration stages (1–2, 7–8) without the
 //! per-body tests that only other bodies need.
 //!
-//! [`super::step::step`] hands a step to [`step_spheres`] when [`applies`] holds: the `sphere_kernel` skip
+//! [`super::step`] hands a step to [`step_spheres`] when [`applies`] holds: the `sphere_kernel` skip
 //! and the `isotropic_rotation` and `still_rotation` skips are on, the rotation scheme is the splitting,
 //! sleeping is off (no body asleep), the loads are current (not the first step), and every body is a
 //! dynamic sphere with equal principal moments. For such a body the general stages decide, per body and
@@ -10,7 +10,7 @@
 //! - 1–2: v ← v + ½Δt (F/m + g − (c/m) v), L ← L + ½Δt p, x ← x + Δt v, the orientation turned about L
 //!   ([`drift_isotropic`], or not at all for L = 0: the general path's `still_rotation` branch);
 //! - 7–8: the second half kick, then the finiteness check of its loads and state (the general step's
-//!   `non_finite_quantity` of [`super::step`]: one sum of the 22 values first, the quantities one by one
+//!   `non_finite_quantity` of [`super::checks`]: one sum of the 22 values first, the quantities one by one
 //!   only when it is not finite).
 //!
 //! Stages 3–6 are the general ones (with the sphere kernel of [`super::sphere_kernel`]), and so are the
@@ -18,27 +18,29 @@
 //! the path is exact: the same bits as the general step, for any number of threads
 //! (`tests/world_sphere_fast_paths.rs` compares the two, and one and two threads).
 
-use std::time::Instant;
-
-use crate::dynamics::rotation::{drift_isotropic, is_isotropic};
+use crate::dynamics::rotation::{drift_isotropic, is_isotropic, SubRotation};
 use crate::dynamics::translation::{drift_position, first_half_kick, second_half_kick};
 use crate::dynamics::{Motion, RigidBody, RotationScheme, TranslationParams};
 use crate::math::{Real, Vector};
 use crate::shape::Shape;
 
-use super::body_inputs;
-use super::energy::StepPowers;
-use super::parallel::{
+use super::super::body_inputs;
+use super::super::parallel::{
     for_each_item3, for_each_item3_checked, for_each_item_checked, integration_work,
 };
-use super::region_profile::{self, Section};
-use super::step::{
-    evaluate_loads, non_finite_quantity, sum_body_loads, StepError, StepParams, StepReport,
-    StepScratch,
-};
-use super::world::World;
+use super::super::region_profile::Section;
+use super::super::timing::{Stage, StageClock};
+use super::super::world::World;
+use super::accumulate::sum_body_loads;
+use super::checks::non_finite_quantity;
+use super::counters::StepCounters;
+use super::ledger::StepPowers;
+use super::loads;
+use super::params::StepParams;
+use super::report::{StepError, StepReport};
+use super::scratch::StepScratch;
 
-/// Whether the next step of `world` under `params` takes the free-sphere path of [`step_spheres`] (see
+/// Whether the next step of `world` under `params` takes the free-sphere path of `step_spheres` (see
 /// the module docs; exported as `world::sphere_step_applies` for the tests that compare the two paths).
 pub fn applies(params: &StepParams, world: &World) -> bool {
     let skips = &params.skips;
@@ -67,7 +69,7 @@ fn kick_and_drift(
     force: &Vector,
     torque: &Vector,
     translation: &TranslationParams,
-    form: crate::dynamics::rotation::SubRotation,
+    form: SubRotation,
     dt: Real,
 ) {
     let h = 0.5 * dt;
@@ -121,7 +123,39 @@ pub(super) fn step_spheres(
     let powers = StepPowers::at_start(params.damping, world);
 
     // 1–2. First half kick with the kept loads, drift.
-    let t = Instant::now();
+    drift_all(
+        params,
+        &translation,
+        form,
+        world,
+        scratch,
+        &mut report.counters,
+    );
+
+    // 3–6. Loads at the new positions (sleeping is off: the sums of a parallel evaluation may wait).
+    loads::evaluate(params, world, scratch, &mut report, dt, true)?;
+
+    // 7–8. Second half kick and checks, in one pass.
+    kick_all(params, &translation, world, scratch, &mut report.counters)?;
+
+    // 9. Ledger and counters (as the general step).
+    powers.close_step(params.damping, dt, world);
+    report.counters.steps = 1;
+    Ok(report)
+}
+
+/// Stages 1–2 of every sphere, with the per-body inputs of stage 3 written in the same pass (as the
+/// general stage does), and the walls moved.
+fn drift_all(
+    params: &StepParams,
+    translation: &TranslationParams,
+    form: SubRotation,
+    world: &mut World,
+    scratch: &mut StepScratch,
+    counters: &mut StepCounters,
+) {
+    let dt = params.dt;
+    let mut clock = StageClock::start();
     let parallel_bodies = integration_work(world.bodies.len(), scratch.inputs.summary.anisotropic)
         >= params.parallel.min_bodies;
     let loads = &world.loads;
@@ -132,7 +166,7 @@ pub(super) fn step_spheres(
         world.broad_phase.centres_at_build(),
         world.broad_phase.rebuild_limit_sq(),
     );
-    region_profile::region(Section::KickDrift, || {
+    clock.region(Section::KickDrift, parallel_bodies, || {
         for_each_item3(
             parallel_bodies,
             &mut world.bodies,
@@ -143,7 +177,7 @@ pub(super) fn step_spheres(
                     body,
                     &loads.forces[i],
                     &loads.torques[i],
-                    &translation,
+                    translation,
                     form,
                     dt,
                 );
@@ -156,28 +190,30 @@ pub(super) fn step_spheres(
     for wall in &mut world.walls {
         wall.pose.translation.vector += dt * wall.velocity;
     }
-    let elapsed = t.elapsed();
-    report.counters.integrate += elapsed;
-    if !parallel_bodies {
-        report.counters.serial += elapsed;
-    }
+    counters.add(Stage::Integrate, clock.stop());
+}
 
-    // 3–6. Loads at the new positions (sleeping is off: the sums of a parallel evaluation may wait).
-    evaluate_loads(params, world, scratch, &mut report, dt, true)?;
-
-    // 7–8. Second half kick and checks, in one pass.
-    let t = Instant::now();
+/// Stages 7–8 of every sphere in one pass (with stage 6's per-body sums first when it left them here);
+/// the first non-finite body in body order is the error.
+fn kick_all(
+    params: &StepParams,
+    translation: &TranslationParams,
+    world: &mut World,
+    scratch: &mut StepScratch,
+    counters: &mut StepCounters,
+) -> Result<(), StepError> {
+    let dt = params.dt;
+    let mut clock = StageClock::start();
     let parallel_bodies = integration_work(world.bodies.len(), scratch.inputs.summary.anisotropic)
         >= params.parallel.min_bodies;
     let non_finite = if std::mem::take(&mut scratch.deferred_gather) {
         let n_bodies = world.bodies.len();
-        let adjacency = region_profile::serial(Section::SerialStore, || {
+        let adjacency = clock.serial(Section::SerialStore, || {
             world.contacts.body_adjacency(n_bodies)
         });
-        report.counters.serial += t.elapsed();
         let evaluated = &scratch.evaluated;
         let loads = &mut world.loads;
-        region_profile::region(Section::KickChecks, || {
+        clock.region(Section::KickChecks, true, || {
             for_each_item3_checked(
                 true,
                 &mut world.bodies,
@@ -185,29 +221,21 @@ pub(super) fn step_spheres(
                 &mut loads.torques,
                 |i, body, force, torque| {
                     sum_body_loads(adjacency, evaluated, i, force, torque);
-                    kick_and_check(body, force, torque, &translation, dt)
+                    kick_and_check(body, force, torque, translation, dt)
                 },
             )
         })
     } else {
         let loads = &world.loads;
-        let non_finite = region_profile::region(Section::KickChecks, || {
+        clock.region(Section::KickChecks, parallel_bodies, || {
             for_each_item_checked(parallel_bodies, &mut world.bodies, |i, body| {
-                kick_and_check(body, &loads.forces[i], &loads.torques[i], &translation, dt)
+                kick_and_check(body, &loads.forces[i], &loads.torques[i], translation, dt)
             })
-        });
-        if !parallel_bodies {
-            report.counters.serial += t.elapsed();
-        }
-        non_finite
+        })
     };
-    report.counters.integrate += t.elapsed();
-    if let Some(found) = non_finite {
-        return Err(StepError::non_finite(world, found));
+    counters.add(Stage::Integrate, clock.stop());
+    match non_finite {
+        Some(found) => Err(StepError::non_finite(world, found)),
+        None => Ok(()),
     }
-
-    // 9. Ledger and counters (as the general step).
-    powers.close_step(params.damping, dt, world);
-    report.counters.steps = 1;
-    Ok(report)
 }

@@ -1,0 +1,273 @@
+//! Stages 4–5: the narrow phase (one contact query per candidate) fused with the laws, in one pass over
+//! the contact store synced to the candidate list.
+
+use crate::contact::{
+    contact_plane_sphere, contact_sphere_sphere, query_with, ContactError, QueryCounters,
+};
+use crate::math::Real;
+use crate::shape::Shape;
+
+use super::super::contact_store::{ContactKey, ContactState};
+use super::super::energy::ContactWork;
+use super::super::parallel::{for_each_chunked, Worker};
+use super::super::region_profile::Section;
+use super::super::skips;
+use super::super::sleeping;
+use super::super::timing::{Stage, StageClock};
+use super::super::world::World;
+use super::counters::StepCounters;
+use super::laws::{contact_law, Evaluated, PairInputs};
+use super::params::StepParams;
+use super::report::StepError;
+use super::scratch::StepScratch;
+use super::sphere_kernel;
+
+/// What stage 6 needs to know of the pass of stages 4–5.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Pass {
+    /// Whether the pass ran on the pool (then stage 6 may gather the sums per body).
+    pub(super) parallel: bool,
+    /// Whether the store's sync created or dropped entries (the frozen sums are rebuilt then).
+    pub(super) store_changed: bool,
+}
+
+/// Stages 4–5, fused: per candidate, the contact query then (if the shapes overlap) the law, in one pass
+/// over the store; the results in `scratch.evaluated`, the picked candidates in the workers.
+pub(super) fn stage(
+    params: &StepParams,
+    world: &mut World,
+    scratch: &mut StepScratch,
+    counters: &mut StepCounters,
+    dt: Real,
+    omegas_fresh: bool,
+) -> Result<Pass, StepError> {
+    // 4–5. Narrow phase and laws, fused: per candidate, the contact query then (if the shapes overlap) the
+    // law, in one pass over the store (in parallel, each candidate writing its own store entry and result
+    // slot). Frozen candidates keep their last geometry and force (see [`super::super::sleeping`]).
+    let mut clock = StageClock::start();
+    let step_index = world.step_index;
+    // The store is taken out of the world for stages 4–5 so that the queries can read the bodies while
+    // writing the per-pair state; it is put back before any return.
+    let mut contacts = std::mem::take(&mut world.contacts);
+    let sync = clock.serial(Section::SerialStore, || {
+        contacts.sync_tagged(
+            &scratch.candidates,
+            scratch.inputs.candidates_tag,
+            step_index,
+        )
+    });
+    counters.contacts_created += sync.created as u64;
+    counters.contacts_dropped += sync.dropped as u64;
+    let store_changed = sync.created + sync.dropped > 0;
+    let n_candidates = scratch.candidates.len();
+    let parallel = n_candidates >= params.parallel.min_candidates;
+    // Every slot's flags are overwritten below (the rest only for overlapping pairs): no clearing.
+    scratch.evaluated.resize(n_candidates, Evaluated::default());
+    let world_ref: &World = world;
+    let candidates = &scratch.candidates;
+    // The sphere path: its per-body inputs, gathered once (see [`super::sphere_kernel`]).
+    let parallel_bodies = world_ref.bodies.len() >= params.parallel.min_bodies;
+    let spheres = (params.skips.sphere_kernel
+        && clock.pool(parallel_bodies, || {
+            sphere_kernel::gather(
+                world_ref,
+                params.skips.isotropic_rotation,
+                parallel_bodies && rayon::current_num_threads() > 1,
+                &mut scratch.spheres,
+            )
+        }))
+    .then_some(scratch.spheres.as_slice());
+    let pair = PairInputs {
+        world: world_ref,
+        isotropic: params.skips.isotropic_rotation,
+        omegas: omegas_fresh.then_some(scratch.inputs.omegas.as_slice()),
+        models: &scratch.models,
+        n_materials: world_ref.materials.len(),
+        dt,
+        step_index,
+        ledger: params.energy_ledger,
+    };
+    let evaluated = clock.region(Section::Narrow, parallel, || {
+        for_each_chunked(
+            parallel,
+            contacts.states_mut(),
+            &mut scratch.evaluated,
+            &mut scratch.workers,
+            |i, state, out, worker| {
+                candidate(params, &pair, spheres, candidates[i], state, out, worker)?;
+                // Every evaluated candidate that stage 6 has to sum is listed (serially, in candidate
+                // order, there).
+                if out.contributes() {
+                    worker.picked.push(i as u32);
+                }
+                Ok(())
+            },
+        )
+    });
+    for worker in &mut scratch.workers {
+        counters.query.merge(&worker.query);
+        worker.query = QueryCounters::default();
+        counters.frozen_pairs += worker.tally;
+    }
+    world.contacts = contacts;
+    evaluated?;
+    counters.add(Stage::Narrow, clock.stop());
+
+    Ok(Pass {
+        parallel,
+        store_changed,
+    })
+}
+
+/// Stages 4–5 for one candidate: kept as it was when frozen (both sides asleep or fixed), else the sphere
+/// path when it takes the pair, else the contact query and the law.
+#[inline(always)]
+fn candidate(
+    params: &StepParams,
+    pair: &PairInputs,
+    spheres: Option<&[sphere_kernel::SphereBody]>,
+    key: ContactKey,
+    state: &mut ContactState,
+    out: &mut Evaluated,
+    worker: &mut Worker,
+) -> Result<(), StepError> {
+    if sleeping::is_frozen_entry(pair.world, key, state) {
+        // Kept from its last evaluation and summed in `scratch.frozen` (stage 6).
+        out.frozen = true;
+        out.overlapping = false;
+        // Frozen bodies do not move: no work.
+        out.work = ContactWork::default();
+        worker.tally += 1;
+        return Ok(());
+    }
+    // The last contact point, for the ledger of a pair that opens in this step.
+    let previous_point = state.geometry.point;
+    if let Some(spheres) = spheres {
+        if let Some(done) = sphere_kernel::evaluate(
+            params,
+            pair,
+            spheres,
+            key,
+            state,
+            &previous_point,
+            out,
+            worker,
+        ) {
+            return done;
+        }
+    }
+    narrow_phase(params, pair.world, key, state, worker).map_err(|source| StepError::Contact {
+        step: pair.step_index,
+        source,
+    })?;
+    contact_law(pair, key, state, &previous_point, out)
+}
+
+/// Stage 4 for one candidate: the contact query between its two shapes (A = body a or the wall, B = body b),
+/// written to `state.geometry`. Sphere–sphere and wall–sphere pairs call their closed forms directly with
+/// the body positions (the dispatcher's own cases, without building the poses: the same values).
+#[inline]
+fn narrow_phase(
+    params: &StepParams,
+    world: &World,
+    key: ContactKey,
+    state: &mut ContactState,
+    worker: &mut Worker,
+) -> Result<(), ContactError> {
+    let tol = &params.tolerances;
+    let (pose_a, shape_a, pose_b, shape_b);
+    let wall_shape;
+    match key {
+        ContactKey::Body { a, b } => {
+            let (a, b) = (a as usize, b as usize);
+            shape_a = world.shape(a);
+            shape_b = world.shape(b);
+            let (xa, xb) = (&world.bodies[a].position, &world.bodies[b].position);
+            if params.skips.bounding_spheres {
+                if let Some(g) = skips::reject_by_bounding_spheres(
+                    xa,
+                    world.radii[a],
+                    xb,
+                    world.radii[b],
+                    shape_a
+                        .length_scale()
+                        .unwrap_or(0.0)
+                        .max(shape_b.length_scale().unwrap_or(0.0)),
+                    tol,
+                    &mut worker.query,
+                ) {
+                    state.geometry = g;
+                    return Ok(());
+                }
+            }
+            if let (Shape::Sphere(sa), Shape::Sphere(sb)) = (shape_a, shape_b) {
+                worker.query.sphere_sphere += 1;
+                state.geometry = contact_sphere_sphere(xa, sa.radius(), xb, sb.radius(), tol);
+                worker.query.record(&state.geometry);
+                return Ok(());
+            }
+            pose_a = world.pose(a);
+            pose_b = world.pose(b);
+            if let Some((pa, pb)) = skips::polyhedra(shape_a, shape_b) {
+                if skips::polyhedron_pair(
+                    &params.skips,
+                    (&pose_a, pa),
+                    (&pose_b, pb),
+                    tol,
+                    state,
+                    &mut worker.epa,
+                    &mut worker.query,
+                ) {
+                    return Ok(());
+                }
+            }
+        }
+        ContactKey::Wall { body, wall } => {
+            let wall = &world.walls[wall as usize];
+            let body = body as usize;
+            if params.skips.bounding_spheres {
+                // The wall list has a skin: a body listed may still be beyond its radius from the plane.
+                let x = &world.bodies[body].position;
+                if let Some(g) = skips::reject_wall_by_bounding_sphere(
+                    wall.signed_distance(x),
+                    &wall.normal_world(),
+                    x,
+                    world.radii[body],
+                    &mut worker.query,
+                ) {
+                    state.geometry = g;
+                    return Ok(());
+                }
+            }
+            if let Shape::Sphere(s) = world.shape(body) {
+                worker.query.sphere_plane += 1;
+                state.geometry = contact_plane_sphere(
+                    &wall.pose,
+                    wall.plane.normal(),
+                    wall.plane.offset(),
+                    &world.bodies[body].position,
+                    s.radius(),
+                    tol,
+                );
+                worker.query.record(&state.geometry);
+                return Ok(());
+            }
+            wall_shape = Shape::Plane(wall.plane);
+            pose_a = wall.pose;
+            shape_a = &wall_shape;
+            pose_b = world.pose(body);
+            shape_b = world.shape(body);
+        }
+    }
+    state.geometry = query_with(
+        &pose_a,
+        shape_a,
+        &pose_b,
+        shape_b,
+        tol,
+        &mut state.cache,
+        &mut worker.epa,
+        &mut worker.query,
+    )?;
+    Ok(())
+}
