@@ -20,7 +20,7 @@ use crate::contact::contact_sphere_sphere::{sphere_sphere_normal, sphere_sphere_
 use crate::contact::ContactTolerances;
 #[cfg(doc)]
 use crate::contact::{contact_plane_sphere, contact_sphere_sphere};
-use crate::law::{ContactModel, ContactResponse, PreparedModel, RadiusScaling, TangentialHistory};
+use crate::law::{ContactModel, ContactResponse, PreparedModel, TangentialHistory};
 use crate::math::{Point, Real, Vector};
 
 use super::super::step::StepError;
@@ -322,20 +322,14 @@ impl PairContext<'_> {
 /// with the root of the effective radius already formed.
 #[inline(always)]
 pub(crate) fn scaled(model: &ContactModel, root_radius: Real) -> ContactModel {
-    match model.normal.radius_scaling {
-        RadiusScaling::Constant => *model,
-        RadiusScaling::SqrtEffectiveRadius => model.with_root_radius(root_radius),
-    }
+    model.for_root_radius(root_radius)
 }
 
 /// A candidate that does not overlap: the law resets its spring, and it contributes nothing.
 ///
 /// A pair that was apart at the last evaluation already holds the cleared spring (`in_contact` false
 /// says so), so it reads and writes nothing but its flag: neither its spring nor its output, whose
-/// records are ~15 times the flag's size. Until 2026-11-23 the flag was a field of the output, and every
-/// separated pair read a cache line of its output and one of its spring on every step (bed c: ~82 % of
-/// ~11 000 listed pairs apart; before 2026-11-22 it also stored both, 17.5 % of `perf record`'s samples
-/// on bed a).
+/// records are ~15 times the flag's size (most listed pairs are apart: ~82 % on bed c).
 #[inline(always)]
 fn separated(history: &mut TangentialHistory, in_contact: &mut bool) {
     if *in_contact {

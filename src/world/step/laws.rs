@@ -2,7 +2,7 @@
 //! stored forces; what stage 6 reads of the result.
 
 use crate::contact::ContactKind;
-use crate::law::{ContactKinematics, ContactModel, DampingLaw, TangentialLaw};
+use crate::law::{ContactKinematics, ContactModel};
 use crate::math::{Point, Real, Vector};
 
 use super::super::body_inputs;
@@ -298,19 +298,7 @@ pub(super) fn overlap_law(
 /// The model with the slots the skips make free: no tangential spring when μ = 0, no damping term when its
 /// coefficient is 0 (see [`super::skips`]).
 pub(crate) fn effective_model(model: &ContactModel, skips: &Skips) -> ContactModel {
-    let mut m = *model;
-    if skips.frictionless_history && m.tangential.stiffness_and_friction(0.0).1 == 0.0 {
-        m.tangential = TangentialLaw::None;
-    }
-    if skips.undamped_contacts {
-        if let DampingLaw::Viscous { coefficient } | DampingLaw::Dashpot { coefficient } = m.damping
-        {
-            if coefficient == 0.0 {
-                m.damping = DampingLaw::None;
-            }
-        }
-    }
-    m
+    model.with_skips(skips.frictionless_history, skips.undamped_contacts)
 }
 
 /// The contact model of every material pair (row-major `n²`, `None` where no law is set) with the skips

@@ -5,6 +5,7 @@ use crate::case::Case;
 
 pub mod chung_ooi;
 pub mod contact;
+pub mod ellipsoid_impact;
 pub mod friction;
 pub mod polyhedra_bed;
 pub mod polyhedra_box;
@@ -27,6 +28,7 @@ pub fn registry() -> Vec<&'static dyn Case> {
         &precession::Precession,
         &single_contact_energy::SingleContactEnergy,
         &restitution::Restitution,
+        &ellipsoid_impact::EllipsoidImpact,
         &chung_ooi::ChungOoi,
         &friction::Friction,
         &rockfill::Rockfill,
