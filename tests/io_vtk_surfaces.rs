@@ -8,7 +8,7 @@ use polydem::dynamics::{PrincipalInertia, RigidBody};
 use polydem::io::vtk::{SeriesKind, VtkFormat, VtkWriter};
 use polydem::law::{ContactModel, DampingLaw, NormalLaw, TangentialLaw};
 use polydem::math::{Point, Pose, Real, Rotation, Vector};
-use polydem::shape::ellipsoid::{SURFACE_LATITUDE_BANDS, SURFACE_MERIDIANS};
+use polydem::shape::surface_mesh::{SURFACE_LATITUDE_BANDS, SURFACE_MERIDIANS};
 use polydem::shape::{Shape, Sphere};
 use polydem::world::{MaterialTable, World};
 

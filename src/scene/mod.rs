@@ -11,8 +11,10 @@ pub mod build;
 pub mod orientation;
 pub mod run;
 pub mod schema;
+pub mod simulation;
 pub mod time_step;
 
-pub use build::{load_scene, parse_scene, SceneError, Simulation};
+pub use build::{load_scene, parse_scene, SceneError};
 pub use run::{EndTimeError, RunError, RunObserver, RunSummary, StepPath, PROGRESS_STEPS};
+pub use simulation::Simulation;
 pub use time_step::TimeStepInfo;

@@ -17,7 +17,7 @@ use crate::world::{
     step, SphereSim, StepCounters, StepError, StepFlatError, StepReport, StepScratch,
 };
 
-use super::Simulation;
+use super::simulation::{steps_to, Simulation};
 
 /// What a run hands the state to: outputs, frames, checkpoints, progress.
 pub trait RunObserver {
@@ -217,12 +217,6 @@ impl Simulation {
         self.steps = steps;
         Ok(())
     }
-}
-
-/// The number of steps of size `dt` that covers `end_time` (at least one; an end time within 1e-9 steps
-/// of a whole number of steps is not rounded up by one more).
-pub(crate) fn steps_to(end_time: Real, dt: Real) -> u64 {
-    (end_time / dt - 1e-9).ceil().max(1.0) as u64
 }
 
 /// Why an end time was refused.

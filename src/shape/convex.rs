@@ -16,14 +16,8 @@ use super::mass::MassProperties;
 use super::polyhedron::ConvexPolyhedron;
 use super::sphere::Sphere;
 use super::support::SupportMap;
-
-/// A closed triangulated or polygonal surface in the body frame, for output only: vertices and faces
-/// (vertex indices, counter-clockwise seen from outside).
-#[derive(Clone, Debug, PartialEq)]
-pub struct SurfaceMesh {
-    pub vertices: Vec<Point>,
-    pub faces: Vec<Vec<u32>>,
-}
+use super::surface_mesh::uv_surface;
+pub use super::surface_mesh::SurfaceMesh;
 
 /// A bounded convex solid described in its body (principal) frame.
 pub trait ConvexShape: SupportMap + Send + Sync + std::fmt::Debug {
@@ -88,7 +82,7 @@ impl ConvexShape for Sphere {
 
     fn surface_mesh(&self) -> SurfaceMesh {
         let r = self.radius();
-        super::ellipsoid::uv_surface(r, r, r)
+        uv_surface(r, r, r)
     }
 }
 

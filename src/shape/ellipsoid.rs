@@ -9,21 +9,16 @@
 //! - bounding radius max(a, b, c); world AABB half-extent along axis e_i: h(Rᵀ e_i) = |D Rᵀ e_i|;
 //! - segment test: the segment mapped by D⁻¹ against the unit ball.
 //!
-//! The VTK surface is a UV tessellation ([`uv_surface`]) with its vertices on the exact surface.
+//! The VTK surface is a UV tessellation ([`super::surface_mesh::uv_surface`]) with its vertices on the exact surface.
 
 use crate::math::{Matrix, Point, Pose, Real, Rotation, Vector};
 
 use super::aabb::Aabb;
-use super::convex::{segment_distance_to_origin, ConvexShape, SurfaceMesh};
+use super::convex::{segment_distance_to_origin, ConvexShape};
 use super::error::ShapeError;
 use super::mass::MassProperties;
 use super::support::SupportMap;
-
-/// Latitude bands of the VTK surface (pole to pole): 16 bands of 11.25°. The chordal error of a band edge
-/// is r(1 − cos(π/32)) ≈ 4.8e-3 r, below a pixel for a body drawn 200 pixels across.
-pub const SURFACE_LATITUDE_BANDS: usize = 16;
-/// Meridians of the VTK surface: 32, so that the facets are about square near the equator.
-pub const SURFACE_MERIDIANS: usize = 32;
+use super::surface_mesh::{uv_surface, SurfaceMesh};
 
 /// A solid ellipsoid centred at the origin of its body frame with semi-axes `(a, b, c)` (m) along x, y, z.
 #[derive(Copy, Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -113,51 +108,4 @@ impl ConvexShape for Ellipsoid {
     fn surface_mesh(&self) -> SurfaceMesh {
         uv_surface(self.semi_axes.x, self.semi_axes.y, self.semi_axes.z)
     }
-}
-
-/// The UV tessellation of the ellipsoid (a, b, c): two poles on ±z and [`SURFACE_LATITUDE_BANDS`] − 1 rings
-/// of [`SURFACE_MERIDIANS`] vertices, all on the exact surface; triangle fans at the poles, two triangles
-/// per quad elsewhere, counter-clockwise seen from outside.
-pub fn uv_surface(a: Real, b: Real, c: Real) -> SurfaceMesh {
-    uv_surface_with(a, b, c, SURFACE_LATITUDE_BANDS, SURFACE_MERIDIANS)
-}
-
-/// [`uv_surface`] with `bands` ≥ 2 latitude bands and `meridians` ≥ 3 meridians.
-pub(crate) fn uv_surface_with(
-    a: Real,
-    b: Real,
-    c: Real,
-    bands: usize,
-    meridians: usize,
-) -> SurfaceMesh {
-    let pi = std::f64::consts::PI;
-    let mut vertices = vec![Point::new(0.0, 0.0, c)];
-    for i in 1..bands {
-        let theta = pi * i as Real / bands as Real;
-        for j in 0..meridians {
-            let phi = 2.0 * pi * j as Real / meridians as Real;
-            vertices.push(Point::new(
-                a * theta.sin() * phi.cos(),
-                b * theta.sin() * phi.sin(),
-                c * theta.cos(),
-            ));
-        }
-    }
-    vertices.push(Point::new(0.0, 0.0, -c));
-    let south = (vertices.len() - 1) as u32;
-    let ring = |i: usize, j: usize| (1 + (i - 1) * meridians + j % meridians) as u32;
-    let mut faces = Vec::with_capacity(2 * meridians * (bands - 1));
-    for j in 0..meridians {
-        faces.push(vec![0, ring(1, j), ring(1, j + 1)]);
-    }
-    for i in 1..bands - 1 {
-        for j in 0..meridians {
-            faces.push(vec![ring(i, j), ring(i + 1, j), ring(i + 1, j + 1)]);
-            faces.push(vec![ring(i, j), ring(i + 1, j + 1), ring(i, j + 1)]);
-        }
-    }
-    for j in 0..meridians {
-        faces.push(vec![south, ring(bands - 1, j + 1), ring(bands - 1, j)]);
-    }
-    SurfaceMesh { vertices, faces }
 }

@@ -24,6 +24,7 @@ mod polygon;
 pub mod polyhedron;
 pub mod sphere;
 mod support;
+pub mod surface_mesh;
 
 pub use aabb::Aabb;
 pub use convex::{ConvexShape, SurfaceMesh};

@@ -1,6 +1,6 @@
 //! Unit tests of the ellipsoid against closed forms and against an independent polyhedral approximation.
 
-use super::ellipsoid::uv_surface_with;
+use super::surface_mesh::uv_surface_with;
 use super::{ConvexPolyhedron, ConvexShape, Ellipsoid, Shape, ShapeError, SupportMap};
 use crate::math::{Point, Pose, Real, Rotation, Vector};
 

@@ -1,7 +1,7 @@
 //! Validation of a parsed scene and construction of the [`Simulation`] it describes, one file per table of
 //! the scene file: `materials`, `interactions` (the contact laws), `shapes`, `bodies`, `body_files`,
 //! `walls` (`[[wall]]` and `[[box]]`), `step_size` (the time step) and `simulation` (the rest of
-//! `[simulation]`); `assemble` puts the checked parts into a [`World`]. `build` reads as the list of
+//! `[simulation]`); `assemble` puts the checked parts into a [`crate::world::World`]. `build` reads as the list of
 //! tables, in the order their errors are reported.
 //!
 //! Every check names the file, the line (from the span toml keeps for each value) and the field, in the
@@ -21,11 +21,9 @@ mod walls;
 
 use std::path::{Path, PathBuf};
 
-use crate::math::{Pose, Real, Rotation};
-use crate::world::{StepParams, World};
-
 use super::schema::SceneFile;
-use super::time_step::TimeStepInfo;
+use super::simulation::steps_to;
+pub use super::simulation::Simulation;
 use ctx::Ctx;
 
 /// Why a scene could not be read.
@@ -53,31 +51,6 @@ pub enum SceneError {
         field: String,
         message: String,
     },
-}
-
-/// A scene ready to run.
-#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
-pub struct Simulation {
-    pub world: World,
-    pub params: StepParams,
-    pub time_step: TimeStepInfo,
-    /// Simulated duration (s) and the number of steps that covers it.
-    pub end_time: Real,
-    pub steps: u64,
-    /// Output every this many steps.
-    pub output_every: u64,
-    /// Bodies written to `bodies.csv`, in file order.
-    pub tracked: Vec<usize>,
-    /// For each body, the pose of its principal frame in the shape's own (input) frame: the body's
-    /// orientation as the user gave it is `orientation · frame.rotation⁻¹`.
-    pub frames: Vec<Pose>,
-}
-
-impl Simulation {
-    /// The orientation of body `i`'s own (input) frame, as the scene gave it.
-    pub fn input_orientation(&self, i: usize) -> Rotation {
-        self.world.bodies[i].orientation * self.frames[i].rotation.inverse()
-    }
 }
 
 /// Reads and builds the scene at `path`.
@@ -127,7 +100,7 @@ fn build(ctx: &Ctx, file: &SceneFile) -> Result<Simulation, SceneError> {
         walls,
     )?;
     let params = simulation::step_params(ctx, sim, time_step.dt, damping)?;
-    let steps = super::run::steps_to(run.end_time, time_step.dt);
+    let steps = steps_to(run.end_time, time_step.dt);
     let output_every = ((run.output_interval / time_step.dt).round() as u64).max(1);
     Ok(Simulation {
         world: assembled.world,

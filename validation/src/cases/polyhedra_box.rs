@@ -376,7 +376,7 @@ impl Case for PolyhedraBox {
             "Elastic normal law (e = 1) with Coulomb friction μ = 0.5: the only dissipation is friction work \
              ({} J). Balance E(t) + dissipated − E(0) = {} J, {} of the mechanical energy {} J. Polyhedra \
              landing flat on a wall carry the known first-order error of the deepest-vertex wall contact \
-             (README, known problems).",
+             (the single_contact_energy case).",
             CaseContext::fmt(e.dissipated_friction),
             CaseContext::fmt(e.balance),
             CaseContext::fmt(balance),
