@@ -87,9 +87,9 @@ const YIELD_AFTER: Duration = Duration::from_micros(20);
 /// thread unrun).
 ///
 /// Why: on the 2-core virtual machine this project runs on, the reading takes different levels for
-/// minutes at a time (41–60, 94–160 and 419–499 ns on 2026-11-27; by their size, the last is two dies of
+/// minutes at a time (41–60, 94–160 and 419–499 ns seen; by their size, the last is two dies of
 /// the host's processor apart, which the guest cannot see directly). Measured between whole runs of sphere bed a
-/// (2026-11-27, 3000 steps, each run of two threads beside the round trip just before and after it):
+/// (3000 steps, each run of two threads beside the round trip just before and after it):
 /// round trips of 96–113 ns went with two-thread runs of 0.334–0.353 s, of 419–486 ns with 0.419–0.442
 /// s, while one-thread runs took 0.605–0.647 s throughout and two independent one-thread runs at once
 /// lost at most 5 % in either state. A run on two threads passes cache lines between the cores every

@@ -1,6 +1,6 @@
 //! Oracle tests: GJK/EPA against the exact SAT answer on seeded random pairs and on the degenerate set.
 //!
-//! Gate (issue 2): zero wrong kinds; depth (or distance) error ≤ 1e-10 L + 1e-9 δ; the reported normal is an
+//! Gate: zero wrong kinds; depth (or distance) error ≤ 1e-10 L + 1e-9 δ; the reported normal is an
 //! optimal axis (support-distance overlap along it equals the exact value within the same tolerance);
 //! c1 and c2 on the surfaces of A and B within the same tolerance; c1 − c2 = δ n (c2 − c1 = d n when apart).
 

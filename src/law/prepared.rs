@@ -23,8 +23,7 @@ pub struct PreparedModel {
     /// The tangential dashpot's c_t over δ^¼: damping · √(m* k̂_t) for [`TangentialLaw::DampedMindlin`]
     /// with k_t = k̂_t √δ (N s/m^(5/4)), zero for the other laws. Formed once per contact, so that an
     /// evaluation takes c_t from the δ^¼ the viscous normal damping also forms instead of a square root
-    /// of m* k_t of its own (until 2026-11-23: c_t = damping · √(m* k_t) per evaluation; the two agree to
-    /// rounding).
+    /// of m* k_t of its own (the two forms agree to rounding).
     pub tangential_dashpot: Real,
 }
 

@@ -26,7 +26,7 @@
 //! they are stolen, and a run one thread has started cannot be shared any more: the expensive candidates
 //! around a projectile are contiguous in candidate order). The load balance per region is measured by
 //! [`super::region_profile`] (`perf_threads --profile`): on the struck bed of 10⁴ polyhedra the costliest
-//! chunk of the narrow phase holds ~6 % of a thread's share (2026-11-22), so chunking alone leaves the
+//! chunk of the narrow phase holds ~6 % of a thread's share, so chunking alone leaves the
 //! threads ≤ ~3 % apart. Errors are reported deterministically: each chunk stops at
 //! its first failing item and the error of the lowest failing chunk wins, which is the first failing item
 //! in item order.
@@ -42,10 +42,10 @@
 //! - `o`, the region overhead: `cargo run --release --example perf_threads -- --overhead` runs the step's
 //!   own [`for_each_item`] over 10³–10⁴ items of ~12 ns, with a serial gap between regions as in a step:
 //!   while the pool's threads still spin (gap ~100 µs) a region costs ~2.5–3 µs more than half the serial
-//!   time (best of 5000 regions, load average 7.6, 2026-11-22: 1000 items 8.5 µs against 12.2 µs serial,
+//!   time (best of 5000 regions, load average 7.6: 1000 items 8.5 µs against 12.2 µs serial,
 //!   4000 items 27.5 against 48.7 µs). Once they have fallen asleep (gaps of ~1 ms, or an idle machine
 //!   where the vCPU halts), waking them costs far more: the quiet-machine runs behind the old defaults
-//!   (2026-11-21, 5000 bodies, below) show ~55 µs per region. The thresholds take the sleeping case, so
+//!   (5000 bodies, below) show ~55 µs per region. The thresholds take the sleeping case, so
 //!   that a region never costs more than it saves on an idle machine.
 //! - `c` per candidate: ~90 ns for one the cached axis or the bounding spheres reject (the cheapest; the
 //!   polyhedra box of `reference/polyhedra_box` at rest), ~400–500 ns on average in the settling bed of 10⁴
@@ -81,24 +81,22 @@ pub const CHUNKS_PER_THREAD: usize = 32;
 /// ~1200 of the cheapest candidates). On a 2-core VM a parallel region costs up to ~55 µs of thread
 /// wake-up, and a candidate that the cached axis or the bounding spheres reject costs ~90 ns, so a region
 /// must hold a few hundred µs of work to pay. Measured with `polydem run` on the
-/// polyhedra box of `reference/polyhedra_box` (quiet machine, 2026-11-21, RAYON_NUM_THREADS 1 vs 2): 1000
+/// polyhedra box of `reference/polyhedra_box` (quiet machine, RAYON_NUM_THREADS 1 vs 2): 1000
 /// bodies, ~1540 candidates per step: narrow phase 1131 ms serial vs 1244 ms parallel over 8000 steps
-/// (slower); 5000 bodies, ~7700 candidates: 1109 vs 831 ms over 2000 steps (1.33× faster). (An earlier
-/// threshold of 128, measured at a load average of ~10, made the 1000-body box slower on two threads.)
+/// (slower); 5000 bodies, ~7700 candidates: 1109 vs 831 ms over 2000 steps (1.33× faster).
 pub const DEFAULT_MIN_CANDIDATES: usize = 4096;
 
 /// Default [`Parallelism::min_bodies`]: 8192 units of integration work ([`integration_work`]). A half
-/// kick and drift cost only ~16 ns per body at rest or nearly (quiet machine, 2026-11-21: 5000 bodies,
+/// kick and drift cost only ~16 ns per body at rest or nearly (quiet machine: 5000 bodies,
 /// integration 160 ms over 2000 steps serial, while the two-thread version took 300 ms, i.e. ~55 µs of
 /// fork/join per region of ~40 µs of work). A region pays from `2 · 55 µs / 16.5 ns ≈ 6700` units (module
 /// docs); 8192 keeps a small margin above it and lets 10⁴ spheres (~170 µs per pass) integrate in parallel.
-/// Tumbling polyhedra cost several times more ([`ANISOTROPIC_WEIGHT`]): 2048 of them are enough. (It was
-/// 20 000 until 2026-11-22, which kept the integration of 10⁴ spheres serial: 26 % of their step.)
+/// Tumbling polyhedra cost several times more ([`ANISOTROPIC_WEIGHT`]): 2048 of them are enough.
 pub const DEFAULT_MIN_BODIES: usize = 8192;
 
 /// Weight of a dynamic body with unequal principal moments in the integration's work
 /// ([`integration_work`]): its rotation splitting (three sub-rotations per drift) costs about this many
-/// sphere kicks and drifts. Measured with `examples/perf_threads.rs` (2026-11-21, 1 thread, load ~10, so
+/// sphere kicks and drifts. Measured with `examples/perf_threads.rs` (1 thread, load ~10, so
 /// both inflated alike): 10^4 spinning polyhedra 3.3 ms of integration per step, 10^4 spheres 0.74 ms
 /// (ratio 4.4, the spheres' time including their cheaper isotropic turn): 4.
 pub const ANISOTROPIC_WEIGHT: usize = 4;

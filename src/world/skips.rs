@@ -44,7 +44,7 @@
 //! bits. `tests/world_skip_motion_bound.rs` checks the bound against the exact test over random motions
 //! and the trajectories of a polyhedral bed with the switch on and off.
 //!
-//! # Measured (2026-11-22, callgrind instruction counts, same machine and build profile)
+//! # Measured (callgrind instruction counts, same machine and build profile)
 //! Trajectories unchanged: the beds (`bed_rocks.csv`), packing traces and penetration monitors of
 //! `polydem rockfill` are byte-identical with and without the two skips, and so are the GJK/EPA counts.
 //!

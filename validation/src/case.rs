@@ -249,7 +249,7 @@ n = 3
 [tolerance.depth]
 value = 1e-10
 unit = "1"
-source = "issue 2"
+source = "a test fixture"
 "#;
         #[derive(Deserialize)]
         #[serde(deny_unknown_fields)]

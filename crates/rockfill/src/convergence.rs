@@ -1,4 +1,4 @@
-//! Convergence of the experiment's results (issue 6): the time step of the penetration run, and the rock count
+//! Convergence of the experiment's results: the time step of the penetration run, and the rock count
 //! through the layer's cross-section, on the residual velocity and the deflection angles; plotted as run time
 //! against the change in the result (a work-precision plot).
 //!

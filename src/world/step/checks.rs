@@ -25,8 +25,7 @@ pub(super) fn non_finite_quantity(
 /// and NaN propagate), so a finite sum answers `None` at once; otherwise the quantities are tested one
 /// by one (which also clears a sum that overflowed from finite terms). Every body of every step takes
 /// the test: as a chain of 18 scalar additions the sum took ~5 % of a step of the flat sphere path
-/// (`perf record`, bed c, 2026-11-23), and before that the general step tested the quantities one by
-/// one.
+/// (`perf record`, bed c).
 #[inline(always)]
 pub(crate) fn first_non_finite(
     force: &Vector,

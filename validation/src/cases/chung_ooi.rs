@@ -1,4 +1,4 @@
-//! Chung & Ooi (2011) benchmark tests 1–4 (issue 3, gate 5) with the Hertz–Mindlin law and the body
+//! Chung & Ooi (2011) benchmark tests 1–4 with the Hertz–Mindlin law and the body
 //! integrator. Tests 1–2: elastic normal impacts against Hertz theory; test 3: output against input
 //! restitution; test 4: oblique impacts against the rigid-body impulse solution with Coulomb friction:
 //! with J_n = m (1 + e) v_n, the sphere slides throughout when tan θ ≥ (7/2) μ (1 + e) ("gross sliding"):

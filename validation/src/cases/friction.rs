@@ -1,4 +1,4 @@
-//! Friction (issue 3, gate 4): a cube on an incline sticks for tan θ < μ and slides with
+//! Friction: a cube on an incline sticks for tan θ < μ and slides with
 //! a = g (sin θ − μ cos θ) otherwise; a sphere launched without spin ends rolling at v = 5v₀/7.
 //!
 //! Close to the friction angle (tan θ = 0.75 μ, 0.9 μ) the sticking is gated too, with the smoothed wall

@@ -1,4 +1,4 @@
-//! Case `polyhedra_bed` (issue 7): the sphere-bed penetration with every sphere of the settled bed replaced
+//! Case `polyhedra_bed`: the sphere-bed penetration with every sphere of the settled bed replaced
 //! by a random convex polyhedron of the same volume (polydem only), run beside the sphere bed of the same
 //! scene, to show what the shape of the grains does to the penetration.
 

@@ -1,4 +1,4 @@
-//! Polyhedra falling into a box, polydem against YADE's Polyhedra module (issue 4, "Show"): the same scene
+//! Polyhedra falling into a box, polydem against YADE's Polyhedra module: the same scene
 //! file (`reference/polyhedra_box/scene.toml`: 1000 random convex polyhedra, same vertices, walls, time step
 //! and end time) run by `polydem` and by the YADE script `reference/yade/polyhedra_box.py`, which reads that
 //! file. YADE uses its own law (normal force proportional to the overlap volume), with the stiffness matched

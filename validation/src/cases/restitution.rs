@@ -1,4 +1,4 @@
-//! Restitution (issue 3, gate 3): the measured coefficient of restitution of normal impacts equals the input
+//! Restitution: the measured coefficient of restitution of normal impacts equals the input
 //! of the damping law, for sphere–sphere, sphere–wall and a cube face-on on a wall (through the contact
 //! core), with the linear and the Hertz-type law, over a range of input e. A time-step sweep shows the
 //! first-order error of the damping term (the contact ends between two steps) against its bound 2Δt/t_c.

@@ -1,4 +1,4 @@
-//! Single-contact energy conservation (issue 3, gate 1): elastic impacts of polyhedra through the contact
+//! Single-contact energy conservation: elastic impacts of polyhedra through the contact
 //! core (`polydem::contact::query`: GJK/EPA and the fast paths) and the body integrator, in every contact
 //! type — vertex–face, edge–face, edge–edge, face–face — plus a box vertex on a wall and a sphere on a box,
 //! with spin, for the linear and the Hertz-type law (paper eqs. 4–5). Measured: the total energy

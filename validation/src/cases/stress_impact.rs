@@ -1,4 +1,4 @@
-//! Stability stress test, extreme impacts (issue 5): a steel polyhedron at 1200 m/s into a small bed of
+//! Stability stress test, extreme impacts: a steel polyhedron at 1200 m/s into a small bed of
 //! rock polyhedra in a closed box, and into a wall. Checked: no step error (non-finite state, failed
 //! query), no tunnelling and no pass-through ([`polydem::world::tunnelling`] defines both), the time-step
 //! guard of the scene refusing a step above the stability limit and admitting one just below it (and the

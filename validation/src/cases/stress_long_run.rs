@@ -1,4 +1,4 @@
-//! Stability stress test, long run (issue 5): a frictionless, perfectly elastic (e = 1) closed box of
+//! Stability stress test, long run: a frictionless, perfectly elastic (e = 1) closed box of
 //! spinning polyhedra of several shapes, run for 10^6 steps in the full profile. With no dissipation the
 //! energy ledger's balance is the integration error alone; it must stay bounded and show no drift trend.
 //!

@@ -1,4 +1,4 @@
-//! Stability stress test, extreme shapes and ratios (issue 5): slivers of 20:1 aspect (needles, plates,
+//! Stability stress test, extreme shapes and ratios: slivers of 20:1 aspect (needles, plates,
 //! thin random hulls), a mass ratio of 1:10^4 between bodies of the same shape, and pairs released from
 //! initial overlaps of 0.1, 0.25 and 0.5 of the particle size. Every run: no step error, every body–body
 //! contact status equal to the exact SAT oracle's at sampled steps (all pairs, not only the broad phase's

@@ -1,4 +1,4 @@
-//! Stability stress test, the largest stable time step (issue 5): for a polyhedron resting on a wall under
+//! Stability stress test, the largest stable time step: for a polyhedron resting on a wall under
 //! gravity (linear and Hertz-type laws, several masses and stiffnesses), the largest Δt at which the run
 //! stays stable is found by bisection and compared with the scene's theoretical limit
 //! Δt_max = f(n) · 2/ω_max (`polydem::scene::time_step`: ω² = κ k_eff/m*, κ = 1 + m r_b²/J_min, f(n) the

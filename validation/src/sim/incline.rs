@@ -1,4 +1,4 @@
-//! A cube resting on an incline (issue 3, gate 4): the incline is a horizontal wall with gravity tilted by θ
+//! A cube resting on an incline: the incline is a horizontal wall with gravity tilted by θ
 //! (the same problem in the wall's frame); contact through the contact core's polyhedron–plane path, linear
 //! normal law with restitution damping (e = 0.3), incremental tangential spring with Coulomb cap, body
 //! integrator. Used by the `friction` case and by `tests/friction_gates.rs`.

@@ -1,4 +1,4 @@
-//! The polyhedral bed of the sphere-bed penetration (issue 7): every sphere of the settled sphere bed
+//! The polyhedral bed of the sphere-bed penetration: every sphere of the settled sphere bed
 //! (`reference/sphere_bed/bed_quick.csv`) replaced by a random convex polyhedron of the same volume.
 //!
 //! # Shapes
@@ -34,7 +34,7 @@ use polydem::shape::ConvexPolyhedron;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
-/// Seed of the shapes (the date of issue 7's polyhedral variant, as a number).
+/// Seed of the shapes (fixed, so that the polyhedral bed is the same on every run).
 pub const SEED: u64 = 20261121;
 /// Fewest hull points per shape.
 pub const MIN_POINTS: usize = 12;
