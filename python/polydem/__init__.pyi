@@ -142,9 +142,16 @@ class Simulation:
     def step_index(self) -> int:
         """Steps done since the start of the scene."""
     @property
-    def dt(self) -> float: ...
+    def dt(self) -> float:
+        """Time step (s)."""
     @property
     def num_bodies(self) -> int: ...
+    @property
+    def end_time(self) -> float:
+        """End time of the scene (s); step() may go past it."""
+    @property
+    def end_step(self) -> int:
+        """The step index at the scene's end time (the steps `polydem run` does)."""
     @property
     def names(self) -> Sequence[str]: ...
     def positions(self) -> FloatArray:

@@ -160,6 +160,18 @@ impl PySimulation {
         self.sim.world.bodies.len()
     }
 
+    /// End time of the scene (s); `step` may go past it.
+    #[getter]
+    fn end_time(&self) -> Real {
+        self.sim.end_time
+    }
+
+    /// The step index at the scene's end time (the steps `polydem run` does).
+    #[getter]
+    fn end_step(&self) -> u64 {
+        self.sim.steps
+    }
+
     /// Body names in body order.
     #[getter]
     fn names(&self) -> Vec<String> {

@@ -1,0 +1,179 @@
+"""Simulations from Python: the same bits as `polydem run` on the same scene, checkpoints and pickling
+that continue bit for bit, the engine's scene errors, and the GIL released while stepping."""
+
+import csv
+import pickle
+import threading
+from collections import defaultdict
+
+import numpy as np
+import pytest
+
+import polydem
+from conftest import run
+
+ELASTIC = "scenes/two_polyhedra_elastic.toml"
+SPHERE_BED = "scenes/sphere_bed_a_hertz_5ms.toml"
+
+
+def state(sim):
+    return {
+        "time": sim.time,
+        "step_index": sim.step_index,
+        "positions": sim.positions(),
+        "velocities": sim.velocities(),
+        "orientations": sim.orientations(),
+        "angular_velocities": sim.angular_velocities(),
+    }
+
+
+def assert_same_state(a, b, what):
+    assert (a["time"], a["step_index"]) == (b["time"], b["step_index"]), what
+    for key in ("positions", "velocities", "orientations", "angular_velocities"):
+        differ = np.flatnonzero(np.any(a[key] != b[key], axis=1))
+        assert differ.size == 0, (
+            f"{what}: {key} differ at bodies {differ[:5]}: {a[key][differ[:5]]} vs {b[key][differ[:5]]}"
+        )
+
+
+def rust_rows(polydem_bin, scene, out, end_time=None):
+    """The rows of `bodies.csv` written by `polydem run`, grouped by time (in file order)."""
+    cmd = [str(polydem_bin), "run", str(scene), "--out", str(out), "--quiet"]
+    if end_time is not None:
+        cmd += ["--end-time", repr(end_time)]
+    run(cmd)
+    rows = defaultdict(dict)
+    with open(out / "bodies.csv", newline="") as f:
+        for row in csv.DictReader(f):
+            rows[float(row["t"])][row["id"]] = row
+    return rows
+
+
+@pytest.mark.parametrize("scene, steps", [(ELASTIC, None), (SPHERE_BED, 300)])
+def test_same_trajectory_as_polydem_run_bit_for_bit(repo, polydem_bin, tmp_path, scene, steps):
+    sim = polydem.Simulation.from_toml(repo / scene)
+    end_time = None if steps is None else steps * sim.dt
+    rows = rust_rows(polydem_bin, repo / scene, tmp_path, end_time)
+    index = {name: i for i, name in enumerate(sim.names)}
+    columns = {
+        "positions": ("x", "y", "z"),
+        "velocities": ("vx", "vy", "vz"),
+        "orientations": ("qw", "qx", "qy", "qz"),
+        "angular_velocities": ("wx", "wy", "wz"),
+    }
+    assert len(rows) > 5, f"{scene}: only {len(rows)} output times"
+    for t, bodies in rows.items():
+        # Step in the chunks between outputs (several steps per call), landing exactly on the row's time.
+        sim.step(round((t - sim.time) / sim.dt))
+        assert sim.time == t, f"{scene}: Python time {sim.time!r}, bodies.csv time {t!r}"
+        now = state(sim)
+        for name, row in bodies.items():
+            for key, cols in columns.items():
+                expected = [float(row[c]) for c in cols]
+                measured = now[key][index[name]].tolist()
+                assert measured == expected, f"{scene} t={t!r} body {name} {key}: {measured} vs {expected}"
+
+
+def test_steps_in_one_call_or_many_agree(repo):
+    one, many = (polydem.Simulation.from_toml(repo / ELASTIC) for _ in range(2))
+    one.step(300)
+    for n in (1, 2, 97, 200):
+        many.step(n)
+    assert_same_state(state(one), state(many), "step(300) against step(1, 2, 97, 200)")
+    assert one.step_index == 300
+
+
+def test_checkpoint_save_load_and_pickle_continue_bit_for_bit(repo, tmp_path):
+    sim = polydem.Simulation(polydem.Scene.from_toml(repo / ELASTIC))
+    sim.step(350)  # inside the impact: the contact store and tangential springs must travel too
+    path = tmp_path / "state.ckpt"
+    assert sim.save(path) == path.stat().st_size
+    pickled = pickle.dumps(sim)
+    sim.step(300)
+    for restored, how in ((polydem.Simulation.load(path), "save/load"), (pickle.loads(pickled), "pickle")):
+        assert restored.step_index == 350
+        restored.step(300)
+        assert_same_state(state(restored), state(sim), how)
+        assert restored.energy() == sim.energy(), how
+
+
+def test_bad_checkpoints(tmp_path):
+    with pytest.raises(OSError, match="missing.ckpt"):
+        polydem.Simulation.load(tmp_path / "missing.ckpt")
+    (tmp_path / "junk.ckpt").write_bytes(b"not a checkpoint at all, just some bytes")
+    with pytest.raises(polydem.CheckpointError, match="not a polydem checkpoint"):
+        polydem.Simulation.load(tmp_path / "junk.ckpt")
+
+
+def test_energy_conservation_of_the_elastic_impact(repo):
+    """The Rust gate (tests/world_energy.rs) from Python: e = 1, no friction, no gravity, so the ledger's
+    balance is the integration error; it stays within 1e-4 of the initial energy at every step."""
+    sim = polydem.Simulation.from_toml(repo / ELASTIC)
+    e0 = sim.energy()["mechanical"]
+    worst = 0.0
+    while sim.step_index < sim.end_step:
+        sim.step(1)
+        worst = max(worst, abs(sim.energy()["balance"]) / e0)
+    end = sim.energy()
+    assert worst <= 1e-4, f"worst |balance| / E0 = {worst:e} over {sim.end_step} steps, bound 1e-4 (E0 = {e0} J)"
+    assert end["rotational_kinetic"] > 1e-2 * e0, (
+        f"rotational energy after the eccentric impact {end['rotational_kinetic']:e} J, expected > {1e-2 * e0:e} J"
+    )
+
+
+def edited(repo, old, new):
+    text = (repo / ELASTIC).read_text()
+    assert old in text
+    text = text.replace(old, new, 1)
+    line = text[: text.index(new)].count("\n") + 1
+    return text, line
+
+
+def test_scene_errors_carry_file_line_and_field(repo):
+    text, line = edited(repo, "restitution = 1.0", "restitution = 1.5")
+    with pytest.raises(polydem.SceneError) as err:
+        polydem.Scene.from_string(text, "broken.toml")
+    e = err.value
+    assert isinstance(e, ValueError)
+    assert (e.path, e.line, e.field) == ("broken.toml", line, "interaction[0].restitution"), str(e)
+    assert str(e).startswith(f"broken.toml:{line}: interaction[0].restitution: ") and "1.5" in str(e), str(e)
+
+    text, line = edited(repo, "velocity = [1.0", "velocty = [1.0")
+    with pytest.raises(polydem.SceneError) as err:
+        polydem.Scene.from_string(text, "typo.toml")
+    assert err.value.line == line and "unknown field `velocty`" in str(err.value), str(err.value)
+
+    with pytest.raises(polydem.SceneError, match="cannot read the scene file") as err:
+        polydem.Scene.from_toml(repo / "scenes" / "no_such_scene.toml")
+    assert err.value.line is None
+
+
+def test_step_releases_the_gil(repo):
+    sim = polydem.Simulation.from_toml(repo / SPHERE_BED)
+    ticks, stop = [0], threading.Event()
+
+    def count():
+        while not stop.is_set():
+            ticks[0] += 1
+
+    thread = threading.Thread(target=count)
+    thread.start()
+    try:
+        before = ticks[0]
+        sim.step(200)  # tens of milliseconds in Rust; the counter only moves if the GIL is free
+        during = ticks[0] - before
+    finally:
+        stop.set()
+        thread.join()
+    assert during > 1000, f"the other thread counted {during} times during sim.step(200)"
+
+
+def test_state_arrays_are_copies(repo):
+    sim = polydem.Simulation.from_toml(repo / ELASTIC)
+    p = sim.positions()
+    p[:] = 0.0
+    assert np.any(sim.positions() != 0.0)
+    before = sim.positions()
+    sim.step(10)
+    assert np.any(sim.positions() != before), "a step moves the bodies"
+    assert sim.positions().shape == (2, 3) and sim.orientations().shape == (2, 4)
