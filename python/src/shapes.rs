@@ -1,6 +1,6 @@
 //! The shapes of the Python package: one base class `Shape` holding the engine's [`Shape`] and the pose of
 //! its principal frame in the frame the user described it in, and one small subclass per kind
-//! (`ConvexPolyhedron`, `Sphere`, `Ellipsoid`) that only constructs it. Mass properties and contact
+//! (`ConvexPolyhedron`, `Sphere`, `Ellipsoid`) that constructs it and answers what is particular to it. Mass properties and contact
 //! queries go through the base class, so a new shape kind is one constructor here.
 
 use std::sync::Arc;
@@ -82,7 +82,9 @@ impl PyShape {
 
 /// A convex polyhedron: the convex hull of a point cloud.
 #[pyclass(extends = PyShape, frozen, name = "ConvexPolyhedron", module = "polydem")]
-pub struct PyConvexPolyhedron;
+pub struct PyConvexPolyhedron {
+    polyhedron: Arc<shape::ConvexPolyhedron>,
+}
 
 #[pymethods]
 impl PyConvexPolyhedron {
@@ -96,89 +98,85 @@ impl PyConvexPolyhedron {
         let points = arrays::points(points, "points")?;
         let (polyhedron, frame) =
             shape::ConvexPolyhedron::from_points(&points).map_err(|e| shape_error("points", e))?;
+        let polyhedron = Arc::new(polyhedron);
         let base = PyShape {
-            shape: Shape::Polyhedron(Arc::new(polyhedron)),
+            shape: Shape::Polyhedron(polyhedron.clone()),
             frame,
         };
-        Bound::new(
-            py,
-            PyClassInitializer::from(base).add_subclass(PyConvexPolyhedron),
-        )
+        let initializer =
+            PyClassInitializer::from(base).add_subclass(PyConvexPolyhedron { polyhedron });
+        Bound::new(py, initializer)
     }
 
     /// The hull's vertices in the input frame, an (N, 3) array (a new array).
     #[getter]
     fn vertices<'py>(slf: PyRef<'py, Self>) -> PyResult<Bound<'py, PyArray2<Real>>> {
-        let base = slf.as_super();
-        let Shape::Polyhedron(p) = &base.shape else {
-            unreachable!("a ConvexPolyhedron holds a polyhedron")
-        };
-        let rows: Vec<Vec<Real>> = p
+        let frame = slf.as_super().frame;
+        let rows: Vec<Vec<Real>> = slf
+            .polyhedron
             .vertices()
             .iter()
-            .map(|v| (base.frame * v).coords.as_slice().to_vec())
+            .map(|v| (frame * v).coords.as_slice().to_vec())
             .collect();
         Ok(PyArray2::from_vec2(slf.py(), &rows)?)
     }
 
     /// Number of faces of the hull (coplanar triangles merged into polygons).
     #[getter]
-    fn num_faces(slf: PyRef<'_, Self>) -> usize {
-        match &slf.as_super().shape {
-            Shape::Polyhedron(p) => p.num_faces(),
-            _ => unreachable!("a ConvexPolyhedron holds a polyhedron"),
-        }
+    fn num_faces(&self) -> usize {
+        self.polyhedron.num_faces()
     }
 }
 
 /// A sphere of radius `radius` (m) centred at its origin.
 #[pyclass(extends = PyShape, frozen, name = "Sphere", module = "polydem")]
-pub struct PySphere;
+pub struct PySphere {
+    radius: Real,
+}
 
 #[pymethods]
 impl PySphere {
     #[new]
     fn new(radius: Real) -> PyResult<PyClassInitializer<Self>> {
         let sphere = shape::Sphere::new(radius).map_err(|e| shape_error("radius", e))?;
+        let radius = sphere.radius();
         let base = PyShape {
             shape: Shape::Sphere(sphere),
             frame: Pose::identity(),
         };
-        Ok(PyClassInitializer::from(base).add_subclass(PySphere))
+        Ok(PyClassInitializer::from(base).add_subclass(PySphere { radius }))
     }
 
     /// Radius (m).
     #[getter]
-    fn radius(slf: PyRef<'_, Self>) -> Real {
-        match &slf.as_super().shape {
-            Shape::Sphere(s) => s.radius(),
-            _ => unreachable!("a Sphere holds a sphere"),
-        }
+    fn radius(&self) -> Real {
+        self.radius
     }
 }
 
 /// An ellipsoid with semi-axes `a`, `b`, `c` (m) along its x, y, z axes, centred at its origin.
 #[pyclass(extends = PyShape, frozen, name = "Ellipsoid", module = "polydem")]
-pub struct PyEllipsoid;
+pub struct PyEllipsoid {
+    semi_axes: [Real; 3],
+}
 
 #[pymethods]
 impl PyEllipsoid {
     #[new]
     fn new(a: Real, b: Real, c: Real) -> PyResult<PyClassInitializer<Self>> {
-        let shape = Shape::ellipsoid(a, b, c).map_err(|e| shape_error("semi-axes", e))?;
+        let ellipsoid = shape::Ellipsoid::new(a, b, c).map_err(|e| shape_error("semi-axes", e))?;
+        let axes = ellipsoid.semi_axes();
         let base = PyShape {
-            shape,
+            shape: Shape::Ellipsoid(ellipsoid),
             frame: Pose::identity(),
         };
-        Ok(PyClassInitializer::from(base).add_subclass(PyEllipsoid))
+        let semi_axes = [axes.x, axes.y, axes.z];
+        Ok(PyClassInitializer::from(base).add_subclass(PyEllipsoid { semi_axes }))
     }
 
     /// Semi-axes (a, b, c) in metres, a new array.
     #[getter]
-    fn semi_axes<'py>(slf: PyRef<'py, Self>) -> Bound<'py, PyArray1<Real>> {
-        match &slf.as_super().shape {
-            Shape::Ellipsoid(e) => PyArray1::from_slice(slf.py(), e.semi_axes().as_slice()),
-            _ => unreachable!("an Ellipsoid holds an ellipsoid"),
-        }
+    fn semi_axes<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<Real>> {
+        PyArray1::from_slice(py, &self.semi_axes)
     }
 }
