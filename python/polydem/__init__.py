@@ -31,6 +31,7 @@ from ._polydem import (
     StepError,
     __version__,
     contact,
+    contact_batch,
 )
 
 __all__ = [
@@ -46,4 +47,5 @@ __all__ = [
     "StepError",
     "__version__",
     "contact",
+    "contact_batch",
 ]

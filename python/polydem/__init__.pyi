@@ -108,6 +108,16 @@ def contact(
 ) -> ContactResult:
     """The contact between a at pose_a and b at pose_b (None: identity), as `polydem contact` answers it."""
 
+def contact_batch(
+    a: Union[Shape, Sequence[Shape]],
+    b: Union[Shape, Sequence[Shape]],
+    pose_a: Optional[Tuple[ArrayLike, ArrayLike]] = None,
+    pose_b: Optional[Tuple[ArrayLike, ArrayLike]] = None,
+) -> dict[str, np.ndarray]:
+    """The contacts of n pairs as arrays (status, solver, depth, distance: (n,); normal, point_a, point_b,
+    point: (n, 3)). a, b: one Shape for every pair or n Shapes; poses: None or (positions (n, 3),
+    quaternions (n, 4) as w, x, y, z). Computed in parallel with the GIL released; equal to contact()."""
+
 class Scene:
     """A scene read and validated by the engine; start Simulations from it."""
 

@@ -62,29 +62,39 @@ fn check_finite(values: &[Real], what: &str) -> PyResult<()> {
     }
 }
 
-/// An (N, 3) array of finite points.
-pub fn points(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<Vec<Point>> {
+/// An (N, K) array of finite numbers, as N rows; `item` names a row in messages ("point", "pose").
+pub fn rows<const K: usize>(
+    obj: &Bound<'_, PyAny>,
+    what: &str,
+    item: &str,
+) -> PyResult<Vec<[Real; K]>> {
     let (shape, values) = real_array(obj, what)?;
-    if shape.len() != 2 || shape[1] != 3 {
+    if shape.len() != 2 || shape[1] != K {
         return Err(value_error(
             what,
             format!(
-                "expected an array of shape (N, 3), got shape {}",
+                "expected an array of shape (N, {K}), got shape {}",
                 shape_text(&shape)
             ),
         ));
     }
     if let Some(i) = values.iter().position(|x| !x.is_finite()) {
-        let row = &values[i / 3 * 3..i / 3 * 3 + 3];
+        let row = &values[i / K * K..i / K * K + K];
         return Err(value_error(
             what,
-            format!("point {} has a non-finite coordinate {row:?}", i / 3),
+            format!("{item} {} has a non-finite value {row:?}", i / K),
         ));
     }
     Ok(values
-        .chunks_exact(3)
-        .map(|c| Point::new(c[0], c[1], c[2]))
+        .chunks_exact(K)
+        .map(|c| std::array::from_fn(|k| c[k]))
         .collect())
+}
+
+/// An (N, 3) array of finite points.
+pub fn points(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<Vec<Point>> {
+    let rows = rows::<3>(obj, what, "point")?;
+    Ok(rows.iter().map(|c| Point::new(c[0], c[1], c[2])).collect())
 }
 
 /// A vector of `N` finite numbers.
@@ -107,7 +117,11 @@ pub fn fixed<const N: usize>(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<[Re
 
 /// A unit quaternion given as (w, x, y, z).
 pub fn quaternion(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<Rotation> {
-    let [w, x, y, z] = fixed::<4>(obj, what)?;
+    unit_quaternion(fixed::<4>(obj, what)?, what)
+}
+
+/// The rotation of a quaternion (w, x, y, z) of unit length (to [`QUATERNION_NORM_TOLERANCE`]).
+pub fn unit_quaternion([w, x, y, z]: [Real; 4], what: &str) -> PyResult<Rotation> {
     let q = nalgebra::Quaternion::new(w, x, y, z);
     if (q.norm() - 1.0).abs() > QUATERNION_NORM_TOLERANCE {
         return Err(value_error(

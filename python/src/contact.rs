@@ -5,10 +5,11 @@
 
 use numpy::PyArray1;
 use polydem::contact::{
-    query_with, ContactGeometry, ContactKind, ContactTolerances, EpaScratch, PairCache,
-    PairSmoothing, QueryCounters, SolverStatus,
+    query_with, ContactError, ContactGeometry, ContactKind, ContactTolerances, EpaScratch,
+    PairCache, PairSmoothing, QueryCounters, SolverStatus,
 };
-use polydem::math::Real;
+use polydem::math::{Pose, Real};
+use polydem::shape::Shape;
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
@@ -24,7 +25,7 @@ pub struct PyContactResult {
     geometry: ContactGeometry,
 }
 
-fn kind_name(kind: ContactKind) -> &'static str {
+pub fn kind_name(kind: ContactKind) -> &'static str {
     match kind {
         ContactKind::Overlap => "overlap",
         ContactKind::Touching => "touching",
@@ -32,7 +33,7 @@ fn kind_name(kind: ContactKind) -> &'static str {
     }
 }
 
-fn solver_name(status: SolverStatus) -> &'static str {
+pub fn solver_name(status: SolverStatus) -> &'static str {
     match status {
         SolverStatus::Exact => "exact",
         SolverStatus::Converged => "converged",
@@ -123,25 +124,32 @@ pub fn contact(
     let pos2 = arrays::pose(pose_b, "pose_b")? * b.frame;
     let (shape1, shape2) = (&a.shape, &b.shape);
     let geometry = py
-        .detach(|| {
-            let mut cache = PairCache::default();
-            let mut scratch = EpaScratch::default();
-            let mut counters = QueryCounters::default();
-            let tolerances = ContactTolerances {
-                pair_smoothing: PairSmoothing::Exact,
-                ..ContactTolerances::default()
-            };
-            query_with(
-                &pos1,
-                shape1,
-                &pos2,
-                shape2,
-                &tolerances,
-                &mut cache,
-                &mut scratch,
-                &mut counters,
-            )
-        })
+        .detach(|| exact_query(&pos1, shape1, &pos2, shape2, &mut EpaScratch::default()))
         .map_err(|e| PyValueError::new_err(e.to_string()))?;
     Ok(PyContactResult { geometry })
+}
+
+/// The exact Minkowski geometry of one pair at engine poses: the dispatch with the default tolerances and
+/// no pair smoothing, a fresh warm-start cache (a query stands alone).
+pub fn exact_query(
+    pos1: &Pose,
+    shape1: &Shape,
+    pos2: &Pose,
+    shape2: &Shape,
+    scratch: &mut EpaScratch,
+) -> Result<ContactGeometry, ContactError> {
+    let tolerances = ContactTolerances {
+        pair_smoothing: PairSmoothing::Exact,
+        ..ContactTolerances::default()
+    };
+    query_with(
+        pos1,
+        shape1,
+        pos2,
+        shape2,
+        &tolerances,
+        &mut PairCache::default(),
+        scratch,
+        &mut QueryCounters::default(),
+    )
 }

@@ -5,6 +5,7 @@
 
 mod arrays;
 mod contact;
+mod contact_batch;
 mod errors;
 mod shapes;
 mod simulation;
@@ -20,6 +21,7 @@ fn _polydem(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<shapes::PyEllipsoid>()?;
     m.add_class::<contact::PyContactResult>()?;
     m.add_function(wrap_pyfunction!(contact::contact, m)?)?;
+    m.add_function(wrap_pyfunction!(contact_batch::contact_batch, m)?)?;
     m.add_class::<simulation::PyScene>()?;
     m.add_class::<simulation::PySimulation>()?;
     m.add("SceneError", py.get_type::<errors::PyPolydemSceneError>())?;
