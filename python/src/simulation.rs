@@ -7,6 +7,8 @@ use numpy::PyArray2;
 use polydem::io::checkpoint;
 use polydem::math::Real;
 use polydem::scene::{self, RunObserver, Simulation};
+use polydem::world::Loads;
+use pyo3::exceptions::{PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyBytes, PyDict, PyType};
 
@@ -85,6 +87,26 @@ fn advance(sim: &mut Simulation, n: u64) -> Result<(), scene::RunError> {
     result.map(|_| ())
 }
 
+/// The step index at time `t` (s) by the engine's rounding ([`Simulation::set_end_time`]), the
+/// simulation left as it was.
+fn step_at(sim: &mut Simulation, t: Real) -> PyResult<u64> {
+    let (end_time, steps) = (sim.end_time, sim.steps);
+    let result = sim.set_end_time(t).map(|()| sim.steps);
+    (sim.end_time, sim.steps) = (end_time, steps);
+    result.map_err(|e| PyValueError::new_err(format!("until: {e}")))
+}
+
+/// A callback interval (s) as a whole number of steps, at least one (the rounding of the scene's
+/// `output_interval`).
+fn interval_steps(every: Real, dt: Real) -> PyResult<u64> {
+    if !(every.is_finite() && every > 0.0) {
+        return Err(PyValueError::new_err(format!(
+            "every: expected a finite positive time in seconds, got {every}"
+        )));
+    }
+    Ok(((every / dt).round() as u64).max(1))
+}
+
 /// A running simulation. The state lives in the engine: every array this class returns is a **copy**
 /// taken when it is called (a view would change under the caller at the next step, and would dangle if
 /// the simulation were dropped). Body rows are in the scene's body order.
@@ -105,6 +127,17 @@ impl PySimulation {
             return Ok(PyArray2::zeros(py, [0, width], false));
         }
         Ok(PyArray2::from_vec2(py, &rows)?)
+    }
+
+    fn current_loads(&self) -> PyResult<&Loads> {
+        let loads = &self.sim.world.loads;
+        if loads.current && loads.forces.len() == self.sim.world.bodies.len() {
+            Ok(loads)
+        } else {
+            Err(PyRuntimeError::new_err(
+                "no contact forces yet: they are evaluated at the first step",
+            ))
+        }
     }
 }
 
@@ -134,6 +167,45 @@ impl PySimulation {
     fn step(&mut self, py: Python<'_>, n: u64) -> PyResult<()> {
         let sim = &mut self.sim;
         py.detach(|| advance(sim, n)).map_err(|e| run_error(&e))
+    }
+
+    /// Runs to the time `until` (s; default: the scene's end time), calling `callback(sim)` every
+    /// `every` seconds of simulated time (rounded to whole steps, at least one) and at the end; without
+    /// `every`, once at the end. The steps run in Rust with the GIL released; it is taken again only for
+    /// the callback. An exception raised by the callback stops the run and propagates.
+    #[pyo3(signature = (until = None, every = None, callback = None))]
+    fn run(
+        slf: &Bound<'_, Self>,
+        until: Option<Real>,
+        every: Option<Real>,
+        callback: Option<Bound<'_, PyAny>>,
+    ) -> PyResult<()> {
+        let py = slf.py();
+        let (last, chunk) = {
+            let mut this = slf.borrow_mut();
+            let dt = this.sim.params.dt;
+            let last = match until {
+                Some(t) => step_at(&mut this.sim, t)?,
+                None => this.sim.steps,
+            };
+            let chunk = every.map(|t| interval_steps(t, dt)).transpose()?;
+            (last, chunk.unwrap_or(u64::MAX))
+        };
+        loop {
+            let done = slf.borrow().sim.world.step_index;
+            if done >= last {
+                return Ok(());
+            }
+            {
+                let mut this = slf.borrow_mut();
+                let sim = &mut this.sim;
+                py.detach(|| advance(sim, chunk.min(last - done)))
+                    .map_err(|e| run_error(&e))?;
+            }
+            if let Some(callback) = &callback {
+                callback.call1((slf,))?;
+            }
+        }
     }
 
     /// Simulated time (s).
@@ -204,6 +276,20 @@ impl PySimulation {
     fn angular_velocities<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<Real>>> {
         let bodies = &self.sim.world.bodies;
         self.rows(py, 3, |i| bodies[i].angular_velocity().as_slice().to_vec())
+    }
+
+    /// Contact forces on the bodies (N, world frame; gravity not included) from the last evaluation, a
+    /// new (N, 3) array (a copy). Raises `RuntimeError` before the first step, when none was evaluated.
+    fn forces<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<Real>>> {
+        let loads = self.current_loads()?;
+        self.rows(py, 3, |i| loads.forces[i].as_slice().to_vec())
+    }
+
+    /// Contact torques about the centres of mass (N·m, world frame) from the last evaluation, a new
+    /// (N, 3) array (a copy). Raises `RuntimeError` before the first step.
+    fn torques<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<Real>>> {
+        let loads = self.current_loads()?;
+        self.rows(py, 3, |i| loads.torques[i].as_slice().to_vec())
     }
 
     /// The energy ledger now (J), as a dict: kinetic (translational, rotational), elastic and

@@ -177,3 +177,49 @@ def test_state_arrays_are_copies(repo):
     sim.step(10)
     assert np.any(sim.positions() != before), "a step moves the bodies"
     assert sim.positions().shape == (2, 3) and sim.orientations().shape == (2, 4)
+
+
+def test_run_with_callbacks_equals_step(repo):
+    ran, stepped = (polydem.Simulation.from_toml(repo / ELASTIC) for _ in range(2))
+    seen = []
+    every = 50 * ran.dt
+    ran.run(until=ran.end_time, every=every, callback=lambda s: seen.append((s.step_index, s.positions())))
+    expected_steps = list(range(50, ran.end_step, 50)) + [ran.end_step]
+    assert [i for i, _ in seen] == expected_steps, [i for i, _ in seen]
+    stepped.step(50)
+    assert seen[0][1].tolist() == stepped.positions().tolist()
+    stepped.step(ran.end_step - 50)
+    assert_same_state(state(ran), state(stepped), "run(until, every, callback) against step(n)")
+
+
+def test_run_stops_at_a_callback_exception_and_refuses_a_past_time(repo):
+    sim = polydem.Simulation.from_toml(repo / ELASTIC)
+
+    def stop(s):
+        if s.step_index >= 20:
+            raise KeyboardInterrupt("enough")
+
+    with pytest.raises(KeyboardInterrupt, match="enough"):
+        sim.run(every=10 * sim.dt, callback=stop)
+    assert sim.step_index == 20
+    with pytest.raises(ValueError, match="until: end time .* lies before the current time"):
+        sim.run(until=sim.dt)
+    with pytest.raises(ValueError, match="every: expected a finite positive time"):
+        sim.run(every=-1.0)
+
+
+def test_contact_forces_balance_between_the_two_bodies(repo):
+    sim = polydem.Simulation.from_toml(repo / ELASTIC)
+    with pytest.raises(RuntimeError, match="no contact forces yet"):
+        sim.forces()
+    sim.step(1)
+    assert np.all(sim.forces() == 0.0), "apart at the start: no contact force"
+    while not np.any(sim.forces() != 0.0):
+        assert sim.step_index < sim.end_step, "the boxes never touched"
+        sim.step(1)
+    sim.step(50)  # well inside the impact (about 200 steps long)
+    f, torques = sim.forces(), sim.torques()
+    scale = np.abs(f).max()
+    assert scale > 0.0, f"the boxes are in contact at step {sim.step_index}"
+    assert np.allclose(f[0] + f[1], 0.0, rtol=0, atol=1e-12 * scale), f"action and reaction: {f}"
+    assert torques.shape == (2, 3) and np.any(torques != 0.0), "the off-centre contact exerts torques"
