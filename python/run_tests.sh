@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Builds the polydem Python package and runs its tests, non-interactively, from any directory:
 #   1. a virtual environment under target/python-venv (created once, reused);
-#   2. `pip install ./python[test]`: maturin builds the extension in release, pytest comes along;
+#   2. `pip install ./python[test]`: maturin builds the extension in release; pytest and mypy (for
+#      stubtest) come along;
 #   3. the `polydem` binary, from which the tests take their Rust references (`polydem run`,
 #      `polydem contact`);
 #   4. pytest over python/tests (extra arguments are passed to pytest).
