@@ -49,11 +49,29 @@ def rust_rows(polydem_bin, scene, out, end_time=None):
     return rows
 
 
-@pytest.mark.parametrize("scene, steps", [(ELASTIC, None), (SPHERE_BED, 300)])
+def flat_sphere_variant(repo, tmp_path):
+    """Sphere bed a with the energy ledger off, so that both sides take the flat sphere layout; the bed
+    file's relative path made absolute for the copy in tmp_path."""
+    text = (repo / SPHERE_BED).read_text()
+    relative = '"../reference/sphere_bed/bed_quick.csv"'
+    assert relative in text and "[simulation]\n" in text
+    text = text.replace(relative, f'"{(repo / "reference/sphere_bed/bed_quick.csv").as_posix()}"')
+    text = text.replace("[simulation]\n", "[simulation]\nenergy_ledger = false\n", 1)
+    path = tmp_path / "sphere_bed_a_flat.toml"
+    path.write_text(text)
+    return path
+
+
+@pytest.mark.parametrize(
+    "scene, steps",
+    [(ELASTIC, None), (SPHERE_BED, 300), ("flat", 300)],
+    ids=["two_polyhedra_whole_run", "sphere_bed_a_general_step", "sphere_bed_a_flat_layout"],
+)
 def test_same_trajectory_as_polydem_run_bit_for_bit(repo, polydem_bin, tmp_path, scene, steps):
-    sim = polydem.Simulation.from_toml(repo / scene)
+    scene = flat_sphere_variant(repo, tmp_path) if scene == "flat" else repo / scene
+    sim = polydem.Simulation.from_toml(scene)
     end_time = None if steps is None else steps * sim.dt
-    rows = rust_rows(polydem_bin, repo / scene, tmp_path, end_time)
+    rows = rust_rows(polydem_bin, scene, tmp_path / "out", end_time)
     index = {name: i for i, name in enumerate(sim.names)}
     columns = {
         "positions": ("x", "y", "z"),
