@@ -1,0 +1,51 @@
+"""polydem: a convex-polyhedral discrete element engine, from Python.
+
+Shapes and contact queries::
+
+    import numpy as np, polydem
+    cube = polydem.ConvexPolyhedron.from_points(np.array([[x, y, z] for x in (0, 1) for y in (0, 1) for z in (0, 1)]))
+    r = polydem.contact(cube, cube, pose_b=([1.5, 0, 0], [1, 0, 0, 0]))
+    r.status, r.distance, r.normal          # 'separated', 0.5, [1, 0, 0]
+
+Simulations from scene files::
+
+    sim = polydem.Simulation(polydem.Scene.from_toml("scenes/two_polyhedra_elastic.toml"))
+    sim.step(100)                           # in Rust, with the GIL released
+    sim.positions(), sim.energy()           # numpy copies of the state, the energy ledger
+
+Every array the package returns is a copy: the state belongs to the engine and changes at the next step.
+Lengths in metres, times in seconds, SI units throughout. Poses are ``(position[3], quaternion[4])`` with
+the quaternion as (w, x, y, z).
+"""
+
+from ._polydem import (
+    CheckpointError,
+    ContactResult,
+    ConvexPolyhedron,
+    Ellipsoid,
+    Scene,
+    SceneError,
+    Shape,
+    Simulation,
+    Sphere,
+    StepError,
+    __version__,
+    contact,
+    contact_batch,
+)
+
+__all__ = [
+    "CheckpointError",
+    "ContactResult",
+    "ConvexPolyhedron",
+    "Ellipsoid",
+    "Scene",
+    "SceneError",
+    "Shape",
+    "Simulation",
+    "Sphere",
+    "StepError",
+    "__version__",
+    "contact",
+    "contact_batch",
+]
