@@ -13,7 +13,7 @@ pub mod timing;
 
 use std::path::Path;
 
-use polydem::contact::{ContactKind, ContactTolerances};
+use polydem::contact::{ContactKind, ContactTolerances, QueryCounters};
 use serde::Deserialize;
 
 use crate::case::{Case, CaseData, Profile, Target};
@@ -211,6 +211,633 @@ fn group(evals: &[&Eval], pick: impl Fn(&Eval) -> Errors) -> Group {
     }
 }
 
+/// The pair tolerance's coefficients: tol = `abs` × size + `rel` × |reference overlap or gap|.
+#[derive(Clone, Copy)]
+struct DepthTolerance {
+    abs: f64,
+    rel: f64,
+}
+
+/// Both pair sets, every pair answered by the oracle, ours and parry.
+struct Evaluated {
+    random: Vec<Pair>,
+    evals: Vec<Eval>,
+    deg_evals: Vec<Eval>,
+    /// Our solver counters over the random set.
+    random_counters: QueryCounters,
+}
+
+/// Generates the random and degenerate sets and evaluates every pair.
+fn evaluate_sets(
+    p: &Params,
+    tol: DepthTolerance,
+    ctx: &mut CaseContext,
+) -> Result<Evaluated, SuiteError> {
+    let spec = p.spec(p.pairs_per_class_and_size);
+    let n_random = p.classes.len() * p.sizes.len() * p.pairs_per_class_and_size;
+    ctx.progress()
+        .stage("generating random pairs", n_random as u64);
+    let random = random_set(&spec, || ctx.progress().inc(1))?;
+    let degenerate = degenerate_set(&p.sizes);
+
+    ctx.progress()
+        .stage("evaluating pairs", (random.len() + degenerate.len()) as u64);
+    let size_index = |pair: &Pair| p.sizes.iter().position(|s| *s == pair.size).unwrap_or(0);
+    let mut evaluate_all = |pairs: &[Pair], ours: &mut Ours| -> Result<Vec<Eval>, SuiteError> {
+        let mut evals = Vec::with_capacity(pairs.len());
+        for pair in pairs {
+            evals.push(evaluate(pair, size_index(pair), ours, tol.abs, tol.rel).map_err(case_err)?);
+            ctx.progress().inc(1);
+        }
+        Ok(evals)
+    };
+    let mut ours = Ours::new(ContactTolerances::default());
+    let evals = evaluate_all(&random, &mut ours)?;
+    let mut ours_deg = Ours::new(ContactTolerances::default());
+    let deg_evals = evaluate_all(&degenerate, &mut ours_deg)?;
+    Ok(Evaluated {
+        random,
+        evals,
+        deg_evals,
+        random_counters: ours.counters,
+    })
+}
+
+/// The random set covers the ranges it claims: overlaps from tiny to large, touching and separated pairs.
+fn check_random_coverage(evals: &[Eval], ctx: &mut CaseContext) {
+    let overlaps: Vec<f64> = evals
+        .iter()
+        .filter(|e| e.reference.kind == ContactKind::Overlap)
+        .map(|e| -e.reference.signed_gap / e.size)
+        .collect();
+    let count = |k: ContactKind| evals.iter().filter(|e| e.reference.kind == k).count() as f64;
+    ctx.check(
+        "random_pairs_overlap_min_rel",
+        overlaps.iter().copied().fold(f64::INFINITY, f64::min),
+        Target::at_most(1e-8),
+        "1",
+    );
+    ctx.check(
+        "random_pairs_overlap_max_rel",
+        overlaps.iter().copied().fold(0.0, f64::max),
+        Target::at_least(0.1),
+        "1",
+    );
+    ctx.check(
+        "random_pairs_touching",
+        count(ContactKind::Touching),
+        Target::at_least(1.0),
+        "pairs",
+    );
+    ctx.check(
+        "random_pairs_separated",
+        count(ContactKind::Separated),
+        Target::at_least(1.0),
+        "pairs",
+    );
+}
+
+/// Our answers on one set: no wrong status, every error within the pair tolerance.
+fn check_ours(tag: &str, g: &Group, ctx: &mut CaseContext) {
+    ctx.check(
+        &format!("ours_{tag}_wrong_status"),
+        g.wrong as f64,
+        Target::equal(0.0),
+        "pairs",
+    );
+    ctx.check(
+        &format!("ours_{tag}_gap_error_over_tol_max"),
+        g.gap_ratio_max,
+        Target::at_most(1.0),
+        "1",
+    );
+    ctx.check(
+        &format!("ours_{tag}_normal_error_over_tol_max"),
+        g.normal_ratio_max,
+        Target::at_most(1.0),
+        "1",
+    );
+    ctx.check(
+        &format!("ours_{tag}_point_error_over_tol_max"),
+        g.point_ratio_max,
+        Target::at_most(1.0),
+        "1",
+    );
+}
+
+/// The page's opening text and the overview table of both methods on both sets.
+fn overview(
+    p: &Params,
+    ev: &Evaluated,
+    tol: DepthTolerance,
+    [ours_all, parry_all, ours_deg_g, parry_deg_g]: [&Group; 4],
+    ctx: &mut CaseContext,
+) -> Result<(), SuiteError> {
+    ctx.text(&format!(
+        "Pairs: {} random ({} classes × {} particle sizes × {} pairs; seed {}) and {} degenerate. Reference: \
+         the exact SAT oracle. Pair tolerance tol = {:e} × size + {:e} × |reference overlap or gap| \
+         (issue 2); size = diameter of the centroid-centred bounding sphere (larger of the two). The rows \
+         above check ours; parry's figures are reported for comparison, not checked.",
+        ev.random.len(),
+        p.classes.len(),
+        p.sizes.len(),
+        p.pairs_per_class_and_size,
+        p.seed,
+        ev.deg_evals.len(),
+        tol.abs,
+        tol.rel
+    ));
+    ctx.section("Overview: ours vs parry3d-f64 against the SAT oracle");
+    let row = |set: &str, m: &str, g: &Group| {
+        vec![
+            set.to_string(),
+            m.to_string(),
+            g.n.to_string(),
+            g.wrong.to_string(),
+            g.over_tol.to_string(),
+            e2(g.gap_max),
+            e2(g.gap_p99),
+            e2(g.gap_median),
+            e2(g.normal_max),
+            e2(g.point_max),
+            e2(g.worst_ratio),
+        ]
+    };
+    ctx.table(
+        Some("overview"),
+        &[
+            "set",
+            "method",
+            "pairs",
+            "wrong status",
+            "pairs over tol",
+            "gap err max /size",
+            "p99",
+            "median",
+            "normal err max /size",
+            "point err max /size",
+            "worst err/tol",
+        ],
+        &[
+            row("random", "ours", ours_all),
+            row("random", "parry", parry_all),
+            row("degenerate", "ours", ours_deg_g),
+            row("degenerate", "parry", parry_deg_g),
+        ],
+    )?;
+    Ok(())
+}
+
+/// Ours and parry side by side per shape class and particle size.
+fn by_class(p: &Params, evals: &[Eval], ctx: &mut CaseContext) -> Result<(), SuiteError> {
+    ctx.section("By shape class and particle size");
+    let mut rows = Vec::new();
+    for class in &p.classes {
+        for (si, size) in p.sizes.iter().enumerate() {
+            let g: Vec<&Eval> = evals
+                .iter()
+                .filter(|e| &e.class == class && e.size_index == si)
+                .collect();
+            let (o, q) = (group(&g, |e| e.ours), group(&g, |e| e.parry));
+            rows.push(vec![
+                class.clone(),
+                format!("{size:e}"),
+                g.len().to_string(),
+                format!("{} / {}", o.wrong, q.wrong),
+                format!("{} / {}", o.over_tol, q.over_tol),
+                format!("{} / {}", e2(o.gap_max), e2(q.gap_max)),
+                format!("{} / {}", e2(o.gap_p99), e2(q.gap_p99)),
+                format!("{} / {}", e2(o.gap_median), e2(q.gap_median)),
+                format!("{} / {}", e2(o.normal_max), e2(q.normal_max)),
+                format!("{} / {}", e2(o.point_max), e2(q.point_max)),
+            ]);
+        }
+    }
+    ctx.text("Each cell: ours / parry. Errors relative to the particle size.");
+    ctx.table(
+        Some("by_class"),
+        &[
+            "class",
+            "size (m)",
+            "pairs",
+            "wrong status",
+            "over tol",
+            "gap err max",
+            "gap err p99",
+            "gap err median",
+            "normal err max",
+            "point err max",
+        ],
+        &rows,
+    )?;
+    Ok(())
+}
+
+/// The pairs where parry's answer is outside the pair tolerance, worst first, with ours beside.
+fn parry_failures(ev: &Evaluated, ctx: &mut CaseContext) -> Result<(), SuiteError> {
+    ctx.section("Where parry fails");
+    let mut worst: Vec<&Eval> = ev
+        .evals
+        .iter()
+        .chain(ev.deg_evals.iter())
+        .filter(|e| e.parry.worst_ratio(e.tol) > 1.0)
+        .collect();
+    worst.sort_by(|a, b| {
+        b.parry
+            .worst_ratio(b.tol)
+            .total_cmp(&a.parry.worst_ratio(a.tol))
+            .then(a.id.cmp(&b.id))
+    });
+    let n_fail = worst.len();
+    worst.truncate(25);
+    ctx.text(&format!(
+        "{n_fail} of {} pairs have a parry answer outside the pair tolerance (wrong status, failed, or an \
+         error above tol); the worst 25 follow, with ours on the same pair.",
+        ev.evals.len() + ev.deg_evals.len()
+    ));
+    let fail_rows: Vec<Vec<String>> = worst
+        .iter()
+        .map(|e| {
+            vec![
+                e.id.clone(),
+                kind_name(Some(e.reference.kind)).into(),
+                e2(-e.reference.signed_gap / e.size),
+                kind_name(e.parry_kind).into(),
+                e2(e.parry.gap / e.size),
+                e2(e.parry.normal / e.size),
+                kind_name(Some(e.ours_kind)).into(),
+                e2(e.ours.gap / e.size),
+                e2(e.ours.normal / e.size),
+            ]
+        })
+        .collect();
+    ctx.table(
+        Some("parry_failures"),
+        &[
+            "pair",
+            "exact kind",
+            "exact overlap /size (< 0: gap)",
+            "parry kind",
+            "parry gap err /size",
+            "parry normal err /size",
+            "ours kind",
+            "ours gap err /size",
+            "ours normal err /size",
+        ],
+        &fail_rows,
+    )?;
+    Ok(())
+}
+
+/// The degenerate set, one row per pair.
+fn degenerate_table(deg_evals: &[Eval], ctx: &mut CaseContext) -> Result<(), SuiteError> {
+    ctx.section("Degenerate set, pair by pair");
+    let deg_rows: Vec<Vec<String>> = deg_evals
+        .iter()
+        .map(|e| {
+            vec![
+                e.id.clone(),
+                kind_name(Some(e.reference.kind)).into(),
+                e2(-e.reference.signed_gap / e.size),
+                kind_name(Some(e.ours_kind)).into(),
+                e2(e.ours.gap / e.size),
+                e2(e.ours.worst_ratio(e.tol)),
+                kind_name(e.parry_kind).into(),
+                e2(e.parry.gap / e.size),
+                e2(e.parry.worst_ratio(e.tol)),
+            ]
+        })
+        .collect();
+    ctx.table(
+        Some("degenerate"),
+        &[
+            "pair",
+            "exact kind",
+            "exact overlap /size (< 0: gap)",
+            "ours kind",
+            "ours gap err /size",
+            "ours worst err/tol",
+            "parry kind",
+            "parry gap err /size",
+            "parry worst err/tol",
+        ],
+        &deg_rows,
+    )?;
+    Ok(())
+}
+
+/// Our GJK/EPA counters over the random set.
+fn solver_statistics(c: &QueryCounters, ctx: &mut CaseContext) -> Result<(), SuiteError> {
+    ctx.section("Solver statistics (ours, random set)");
+    let per = |n: u64, d: u64| if d == 0 { 0.0 } else { n as f64 / d as f64 };
+    ctx.table(
+        Some("counters"),
+        &[
+            "queries",
+            "GJK runs",
+            "GJK iterations/run",
+            "EPA runs",
+            "EPA iterations/run",
+            "SAT fallbacks (max iterations)",
+            "SAT fallbacks (degenerate)",
+        ],
+        &[vec![
+            c.polyhedron_polyhedron.to_string(),
+            c.gjk_runs.to_string(),
+            format!("{:.2}", per(c.gjk_iterations, c.gjk_runs)),
+            c.epa_runs.to_string(),
+            format!("{:.2}", per(c.epa_iterations, c.epa_runs)),
+            c.fallback_max_iterations.to_string(),
+            c.fallback_degenerate.to_string(),
+        ]],
+    )?;
+    Ok(())
+}
+
+/// Scatter of the depth error against the exact overlap, with the tolerance line.
+fn depth_error_plot(
+    p: &Params,
+    evals: &[Eval],
+    tol: DepthTolerance,
+    ctx: &mut CaseContext,
+) -> Result<(), SuiteError> {
+    let (depth_abs, depth_rel) = (tol.abs, tol.rel);
+    ctx.section("Depth error against overlap");
+    let over: Vec<&Eval> = evals
+        .iter()
+        .filter(|e| e.reference.kind == ContactKind::Overlap)
+        .collect();
+    let scatter = |label: &str, pick: &dyn Fn(&Eval) -> f64| Series {
+        label: label.into(),
+        style: SeriesStyle::Points,
+        points: over
+            .iter()
+            .map(|e| {
+                (
+                    -e.reference.signed_gap / e.size,
+                    (pick(e) / e.size).max(PLOT_FLOOR),
+                )
+            })
+            .collect(),
+    };
+    let tol_line = Series {
+        label: format!("tolerance {depth_abs:e} + {depth_rel:e}·overlap"),
+        style: SeriesStyle::Line,
+        points: [p.overlap_min_rel, 1e-6, 1e-3, p.overlap_max_rel]
+            .iter()
+            .map(|x| (*x, depth_abs + depth_rel * x))
+            .collect(),
+    };
+    ctx.plot(&Plot {
+        name: "depth_error_vs_overlap".into(),
+        title: "Depth error against exact overlap (random overlapping pairs)".into(),
+        x_label: "exact overlap / particle size".into(),
+        y_label: "|depth error| / particle size".into(),
+        x_log: true,
+        y_log: true,
+        series: vec![
+            scatter("ours (GJK/EPA)", &|e| e.ours.gap),
+            scatter("parry3d-f64", &|e| e.parry.gap),
+            tol_line,
+        ],
+        caption: format!(
+            "All sizes pooled. Errors below {PLOT_FLOOR:e} × size (including exact zeros) are drawn at \
+             {PLOT_FLOOR:e}."
+        ),
+    })?;
+    Ok(())
+}
+
+/// Cumulative distribution of the gap/depth error of ours and parry over the random set.
+fn error_cdf_plot(evals: &[Eval], ctx: &mut CaseContext) -> Result<(), SuiteError> {
+    ctx.section("Error distribution");
+    let cdf = |label: &str, pick: &dyn Fn(&Eval) -> f64| {
+        let s = sorted(
+            evals
+                .iter()
+                .map(|e| (pick(e) / e.size).max(PLOT_FLOOR))
+                .collect(),
+        );
+        let n = s.len();
+        let step = n.div_ceil(CDF_POINTS).max(1);
+        let points = s
+            .iter()
+            .enumerate()
+            .filter(|(i, _)| i % step == 0 || *i + 1 == n)
+            .map(|(i, v)| (*v, (i + 1) as f64 / n as f64))
+            .collect();
+        Series {
+            label: label.into(),
+            style: SeriesStyle::Line,
+            points,
+        }
+    };
+    ctx.plot(&Plot {
+        name: "error_cdf".into(),
+        title: "Cumulative distribution of the gap/depth error (all random pairs)".into(),
+        x_label: "|signed gap error| / particle size".into(),
+        y_label: "fraction of pairs with error ≤ x".into(),
+        x_log: true,
+        y_log: false,
+        series: vec![
+            cdf("ours (GJK/EPA)", &|e| e.ours.gap),
+            cdf("parry3d-f64", &|e| e.parry.gap),
+        ],
+        caption: format!(
+            "Errors below {PLOT_FLOOR:e} × size are drawn at {PLOT_FLOOR:e}. Lines drawn through at most \
+             {CDF_POINTS} ranks per method (the CSV has the same points)."
+        ),
+    })?;
+    Ok(())
+}
+
+/// Ours against parry in ns per query on each class's size-1 pairs. Returns the overlapping timing pairs of
+/// all classes, pooled for the work-precision sweep.
+fn speed(p: &Params, ev: &Evaluated, ctx: &mut CaseContext) -> Result<Vec<Built>, SuiteError> {
+    let timing_size = p.sizes.iter().position(|s| *s == 1.0).unwrap_or(0);
+    let pick = |class: &str, kind: ContactKind| -> Result<Vec<Built>, SuiteError> {
+        ev.random
+            .iter()
+            .zip(&ev.evals)
+            .filter(|(pair, e)| {
+                pair.class == class && e.size_index == timing_size && e.reference.kind == kind
+            })
+            .take(p.timing_pairs_per_class)
+            .map(|(pair, _)| build(pair).map_err(case_err))
+            .collect()
+    };
+    ctx.progress()
+        .stage("timing", (p.classes.len() + p.epa_gaps.len()) as u64);
+    let mut timing_rows = Vec::new();
+    let mut pooled_overlap: Vec<Built> = Vec::new();
+    for class in &p.classes {
+        let ov = pick(class, ContactKind::Overlap)?;
+        let sep = pick(class, ContactKind::Separated)?;
+        let ours_ns = timing::ours_query_ns(&ov, ContactTolerances::default(), p.timing_repeats);
+        let parry_ns = timing::parry_query_ns(&ov, p.timing_repeats);
+        let ours_sep = timing::ours_intersects_ns(&sep, p.timing_repeats);
+        let parry_sep = timing::parry_intersects_ns(&sep, p.timing_repeats);
+        timing_rows.push(vec![
+            class.clone(),
+            ov.len().to_string(),
+            format!("{ours_ns:.0}"),
+            format!("{parry_ns:.0}"),
+            format!("{:.2}", ours_ns / parry_ns),
+            sep.len().to_string(),
+            format!("{ours_sep:.0}"),
+            format!("{parry_sep:.0}"),
+            format!("{:.2}", ours_sep / parry_sep),
+        ]);
+        pooled_overlap.extend(ov);
+        ctx.progress().inc(1);
+    }
+    speed_report(&timing_rows, ctx)?;
+    Ok(pooled_overlap)
+}
+
+fn speed_report(timing_rows: &[Vec<String>], ctx: &mut CaseContext) -> Result<(), SuiteError> {
+    ctx.section("Speed (same pairs, same run)");
+    ctx.text(
+        "ns per query, minimum over repeated passes, size-1 pairs of the random set. Overlapping: our full \
+         query (cold cache) vs parry's `query::contact`. Separated: our boolean intersection test vs parry's \
+         `intersection_test`. Ratio = ours / parry (issue 2 target: ≤ 1/3 on voronoi and hull16–32 and for \
+         separated rejection). Wall-clock figures vary between runs; the criterion bench `benches/contact.rs` \
+         gives the careful measurement.",
+    );
+    ctx.table(
+        Some("timing"),
+        &[
+            "class",
+            "overlapping pairs",
+            "ours ns",
+            "parry ns",
+            "ratio",
+            "separated pairs",
+            "ours ns",
+            "parry ns",
+            "ratio",
+        ],
+        timing_rows,
+    )?;
+    Ok(())
+}
+
+/// The exact depth (SAT oracle) and the particle size (m) of each pooled pair.
+fn exact_depths(pooled: &[Built]) -> Vec<(f64, f64)> {
+    pooled
+        .iter()
+        .map(|b| {
+            let exact = sat(&b.pos1, &b.a, &b.pos2, &b.b).depth;
+            (exact, b.a.length_scale().max(b.b.length_scale()))
+        })
+        .collect()
+}
+
+/// Largest depth error relative to size against `exact` (from [`exact_depths`]), floored at
+/// [`PLOT_FLOOR`].
+fn max_depth_error(exact: &[(f64, f64)], depths: &[f64]) -> f64 {
+    depths
+        .iter()
+        .zip(exact)
+        .map(|(d, (x, s))| ((d - x).abs() / s).max(PLOT_FLOOR))
+        .fold(PLOT_FLOOR, f64::max)
+}
+
+/// Our EPA tolerance sweep: (ns per query, max depth error) per stopping gap, and its table rows.
+fn epa_sweep(
+    p: &Params,
+    pooled: &[Built],
+    exact: &[(f64, f64)],
+    ctx: &mut CaseContext,
+) -> (Vec<(f64, f64)>, Vec<Vec<String>>) {
+    let mut ours_pts = Vec::new();
+    let mut wp_rows = Vec::new();
+    for gap in &p.epa_gaps {
+        let tol = ContactTolerances {
+            epa_gap: *gap,
+            ..ContactTolerances::default()
+        };
+        let mut o = Ours::new(tol);
+        let depths: Vec<f64> = pooled
+            .iter()
+            .map(|b| o.query(&b.pos1, &b.a, &b.pos2, &b.b).depth)
+            .collect();
+        let ns = timing::ours_query_ns(pooled, tol, p.timing_repeats);
+        let err = max_depth_error(exact, &depths);
+        ours_pts.push((ns, err));
+        wp_rows.push(vec![
+            format!("ours, epa_gap = {gap:e}"),
+            format!("{ns:.0}"),
+            e2(err),
+        ]);
+        ctx.progress().inc(1);
+    }
+    (ours_pts, wp_rows)
+}
+
+/// Work-precision: error over the pooled overlapping timing pairs, against ns per query.
+fn work_precision(p: &Params, pooled: &[Built], ctx: &mut CaseContext) -> Result<(), SuiteError> {
+    let exact = exact_depths(pooled);
+    let (ours_pts, mut wp_rows) = epa_sweep(p, pooled, &exact, ctx);
+    let parry_depths: Vec<f64> = pooled
+        .iter()
+        .map(|b| {
+            let peer = crate::peers::parry::ParryPair {
+                a: &b.parry_a,
+                b: &b.parry_b,
+            };
+            match peer.contact(&b.pos1, &b.pos2, 0.0) {
+                Ok(Some(c)) => -c.signed_gap,
+                _ => f64::NAN,
+            }
+        })
+        .collect();
+    let parry_ns = timing::parry_query_ns(pooled, p.timing_repeats);
+    let parry_err = max_depth_error(&exact, &parry_depths);
+    let sat_ns = timing::sat_query_ns(pooled, p.sat_timing_repeats);
+    wp_rows.push(vec![
+        "parry3d-f64".into(),
+        format!("{parry_ns:.0}"),
+        e2(parry_err),
+    ]);
+    wp_rows.push(vec![
+        "SAT oracle (the reference)".into(),
+        format!("{sat_ns:.0}"),
+        e2(PLOT_FLOOR),
+    ]);
+    let line = |label: &str, points| Series {
+        label: label.into(),
+        style: SeriesStyle::LinePoints,
+        points,
+    };
+    ctx.section("Work-precision: depth error against time per query");
+    ctx.plot(&Plot {
+        name: "work_precision".into(),
+        title: "Contact queries: max depth error vs time per query".into(),
+        x_label: "time per query (ns)".into(),
+        y_label: "max |depth error| / particle size".into(),
+        x_log: true,
+        y_log: true,
+        series: vec![
+            line("ours, EPA tolerance sweep", ours_pts),
+            line("parry3d-f64", vec![(parry_ns, parry_err)]),
+            line("SAT oracle (error 0 by definition)", vec![(sat_ns, PLOT_FLOOR)]),
+        ],
+        caption: format!(
+            "{} overlapping size-1 pairs pooled over all classes; cold pair cache. The SAT oracle is the \
+             reference, so its error is zero and drawn at the floor {PLOT_FLOOR:e}; a NaN (failed) parry \
+             answer would count as an infinite error.",
+            pooled.len()
+        ),
+    })?;
+    ctx.table(
+        Some("work_precision_table"),
+        &["method", "ns per query", "max depth err / size"],
+        &wp_rows,
+    )?;
+    Ok(())
+}
+
 impl Case for Contact {
     fn name(&self) -> &'static str {
         NAME
@@ -227,536 +854,34 @@ impl Case for Contact {
         ctx: &mut CaseContext,
     ) -> Result<(), SuiteError> {
         let p: Params = data.params(NAME, profile)?;
-        let depth_abs = data.tolerance(NAME, "depth_abs")?.value;
-        let depth_rel = data.tolerance(NAME, "depth_rel")?.value;
-        let spec = p.spec(p.pairs_per_class_and_size);
+        let tol = DepthTolerance {
+            abs: data.tolerance(NAME, "depth_abs")?.value,
+            rel: data.tolerance(NAME, "depth_rel")?.value,
+        };
+        let ev = evaluate_sets(&p, tol, ctx)?;
 
-        let n_random = p.classes.len() * p.sizes.len() * p.pairs_per_class_and_size;
-        ctx.progress()
-            .stage("generating random pairs", n_random as u64);
-        let random = random_set(&spec, || ctx.progress().inc(1))?;
-        let degenerate = degenerate_set(&p.sizes);
-
-        ctx.progress()
-            .stage("evaluating pairs", (random.len() + degenerate.len()) as u64);
-        let mut ours = Ours::new(ContactTolerances::default());
-        let size_index = |pair: &Pair| p.sizes.iter().position(|s| *s == pair.size).unwrap_or(0);
-        let mut evals = Vec::with_capacity(random.len());
-        for pair in &random {
-            evals.push(
-                evaluate(pair, size_index(pair), &mut ours, depth_abs, depth_rel)
-                    .map_err(case_err)?,
-            );
-            ctx.progress().inc(1);
-        }
-        let random_counters = ours.counters;
-        let mut ours_deg = Ours::new(ContactTolerances::default());
-        let mut deg_evals = Vec::with_capacity(degenerate.len());
-        for pair in &degenerate {
-            deg_evals.push(
-                evaluate(pair, size_index(pair), &mut ours_deg, depth_abs, depth_rel)
-                    .map_err(case_err)?,
-            );
-            ctx.progress().inc(1);
-        }
-
-        // ---- checks -------------------------------------------------------------------------------
-        let all: Vec<&Eval> = evals.iter().collect();
-        let deg: Vec<&Eval> = deg_evals.iter().collect();
+        let all: Vec<&Eval> = ev.evals.iter().collect();
+        let deg: Vec<&Eval> = ev.deg_evals.iter().collect();
         let (ours_all, parry_all) = (group(&all, |e| e.ours), group(&all, |e| e.parry));
-        let (ours_deg_g, parry_deg_g) = (group(&deg, |e| e.ours), group(&deg, |e| e.parry));
-        let overlaps: Vec<f64> = evals
-            .iter()
-            .filter(|e| e.reference.kind == ContactKind::Overlap)
-            .map(|e| -e.reference.signed_gap / e.size)
-            .collect();
-        let count = |k: ContactKind| evals.iter().filter(|e| e.reference.kind == k).count() as f64;
-        ctx.check(
-            "random_pairs_overlap_min_rel",
-            overlaps.iter().copied().fold(f64::INFINITY, f64::min),
-            Target::at_most(1e-8),
-            "1",
-        );
-        ctx.check(
-            "random_pairs_overlap_max_rel",
-            overlaps.iter().copied().fold(0.0, f64::max),
-            Target::at_least(0.1),
-            "1",
-        );
-        ctx.check(
-            "random_pairs_touching",
-            count(ContactKind::Touching),
-            Target::at_least(1.0),
-            "pairs",
-        );
-        ctx.check(
-            "random_pairs_separated",
-            count(ContactKind::Separated),
-            Target::at_least(1.0),
-            "pairs",
-        );
-        for (tag, g) in [("random", &ours_all), ("degenerate", &ours_deg_g)] {
-            ctx.check(
-                &format!("ours_{tag}_wrong_status"),
-                g.wrong as f64,
-                Target::equal(0.0),
-                "pairs",
-            );
-            ctx.check(
-                &format!("ours_{tag}_gap_error_over_tol_max"),
-                g.gap_ratio_max,
-                Target::at_most(1.0),
-                "1",
-            );
-            ctx.check(
-                &format!("ours_{tag}_normal_error_over_tol_max"),
-                g.normal_ratio_max,
-                Target::at_most(1.0),
-                "1",
-            );
-            ctx.check(
-                &format!("ours_{tag}_point_error_over_tol_max"),
-                g.point_ratio_max,
-                Target::at_most(1.0),
-                "1",
-            );
-        }
+        let (ours_deg, parry_deg) = (group(&deg, |e| e.ours), group(&deg, |e| e.parry));
+        check_random_coverage(&ev.evals, ctx);
+        check_ours("random", &ours_all, ctx);
+        check_ours("degenerate", &ours_deg, ctx);
 
-        // ---- page ---------------------------------------------------------------------------------
-        ctx.text(&format!(
-            "Pairs: {} random ({} classes × {} particle sizes × {} pairs; seed {}) and {} degenerate. Reference: \
-             the exact SAT oracle. Pair tolerance tol = {:e} × size + {:e} × |reference overlap or gap| \
-             (issue 2); size = diameter of the centroid-centred bounding sphere (larger of the two). The rows \
-             above check ours; parry's figures are reported for comparison, not checked.",
-            random.len(),
-            p.classes.len(),
-            p.sizes.len(),
-            p.pairs_per_class_and_size,
-            p.seed,
-            degenerate.len(),
-            depth_abs,
-            depth_rel
-        ));
-        ctx.section("Overview: ours vs parry3d-f64 against the SAT oracle");
-        let row = |set: &str, m: &str, g: &Group| {
-            vec![
-                set.to_string(),
-                m.to_string(),
-                g.n.to_string(),
-                g.wrong.to_string(),
-                g.over_tol.to_string(),
-                e2(g.gap_max),
-                e2(g.gap_p99),
-                e2(g.gap_median),
-                e2(g.normal_max),
-                e2(g.point_max),
-                e2(g.worst_ratio),
-            ]
-        };
-        ctx.table(
-            Some("overview"),
-            &[
-                "set",
-                "method",
-                "pairs",
-                "wrong status",
-                "pairs over tol",
-                "gap err max /size",
-                "p99",
-                "median",
-                "normal err max /size",
-                "point err max /size",
-                "worst err/tol",
-            ],
-            &[
-                row("random", "ours", &ours_all),
-                row("random", "parry", &parry_all),
-                row("degenerate", "ours", &ours_deg_g),
-                row("degenerate", "parry", &parry_deg_g),
-            ],
-        )?;
+        let groups = [&ours_all, &parry_all, &ours_deg, &parry_deg];
+        overview(&p, &ev, tol, groups, ctx)?;
+        by_class(&p, &ev.evals, ctx)?;
+        parry_failures(&ev, ctx)?;
+        degenerate_table(&ev.deg_evals, ctx)?;
+        solver_statistics(&ev.random_counters, ctx)?;
+        depth_error_plot(&p, &ev.evals, tol, ctx)?;
+        error_cdf_plot(&ev.evals, ctx)?;
 
-        ctx.section("By shape class and particle size");
-        let mut rows = Vec::new();
-        for class in &p.classes {
-            for (si, size) in p.sizes.iter().enumerate() {
-                let g: Vec<&Eval> = evals
-                    .iter()
-                    .filter(|e| &e.class == class && e.size_index == si)
-                    .collect();
-                let (o, q) = (group(&g, |e| e.ours), group(&g, |e| e.parry));
-                rows.push(vec![
-                    class.clone(),
-                    format!("{size:e}"),
-                    g.len().to_string(),
-                    format!("{} / {}", o.wrong, q.wrong),
-                    format!("{} / {}", o.over_tol, q.over_tol),
-                    format!("{} / {}", e2(o.gap_max), e2(q.gap_max)),
-                    format!("{} / {}", e2(o.gap_p99), e2(q.gap_p99)),
-                    format!("{} / {}", e2(o.gap_median), e2(q.gap_median)),
-                    format!("{} / {}", e2(o.normal_max), e2(q.normal_max)),
-                    format!("{} / {}", e2(o.point_max), e2(q.point_max)),
-                ]);
-            }
-        }
-        ctx.text("Each cell: ours / parry. Errors relative to the particle size.");
-        ctx.table(
-            Some("by_class"),
-            &[
-                "class",
-                "size (m)",
-                "pairs",
-                "wrong status",
-                "over tol",
-                "gap err max",
-                "gap err p99",
-                "gap err median",
-                "normal err max",
-                "point err max",
-            ],
-            &rows,
-        )?;
-
-        ctx.section("Where parry fails");
-        let mut worst: Vec<&Eval> = evals
-            .iter()
-            .chain(deg_evals.iter())
-            .filter(|e| e.parry.worst_ratio(e.tol) > 1.0)
-            .collect();
-        worst.sort_by(|a, b| {
-            b.parry
-                .worst_ratio(b.tol)
-                .total_cmp(&a.parry.worst_ratio(a.tol))
-                .then(a.id.cmp(&b.id))
-        });
-        let n_fail = worst.len();
-        worst.truncate(25);
-        ctx.text(&format!(
-            "{n_fail} of {} pairs have a parry answer outside the pair tolerance (wrong status, failed, or an \
-             error above tol); the worst 25 follow, with ours on the same pair.",
-            evals.len() + deg_evals.len()
-        ));
-        let fail_rows: Vec<Vec<String>> = worst
-            .iter()
-            .map(|e| {
-                vec![
-                    e.id.clone(),
-                    kind_name(Some(e.reference.kind)).into(),
-                    e2(-e.reference.signed_gap / e.size),
-                    kind_name(e.parry_kind).into(),
-                    e2(e.parry.gap / e.size),
-                    e2(e.parry.normal / e.size),
-                    kind_name(Some(e.ours_kind)).into(),
-                    e2(e.ours.gap / e.size),
-                    e2(e.ours.normal / e.size),
-                ]
-            })
-            .collect();
-        ctx.table(
-            Some("parry_failures"),
-            &[
-                "pair",
-                "exact kind",
-                "exact overlap /size (< 0: gap)",
-                "parry kind",
-                "parry gap err /size",
-                "parry normal err /size",
-                "ours kind",
-                "ours gap err /size",
-                "ours normal err /size",
-            ],
-            &fail_rows,
-        )?;
-
-        ctx.section("Degenerate set, pair by pair");
-        let deg_rows: Vec<Vec<String>> = deg_evals
-            .iter()
-            .map(|e| {
-                vec![
-                    e.id.clone(),
-                    kind_name(Some(e.reference.kind)).into(),
-                    e2(-e.reference.signed_gap / e.size),
-                    kind_name(Some(e.ours_kind)).into(),
-                    e2(e.ours.gap / e.size),
-                    e2(e.ours.worst_ratio(e.tol)),
-                    kind_name(e.parry_kind).into(),
-                    e2(e.parry.gap / e.size),
-                    e2(e.parry.worst_ratio(e.tol)),
-                ]
-            })
-            .collect();
-        ctx.table(
-            Some("degenerate"),
-            &[
-                "pair",
-                "exact kind",
-                "exact overlap /size (< 0: gap)",
-                "ours kind",
-                "ours gap err /size",
-                "ours worst err/tol",
-                "parry kind",
-                "parry gap err /size",
-                "parry worst err/tol",
-            ],
-            &deg_rows,
-        )?;
-
-        ctx.section("Solver statistics (ours, random set)");
-        let c = &random_counters;
-        let per = |n: u64, d: u64| if d == 0 { 0.0 } else { n as f64 / d as f64 };
-        ctx.table(
-            Some("counters"),
-            &[
-                "queries",
-                "GJK runs",
-                "GJK iterations/run",
-                "EPA runs",
-                "EPA iterations/run",
-                "SAT fallbacks (max iterations)",
-                "SAT fallbacks (degenerate)",
-            ],
-            &[vec![
-                c.polyhedron_polyhedron.to_string(),
-                c.gjk_runs.to_string(),
-                format!("{:.2}", per(c.gjk_iterations, c.gjk_runs)),
-                c.epa_runs.to_string(),
-                format!("{:.2}", per(c.epa_iterations, c.epa_runs)),
-                c.fallback_max_iterations.to_string(),
-                c.fallback_degenerate.to_string(),
-            ]],
-        )?;
-
-        // ---- plots --------------------------------------------------------------------------------
-        ctx.section("Depth error against overlap");
-        let over: Vec<&Eval> = evals
-            .iter()
-            .filter(|e| e.reference.kind == ContactKind::Overlap)
-            .collect();
-        let scatter = |label: &str, pick: &dyn Fn(&Eval) -> f64| Series {
-            label: label.into(),
-            style: SeriesStyle::Points,
-            points: over
-                .iter()
-                .map(|e| {
-                    (
-                        -e.reference.signed_gap / e.size,
-                        (pick(e) / e.size).max(PLOT_FLOOR),
-                    )
-                })
-                .collect(),
-        };
-        let tol_line = Series {
-            label: format!("tolerance {depth_abs:e} + {depth_rel:e}·overlap"),
-            style: SeriesStyle::Line,
-            points: [p.overlap_min_rel, 1e-6, 1e-3, p.overlap_max_rel]
-                .iter()
-                .map(|x| (*x, depth_abs + depth_rel * x))
-                .collect(),
-        };
-        ctx.plot(&Plot {
-            name: "depth_error_vs_overlap".into(),
-            title: "Depth error against exact overlap (random overlapping pairs)".into(),
-            x_label: "exact overlap / particle size".into(),
-            y_label: "|depth error| / particle size".into(),
-            x_log: true,
-            y_log: true,
-            series: vec![scatter("ours (GJK/EPA)", &|e| e.ours.gap), scatter("parry3d-f64", &|e| e.parry.gap), tol_line],
-            caption: format!("All sizes pooled. Errors below {PLOT_FLOOR:e} × size (including exact zeros) are drawn at {PLOT_FLOOR:e}."),
-        })?;
-
-        ctx.section("Error distribution");
-        let cdf = |label: &str, pick: &dyn Fn(&Eval) -> f64| {
-            let s = sorted(
-                evals
-                    .iter()
-                    .map(|e| (pick(e) / e.size).max(PLOT_FLOOR))
-                    .collect(),
-            );
-            let n = s.len();
-            let step = n.div_ceil(CDF_POINTS).max(1);
-            let points = s
-                .iter()
-                .enumerate()
-                .filter(|(i, _)| i % step == 0 || *i + 1 == n)
-                .map(|(i, v)| (*v, (i + 1) as f64 / n as f64))
-                .collect();
-            Series {
-                label: label.into(),
-                style: SeriesStyle::Line,
-                points,
-            }
-        };
-        ctx.plot(&Plot {
-            name: "error_cdf".into(),
-            title: "Cumulative distribution of the gap/depth error (all random pairs)".into(),
-            x_label: "|signed gap error| / particle size".into(),
-            y_label: "fraction of pairs with error ≤ x".into(),
-            x_log: true,
-            y_log: false,
-            series: vec![cdf("ours (GJK/EPA)", &|e| e.ours.gap), cdf("parry3d-f64", &|e| e.parry.gap)],
-            caption: format!(
-                "Errors below {PLOT_FLOOR:e} × size are drawn at {PLOT_FLOOR:e}. Lines drawn through at most \
-                 {CDF_POINTS} ranks per method (the CSV has the same points)."
-            ),
-        })?;
-
-        // ---- timing and work-precision ------------------------------------------------------------
         // Timings produce no checked rows; an in-memory run (the `cargo test` gate) skips them.
         if !ctx.writes_files() {
             return Ok(());
         }
-        let timing_size = p.sizes.iter().position(|s| *s == 1.0).unwrap_or(0);
-        let pick = |class: &str, kind: ContactKind| -> Result<Vec<Built>, SuiteError> {
-            random
-                .iter()
-                .zip(&evals)
-                .filter(|(pair, e)| {
-                    pair.class == class && e.size_index == timing_size && e.reference.kind == kind
-                })
-                .take(p.timing_pairs_per_class)
-                .map(|(pair, _)| build(pair).map_err(case_err))
-                .collect()
-        };
-        ctx.progress()
-            .stage("timing", (p.classes.len() + p.epa_gaps.len()) as u64);
-        let mut timing_rows = Vec::new();
-        let mut pooled_overlap: Vec<Built> = Vec::new();
-        for class in &p.classes {
-            let ov = pick(class, ContactKind::Overlap)?;
-            let sep = pick(class, ContactKind::Separated)?;
-            let ours_ns =
-                timing::ours_query_ns(&ov, ContactTolerances::default(), p.timing_repeats);
-            let parry_ns = timing::parry_query_ns(&ov, p.timing_repeats);
-            let ours_sep = timing::ours_intersects_ns(&sep, p.timing_repeats);
-            let parry_sep = timing::parry_intersects_ns(&sep, p.timing_repeats);
-            timing_rows.push(vec![
-                class.clone(),
-                ov.len().to_string(),
-                format!("{ours_ns:.0}"),
-                format!("{parry_ns:.0}"),
-                format!("{:.2}", ours_ns / parry_ns),
-                sep.len().to_string(),
-                format!("{ours_sep:.0}"),
-                format!("{parry_sep:.0}"),
-                format!("{:.2}", ours_sep / parry_sep),
-            ]);
-            pooled_overlap.extend(ov);
-            ctx.progress().inc(1);
-        }
-        ctx.section("Speed (same pairs, same run)");
-        ctx.text(
-            "ns per query, minimum over repeated passes, size-1 pairs of the random set. Overlapping: our full \
-             query (cold cache) vs parry's `query::contact`. Separated: our boolean intersection test vs parry's \
-             `intersection_test`. Ratio = ours / parry (issue 2 target: ≤ 1/3 on voronoi and hull16–32 and for \
-             separated rejection). Wall-clock figures vary between runs; the criterion bench `benches/contact.rs` \
-             gives the careful measurement.",
-        );
-        ctx.table(
-            Some("timing"),
-            &[
-                "class",
-                "overlapping pairs",
-                "ours ns",
-                "parry ns",
-                "ratio",
-                "separated pairs",
-                "ours ns",
-                "parry ns",
-                "ratio",
-            ],
-            &timing_rows,
-        )?;
-
-        // Work-precision: error over the pooled overlapping timing pairs, against ns per query.
-        let exact: Vec<f64> = pooled_overlap
-            .iter()
-            .map(|b| sat(&b.pos1, &b.a, &b.pos2, &b.b).depth)
-            .collect();
-        let sizes: Vec<f64> = pooled_overlap
-            .iter()
-            .map(|b| b.a.length_scale().max(b.b.length_scale()))
-            .collect();
-        let max_err = |depths: &[f64]| {
-            depths
-                .iter()
-                .zip(&exact)
-                .zip(&sizes)
-                .map(|((d, x), s)| ((d - x).abs() / s).max(PLOT_FLOOR))
-                .fold(PLOT_FLOOR, f64::max)
-        };
-        let mut ours_pts = Vec::new();
-        let mut wp_rows = Vec::new();
-        for gap in &p.epa_gaps {
-            let tol = ContactTolerances {
-                epa_gap: *gap,
-                ..ContactTolerances::default()
-            };
-            let mut o = Ours::new(tol);
-            let depths: Vec<f64> = pooled_overlap
-                .iter()
-                .map(|b| o.query(&b.pos1, &b.a, &b.pos2, &b.b).depth)
-                .collect();
-            let ns = timing::ours_query_ns(&pooled_overlap, tol, p.timing_repeats);
-            let err = max_err(&depths);
-            ours_pts.push((ns, err));
-            wp_rows.push(vec![
-                format!("ours, epa_gap = {gap:e}"),
-                format!("{ns:.0}"),
-                e2(err),
-            ]);
-            ctx.progress().inc(1);
-        }
-        let parry_depths: Vec<f64> = pooled_overlap
-            .iter()
-            .map(|b| {
-                let peer = crate::peers::parry::ParryPair {
-                    a: &b.parry_a,
-                    b: &b.parry_b,
-                };
-                match peer.contact(&b.pos1, &b.pos2, 0.0) {
-                    Ok(Some(c)) => -c.signed_gap,
-                    _ => f64::NAN,
-                }
-            })
-            .collect();
-        let parry_ns = timing::parry_query_ns(&pooled_overlap, p.timing_repeats);
-        let parry_err = max_err(&parry_depths);
-        let sat_ns = timing::sat_query_ns(&pooled_overlap, p.sat_timing_repeats);
-        wp_rows.push(vec![
-            "parry3d-f64".into(),
-            format!("{parry_ns:.0}"),
-            e2(parry_err),
-        ]);
-        wp_rows.push(vec![
-            "SAT oracle (the reference)".into(),
-            format!("{sat_ns:.0}"),
-            e2(PLOT_FLOOR),
-        ]);
-        ctx.section("Work-precision: depth error against time per query");
-        ctx.plot(&Plot {
-            name: "work_precision".into(),
-            title: "Contact queries: max depth error vs time per query".into(),
-            x_label: "time per query (ns)".into(),
-            y_label: "max |depth error| / particle size".into(),
-            x_log: true,
-            y_log: true,
-            series: vec![
-                Series { label: "ours, EPA tolerance sweep".into(), style: SeriesStyle::LinePoints, points: ours_pts },
-                Series { label: "parry3d-f64".into(), style: SeriesStyle::LinePoints, points: vec![(parry_ns, parry_err)] },
-                Series { label: "SAT oracle (error 0 by definition)".into(), style: SeriesStyle::LinePoints, points: vec![(sat_ns, PLOT_FLOOR)] },
-            ],
-            caption: format!(
-                "{} overlapping size-1 pairs pooled over all classes; cold pair cache. The SAT oracle is the \
-                 reference, so its error is zero and drawn at the floor {PLOT_FLOOR:e}; a NaN (failed) parry \
-                 answer would count as an infinite error.",
-                pooled_overlap.len()
-            ),
-        })?;
-        ctx.table(
-            Some("work_precision_table"),
-            &["method", "ns per query", "max depth err / size"],
-            &wp_rows,
-        )?;
-        Ok(())
+        let pooled_overlap = speed(&p, &ev, ctx)?;
+        work_precision(&p, &pooled_overlap, ctx)
     }
 }
