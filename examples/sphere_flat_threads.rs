@@ -10,8 +10,8 @@
 //! stretch: each variant's steps back to back).
 //! Printed per variant and round: wall time, process CPU time (all threads), the share of the machine's
 //! CPU time the hypervisor stole during the round (a busy host), on several threads the core-to-core
-//! round trip right after the round (`polydem::host::core_round_trip_ns`: 41–160 ns or 419–499 ns on
-//! 2026-11-27, as the host placed the two virtual CPUs), particle-steps/s (wall), the load
+//! round trip right after the round (`polydem::host::core_round_trip_ns`: 41–160 ns or 419–499 ns,
+//! as the host placed the two virtual CPUs), particle-steps/s (wall), the load
 //! average, the wall time per step of each stage (the step's counters: kick and drift, lists, pair
 //! loop, walls and ledger) and whether the final state is bit-identical to the first variant's; then
 //! the median and range over the rounds of each variant's speed-up over the first.
@@ -21,8 +21,8 @@
 //!     [--splits default,fixed,0.2] [--interleave N] [--repeat N]
 //!     [--scenes spheres,a_hertz_5ms,b_hertz_200ms,c_linear_5ms] [--driver run|step]
 //! ```
-//! A split is `default` (`TeamSplit::default()`), `fixed` (`TeamSplit::fixed()`: the split before
-//! 2026-11-23) or a number: the default with that middle share of the pair loop.
+//! A split is `default` (`TeamSplit::default()`), `fixed` (`TeamSplit::fixed()`: blocks of equal
+//! weight, no middles) or a number: the default with that middle share of the pair loop.
 //! Defaults: 1000 steps after a warm-up of 1000, threads 1,2, the default split, 3 repeats, scene
 //! `spheres`, the steps run by `SphereSim::run_steps` as the suite's sphere_bed case runs them
 //! (`--driver step`: `SphereSim::step` called for each step, each step's team job a rayon broadcast).

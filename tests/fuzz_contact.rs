@@ -5,7 +5,7 @@
 //! contain its input points; every pair query must agree with the exact SAT oracle on the kind of contact
 //! and on the Minkowski overlap, and its normal must be an optimal axis. proptest shrinks any failure to a
 //! small reproducible input. 256 cases per property by default; `PROPTEST_CASES=20000` runs a deeper fuzz (the
-//! deeper run passed on 2026-11-21 in 16 s).
+//! deeper run passed in 16 s).
 
 use nalgebra::{Translation3, UnitQuaternion};
 use polydem::contact::{query_polyhedra, sat_polyhedra, ContactKind};

@@ -10,7 +10,7 @@
 //! and, for `Invalid`, a field. Random valid scenes must build. 256 cases per property by default, from a
 //! fixed seed; `PROPTEST_CASES=5000 PROPTEST_RNG_SEED=<n>` runs a deeper or different fuzz.
 //!
-//! Two bugs this fuzz found (2026-11-21) are fixed and now asserted like every other property: a density
+//! Two bugs this fuzz found are fixed and now asserted like every other property: a density
 //! near the smallest f64 made the derived step 0 s, and a finite but huge `angular_velocity` gave a
 //! non-finite angular momentum; both scenes are now refused with an error naming the line.
 

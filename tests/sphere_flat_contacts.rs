@@ -143,7 +143,7 @@ fn oblique_sliding_impact_transfers_mu_times_the_normal_impulse() {
     let expected = -mu * normal_impulse / mass;
     // The closed form takes the normal fixed; it turns by up to θ = v_t t_c / 2R during the contact, which
     // tilts the normal force (μ⁻¹ times the friction) by up to θ into the tangent: 2θ/μ. Measured besides
-    // (2026-11-22): a residual of 1.7e-3 that changes neither with Δt (t_c/500 … t_c/8000) nor with θ
+    // it: a residual of 1.7e-3 that changes neither with Δt (t_c/500 … t_c/8000) nor with θ
     // (v_n 0.02 … 0.0002 m/s), not explained (a guess: the incremental spring sticks for a few steps at
     // the end of the contact, where the Mindlin k_t ∝ √δ vanishes); the tolerance takes 2.5e-3 for it.
     let t_c = model.normal.elastic_contact_time(0.5 * mass, vn);

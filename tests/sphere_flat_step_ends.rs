@@ -3,7 +3,7 @@
 //! bits (not only the final state after a write-back, which `tests/sphere_flat_paths.rs` compares), and a
 //! non-finite state is reported by the same step, for the same body and quantity, as the general step
 //! reports it. Written for a variant that left each step's second half kick to the next step's first
-//! pass (tried 2026-11-22 and dropped: no measured gain); it guards any such change of the step's passes.
+//! pass (tried and dropped: no measured gain); it guards any such change of the step's passes.
 
 use std::path::Path;
 

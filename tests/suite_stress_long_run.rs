@@ -8,8 +8,8 @@
 
 use polydem_validation::gate::assert_quick_case;
 
-/// Rows that failed on the engine of 2026-11-21 (see reports/stress_long_run.md), and why. Both pass in the
-/// report of 2026-11-22 (7.8e-4 against 1e-3, 0.29 against 1), on one trajectory of a mechanism that does not
+/// Rows that failed on an earlier engine (see reports/stress_long_run.md), and why. Both pass in the
+/// current report (7.8e-4 against 1e-3, 0.29 against 1), on one trajectory of a mechanism that does not
 /// shrink with Δt, so they stay unasserted: a change of arithmetic can move them back over the bound.
 const KNOWN_FAILURES: &[(&str, &str)] = &[
     (

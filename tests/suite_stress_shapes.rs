@@ -9,7 +9,7 @@
 
 use polydem_validation::gate::assert_quick_case;
 
-/// Rows not asserted, and why: none since 2026-11-22. Both former entries pass: `mass_ratio_energy_error_max`
+/// Rows not asserted, and why: none. Both former entries pass: `mass_ratio_energy_error_max`
 /// (6.1e-3 against 1e-2 since the wall and pair bands follow the rule of `polydem::contact::wall_depth`) and
 /// `overlap_0.25_energy_error_max` (6.2e-5 against 1e-3 since the release runs' pair smoothing band does too;
 /// with the default band it read 1.56e-3, a one-step blip proportional to Δt: the report's band sweep).

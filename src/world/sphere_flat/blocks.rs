@@ -21,13 +21,13 @@ use super::NeighbourList;
 /// until they meet ([`super::team::TwoEnded`]). So a thread that its core runs slower for a while (a
 /// shared host) does less of the middle instead of holding the other at the barrier: on bed c, with
 /// blocks only, the two threads' pair loops differed by 2–18 µs per step of ~70 µs, which thread was
-/// slower changing from run to run (per-thread timers, 2026-11-23). Every sphere of a middle is
+/// slower changing from run to run (per-thread timers). Every sphere of a middle is
 /// gathered, since either thread may run its row: that costs its kick about two kicks' time more
 /// (below), the price of the middle's size ([`TeamSplit::middle_share`]).
 ///
 /// **Weights.** Blocks and middles are cut at equal sums of a per-sphere weight: its row's pairs and
-/// its walls, a pair in contact counting [`CONTACT_WEIGHT`], plus one for the sphere itself (before
-/// 2026-11-22 (night), equal numbers of pairs).
+/// its walls, a pair in contact counting [`CONTACT_WEIGHT`], plus one for the sphere itself (equal numbers of
+/// pairs balance worse).
 ///
 /// One block per thread, no more: on the settled bed of the sphere-bed scenes, whose spheres are
 /// numbered by height, about 5 % of the spheres are gathered with 2 blocks, 15 % with 4, 35 % with 8
@@ -104,7 +104,7 @@ impl Blocks {
             };
         }
         // In contact: the pair's flag, which a build sets when the pair holds a spring and an
-        // evaluation when it overlaps (blocks made for a new pool between builds). Until 2026-11-23 the
+        // evaluation when it overlaps (blocks made for a new pool between builds). Formerly the
         // springs themselves were read: ~40 µs of ~55 µs per build of bed c.
         let cost = |in_contact: &[bool]| -> usize {
             in_contact
@@ -137,7 +137,7 @@ impl Blocks {
             gathered[range.clone()].fill(true);
         }
         // The kick: a gathered sphere also sums its pairs, which took about two kicks' time (per-thread
-        // timestamps on bed c, 2026-11-22 (late): with the pair blocks' split the thread of the second
+        // timestamps on bed c: with the pair blocks' split the thread of the second
         // block, ~1700 spheres of which ~160 gathered, kicked in ~21 µs against ~13 µs for ~1300).
         // The last thread also forms the walls' sums in the kick phase (`super::fused`): counted as
         // one more item of a third of a kick per body–wall pair (the sums took 1.2–2.6 µs per step and
@@ -228,7 +228,7 @@ fn blocks_and_middles(
 ///
 /// Why: on the shared 2-core host one core ran 20–40 % slower than the other for seconds at a time, in
 /// every pass alike, and which one changed from run to run (per-thread timers of the fused step on beds
-/// a and c, 2026-11-23: pair loops of 123 against 96 µs, kicks of 21.6 against 16.5, drifts of 13.0
+/// a and c: pair loops of 123 against 96 µs, kicks of 21.6 against 16.5, drifts of 13.0
 /// against 11.8): blocks of equal weight then leave the faster thread waiting at each barrier. The
 /// blocks are made anew at each build of the lists (every ~40–80 steps on the sphere beds), soon enough
 /// to follow such a change. The bits do not depend on the split.
@@ -319,7 +319,7 @@ pub struct TeamSplit {
 impl Default for TeamSplit {
     /// Middles of 0.1 in the pair loop, 0.3 in the drift and the kick, shares that follow the speeds.
     /// Measured against [`TeamSplit::fixed`] on two threads, the variants taking turns every 300 steps
-    /// in one process (`examples/sphere_flat_threads --splits`, 2026-11-23), on beds a / b / c:
+    /// in one process (`examples/sphere_flat_threads --splits`), on beds a / b / c:
     /// - 1.070 / 1.050 / 1.059 times as fast (medians of 8 rounds of 3000 steps, rounds 0.98–1.16);
     ///   middles of 0.05 in the pair loop: 1.058 / 1.031 / 1.051; of 0.15: 1.065 / 1.029 / 1.057;
     /// - a second run, with one-thread turns between them: 0.99 / 1.05 / 1.00 (the two-thread speed-ups
@@ -339,7 +339,7 @@ impl Default for TeamSplit {
 }
 
 impl TeamSplit {
-    /// The split before 2026-11-23: fixed blocks of equal weight, no middles.
+    /// The fixed split: blocks of equal weight, no middles.
     pub fn fixed() -> Self {
         Self {
             middle_share: 0.0,
@@ -365,7 +365,7 @@ impl TeamSplit {
 /// several times the distance test, and the contacts crowd where the projectile strikes and at the
 /// floor, so blocks of equal pair counts are not blocks of equal work. 8 is the best of 1, 4, 6, 8, 12
 /// and 16 measured on the sphere beds a–c on two threads (`examples/sphere_flat_threads`, medians of 4–5
-/// runs, 2026-11-22: 1.43 / 1.67 / 1.43× over one thread with 1, 1.79 / 1.79 / 1.63× with 8); the
+/// runs: 1.43 / 1.67 / 1.43× over one thread with 1, 1.79 / 1.79 / 1.63× with 8); the
 /// 10^4-sphere settling scene came out slightly slower (medians 1.39–1.51× against 1.51–1.57×, not
 /// understood). A frictionless law keeps no spring, so its pairs all weigh 1, as before.
 const CONTACT_WEIGHT: usize = 8;

@@ -3,7 +3,7 @@
 //! started and joined as a new rayon job every step.
 //!
 //! Why: starting a `rayon::broadcast` and joining it took 0.3–7.7 µs and 0.9–8.4 µs per step on the
-//! 2-core VM (per-thread timestamps of the fused job on sphere beds a, b and c, 2026-11-23, steps of
+//! 2-core VM (per-thread timestamps of the fused job on sphere beds a, b and c, steps of
 //! 80–240 µs on two threads), about as much as the two threads' imbalance; held in a crew, 0.1–0.6 µs
 //! and 0.8–5.4 µs (the upper ends in rounds where the host was busy). The thread that
 //! waits for the others' part of a broadcast soon sleeps in rayon's idle loop, and waking it is a

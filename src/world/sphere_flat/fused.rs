@@ -3,7 +3,7 @@
 //!
 //! Why: each job of the team (`rayon::broadcast`) cost ~4–10 µs to start and join on the 2-core VM, on
 //! top of the work of its parts (a pass's wall time less its slowest part's, per-part timestamps on the
-//! sphere beds, 2026-11-23): about 20 µs of a two-thread step of ~200 µs. A barrier between two phases of
+//! sphere beds): about 20 µs of a two-thread step of ~200 µs. A barrier between two phases of
 //! one job costs the wait for the slower thread only. In a run of steps ([`SphereSim::run_steps`]) the
 //! job is a task of the run's [`Crew`], whose threads are already running, instead of a broadcast.
 //!
@@ -443,8 +443,8 @@ impl Job<'_> {
         pass.run(bodies.start, part)
     }
 
-    /// Stage 9's wall sums (which the lead took serially after the job until 2026-11-23: 1.2–2.6 µs of
-    /// a two-thread step of 80–130 µs on the sphere beds).
+    /// Stage 9's wall sums, taken inside the job: serially by the lead after it they cost 1.2–2.6 µs of a
+    /// two-thread step of 80–130 µs on the sphere beds.
     ///
     /// # Safety
     /// Called in the kick phase, which only reads the wall outputs and flags.

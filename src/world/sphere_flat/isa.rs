@@ -4,7 +4,7 @@
 //!
 //! Why: with three-operand AVX instructions the pair loop needs fewer register copies and shuffles, and
 //! the same passes ran 7–10 % faster (the whole crate built with `-C target-cpu=x86-64-v3`,
-//! `examples/sphere_bed_speed`, one thread, 6 paired rounds, 2026-11-23: CPU-time ratios bed a 0.907,
+//! `examples/sphere_bed_speed`, one thread, 6 paired rounds: CPU-time ratios bed a 0.907,
 //! b 0.911, c 0.931). Building the whole crate for x86-64-v3 would make a binary that stops on an older
 //! CPU; choosing at run time keeps one binary for both.
 //!

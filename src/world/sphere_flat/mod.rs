@@ -39,7 +39,7 @@
 //! asleep; the per-contact energy ledger off (`energy_ledger = false`: the path books no contact
 //! damping or friction work, as the general step does not then either).
 //!
-//! # Cost (callgrind instructions, one thread, 2026-11-22)
+//! # Cost (callgrind instructions, one thread)
 //! The first 1000 steps of sphere beds a / b / c (`examples/sphere_bed_speed.rs`, run under
 //! `valgrind --tool=callgrind --toggle-collect='*run_flat*'`), per particle-step: 1481 / 1774 / 1206,
 //! from 1750 / 2216 / 1438 (−15 / −20 / −16 %) with the scenes' LIGGGHTS projection of the spring
@@ -56,7 +56,7 @@
 //! checksums): a separated pair no longer stores its cleared spring and flag again ([`pair`]), and the kicks
 //! leave out the viscous-damping terms this path never has ([`step`]): bed a 1.31–1.51 s (five of six runs
 //! ≤ 1.37 s) against 1.49–1.54 s, b 2.19–2.35 against 2.34–2.49, c 1.08–1.17 against 1.31–1.42 (release
-//! build, six and three runs, 2026-11-22; `perf record` of bed a then
+//! build, six and three runs; `perf record` of bed a then
 //! puts ~73 % of the samples in the pair loop and ~17 % in the kicks and drift).
 //!
 //! # Validity of the owned state

@@ -36,8 +36,8 @@
 //! law) are functions of its two bodies, so they are carried by it too instead of formed again — the
 //! same bits. A build fills the vectors of the build before the last (`spare`) instead of fresh ones.
 //! Both together took a build of the 3000-sphere bed c from ~0.8–1.3 ms to ~0.55–0.65 ms beside the
-//! search (one thread, per-phase timers, 2026-11-22 (late); the search itself, ~1 ms, is unchanged) and
-//! its minor page faults over 5000 steps from 11 788 to 4 868. Since 2026-11-23 each chunk of the
+//! search (one thread, per-phase timers; the search itself, ~1 ms, is unchanged) and
+//! its minor page faults over 5000 steps from 11 788 to 4 868. Now each chunk of the
 //! search also merges its bodies' rows and copies their springs and constants (in parallel on several
 //! threads), and the build only joins the chunks' vectors; the walls' springs likewise.
 
@@ -548,7 +548,7 @@ impl NeighbourList {
         };
         // Per chunk of bodies, independently: their rows, walls, and each pair's spring and constants
         // carried over (the constants are functions of the two bodies: the same bits as forming them
-        // again), or imported, or new. Until 2026-11-23 everything after the search ran serially,
+        // again), or imported, or new. Formerly everything after the search ran serially,
         // ~0.45 ms of a build of ~1.4 ms on two threads (bed c).
         let search = |(range, rows): (std::ops::Range<usize>, &mut ChunkRows)| {
             rows.clear();

@@ -200,8 +200,8 @@ impl PairContext<'_> {
     /// [`PairContext::body_pair`], asked ahead of it (false for NaN positions, as there).
     ///
     /// Why ahead: whether a listed pair overlaps follows no pattern along the list, so the branch on it
-    /// was mispredicted for about 4 pairs in 10 (`valgrind --tool=cachegrind --branch-sim=yes`, bed c,
-    /// 2026-11-23: 5.1 of 11.3 million). The pair loop asks this of a chunk of pairs and notes the
+    /// was mispredicted for about 4 pairs in 10 (`valgrind --tool=cachegrind --branch-sim=yes`, bed c:
+    /// 5.1 of 11.3 million). The pair loop asks this of a chunk of pairs and notes the
     /// others without a branch ([`super::passes::PairChunks`]), then runs `body_pair` on those (and on
     /// those apart that were in contact: their springs are released there).
     #[inline(always)]

@@ -473,7 +473,7 @@ impl PairBlocks<'_> {
 /// test.
 ///
 /// Why bits and not a list of indices: a list written at a position that depends on the last answer
-/// made each pair's loads wait for the previous pair's test (bed c, 2026-11-23: ~23 cycles per pair,
+/// made each pair's loads wait for the previous pair's test (bed c: ~23 cycles per pair,
 /// 45 % of the pair loop's samples).
 pub(super) struct PairChunks {
     pairs: usize,

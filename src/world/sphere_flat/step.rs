@@ -58,7 +58,7 @@ impl SphereSim {
         debug_assert_eq!(self.params.damping, crate::dynamics::ViscousDamping::None);
 
         // The walls move first: their moves do not depend on the spheres (the drift is the same either
-        // way; until 2026-11-23 they moved after it).
+        // way; formerly they moved after it).
         let t = Instant::now();
         for (wall, plane) in self.walls.iter_mut().zip(&mut self.planes) {
             wall.pose.translation.vector += dt * wall.velocity;
@@ -319,7 +319,7 @@ impl SphereSim {
                 torque: &mut self.torque,
             });
             self.outs_valid = true;
-            // Before 2026-11-22 (evening) this returned without joining the wall warnings to the list:
+            // Formerly this returned without joining the wall warnings to the list:
             // a step on one block reported no overlap warning against a wall.
             return found.finish();
         }

@@ -13,7 +13,7 @@
 //!
 //! A thread that ends its part first spins until the others end theirs ([`spin_until_all`]) instead of
 //! returning to rayon, whose idle loop soon puts it to sleep: starting and joining the other thread cost
-//! ~3–8 µs per pass on the 2-core VM (per-thread timestamps, 2026-11-22 (late)). Since 2026-11-23 a step
+//! ~3–8 µs per pass on the 2-core VM (per-thread timestamps). Now a step
 //! whose lists hold runs its three passes as one job, with a [`Barrier`] between them and the arrays
 //! shared as [`PhaseSlice`]s (`super::fused`); [`for_each_part`] runs the passes of the other steps.
 //!
