@@ -72,7 +72,7 @@
 //! v_(n+1)·a_(n+1)), which telescopes (measured: fitted order 1.93, same test).
 
 use crate::law::tangential::{release_spring, rotate_into_tangent_plane};
-use crate::law::{ContactModel, ContactResponse, TangentialHistory};
+use crate::law::{ContactResponse, TangentialHistory, TangentialLaw};
 use crate::math::Real;
 use crate::math::Vector;
 
@@ -236,14 +236,14 @@ impl ContactWork {
     /// The terms of a contact that opened in this step (its last evaluation overlapped): the forces of
     /// that evaluation acted for the first half kick, with `relative_velocity` at the last contact point
     /// and the last lever arms; the spring is released ([`release_spring`], the law's k_t at zero
-    /// overlap).
+    /// overlap; `tangential` is the tangential slot of the pair's model).
     pub fn of_release(
-        model: &ContactModel,
+        tangential: &TangentialLaw,
         previous: &LastForces,
         relative_velocity: &Vector,
         dt: Real,
     ) -> Self {
-        let (end_stiffness, _) = model.tangential.stiffness_and_friction(0.0);
+        let (end_stiffness, _) = tangential.stiffness_and_friction(0.0);
         let mut history = previous.history;
         let (friction, stiffness) =
             release_spring(end_stiffness, relative_velocity, dt, &mut history);

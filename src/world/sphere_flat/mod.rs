@@ -69,6 +69,7 @@ mod blocks;
 mod crew;
 mod fused;
 mod isa;
+mod ledger;
 mod neighbours;
 mod pair;
 mod passes;
@@ -86,7 +87,7 @@ use rayon::prelude::*;
 
 use super::broad_phase::BroadPhase;
 use super::contact_store::{ContactKey, ContactState, ContactStore};
-use super::energy::EnergyLedger;
+use super::energy::{ContactWork, EnergyLedger};
 use super::skips;
 use super::step::{effective_model, StepError, StepParams};
 use super::world::{Wall, World};
@@ -163,6 +164,10 @@ pub struct SphereSim {
     start_potential: Real,
     external_power: Real,
     ledger: EnergyLedger,
+    /// Per listed pair, what the energy ledger books (empty when it is off; [`ledger`]).
+    pair_ledger: ledger::PairLedger,
+    /// The contact terms of the ledger booked by the last step (zero when it is off).
+    step_work: ContactWork,
     time: Real,
     step_index: u64,
 }
@@ -200,7 +205,6 @@ impl SphereSim {
             !params.sleeping.enabled && world.sleep.sleeping == 0,
             "sleeping off",
         )?;
-        need(!params.energy_ledger, "energy_ledger = false")?;
         let n = world.bodies.len();
         let mut kin = Vec::with_capacity(n);
         let mut spin = Vec::with_capacity(n);
@@ -290,6 +294,8 @@ impl SphereSim {
             start_potential: world.loads.elastic_potential,
             external_power: world.loads.external_power,
             ledger: world.ledger,
+            pair_ledger: ledger::PairLedger::default(),
+            step_work: ContactWork::default(),
             time: world.time,
             step_index: world.step_index,
         };
@@ -313,6 +319,10 @@ impl SphereSim {
             world.step_index,
             &import,
         );
+        if params.energy_ledger {
+            // The last forces of the store's pairs, as their springs.
+            sim.pair_ledger.carry(&mut sim.list, None, Some(store));
+        }
         sim.prepare_pairs(parallel);
         if world.loads.current && world.loads.forces.len() == n {
             sim.force.clone_from(&world.loads.forces);
@@ -324,6 +334,8 @@ impl SphereSim {
             // Stage 0: the loads of the initial state, no tangential increment.
             let found = sim.evaluate(0.0)?;
             sim.gather_only(found.scattered);
+            // The general step books no term of the initial evaluation either.
+            sim.pair_ledger.take_sums();
             if sim.ledger.initial_total.is_none() {
                 let mut at_start = world.clone();
                 at_start.loads.forces.clone_from(&sim.force);
@@ -584,9 +596,9 @@ impl SphereSim {
         loads.torques.clone_from(&self.torque);
         loads.wall_forces.clone_from(&self.wall_forces);
         loads.elastic_potential = self.elastic_potential();
-        loads.damping_work = 0.0;
-        loads.friction_dissipation = 0.0;
-        loads.tangential_stiffness_work = 0.0;
+        loads.damping_work = self.step_work.damping;
+        loads.friction_dissipation = self.step_work.friction;
+        loads.tangential_stiffness_work = self.step_work.stiffness;
         loads.external_power = self.external_power;
         loads.current = true;
     }
