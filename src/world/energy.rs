@@ -178,7 +178,7 @@ pub(crate) struct ContactWork {
 impl ContactWork {
     /// The terms of an overlapping contact whose last evaluation applied no force to book (a new
     /// contact): `relative_velocity` is v_B − v_A at the contact point with the half-step velocities.
-    #[inline]
+    #[inline(always)]
     pub fn of_new_contact(
         response: &ContactResponse,
         relative_velocity: &Vector,
@@ -200,7 +200,7 @@ impl ContactWork {
     /// increment of the spring with this step's v (at the new contact point, in the new tangent plane),
     /// corrected by the difference between the work the last spring force did with the integrator's
     /// lever arms, ½ Δt f_s^n·v_prev, and the work the law's increment assumed, −½ k_t^n u_prev·v_t Δt.
-    #[inline]
+    #[inline(always)]
     pub fn of_evaluation(
         previous: &LastForces,
         previous_velocity: &Vector,

@@ -423,6 +423,7 @@ impl Job<'_> {
         let (part, kin) = unsafe {
             let ledger = if self.ledger {
                 LedgerPart {
+                    in_order: false,
                     last: self.last.part(pairs.clone()),
                     work: self.work.part(pairs.clone()),
                     wall_last: self.wall_last.part(walls.clone()),

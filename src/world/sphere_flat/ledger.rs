@@ -4,12 +4,14 @@
 //! force, the friction (slip) work and the tangential stiffness work ([`ContactWork`], see
 //! [`crate::world::energy`]), and sums them serially in candidate order. The flat path does the same with
 //! the same functions: per listed pair it keeps the last evaluation's damping force and contact point
-//! ([`LastContact`]; the spring is the list's), the pair loop writes each evaluated pair's terms into the
-//! pair's own slot ([`super::pair`]), and stage 9 sums the slots serially in pair order — body pairs by
-//! (a, b), then body–wall pairs by (body, wall): the general step's candidate order — resetting each
-//! slot for the next step ([`PairLedger::take_sums`]). A pair the pair loop skips (apart, and apart at
-//! the last evaluation) books nothing on either path, and a zero slot added to a sum that starts at +0
-//! leaves it unchanged, so the sums are the same bits as the general step's, for any number of threads.
+//! ([`LastContact`]; the spring is the list's), and the terms are summed in pair order — body pairs by
+//! (a, b), then body–wall pairs by (body, wall): the general step's candidate order. A serial pair loop
+//! (one block) visits the pairs in that order and sums them as it goes; a pair loop in blocks writes
+//! each evaluated pair's terms into the pair's own slot ([`super::pair`]), and stage 9 sums the slots
+//! serially, resetting each for the next step ([`PairLedger::take_sums`]). A pair the pair loop skips
+//! (apart, and apart at the last evaluation) books nothing on either path, and a zero added to a sum
+//! that starts at +0 leaves it unchanged, so the sums are the same bits as the general step's, for any
+//! number of threads.
 //!
 //! The last forces follow a pair across a rebuild of the lists ([`PairLedger::carry`]) and are imported
 //! from the world's contact store on the first build, as the springs are. A pair with a damping force
@@ -39,6 +41,9 @@ pub(crate) struct PairLedger {
     pub(crate) work: Vec<ContactWork>,
     pub(crate) wall_last: Vec<LastContact>,
     pub(crate) wall_work: Vec<ContactWork>,
+    /// The sums of the last evaluation when its pair loop took them in pair order itself (one block),
+    /// leaving the slots zero.
+    pub(crate) summed: Option<ContactWork>,
 }
 
 /// The wall rows of the lists before a build, to find a wall pair's slot of the build before (the lists
@@ -103,12 +108,12 @@ impl PairLedger {
             .wall_body
             .iter()
             .zip(&list.wall_of)
-            .map(|(&body, &wall)| {
-                match old_walls.and_then(|old| old.slot(body as usize, wall)) {
+            .map(
+                |(&body, &wall)| match old_walls.and_then(|old| old.slot(body as usize, wall)) {
                     Some(k) => old_wall_last.get(k).copied().unwrap_or_default(),
                     None => imported(ContactKey::Wall { body, wall }),
-                }
-            })
+                },
+            )
             .collect();
         self.work.clear();
         self.work.resize(self.last.len(), ContactWork::default());
@@ -127,6 +132,9 @@ impl PairLedger {
     /// The sums of the step's terms in pair order (body pairs, then body–wall pairs; each term its own
     /// sum from +0, as the general step's stage 6), every slot reset to zero for the next step.
     pub(crate) fn take_sums(&mut self) -> ContactWork {
+        if let Some(sum) = self.summed.take() {
+            return sum;
+        }
         let mut sum = ContactWork::default();
         for w in self.work.iter_mut().chain(self.wall_work.iter_mut()) {
             let w = std::mem::take(w);

@@ -318,12 +318,26 @@ impl PairContext<'_> {
         let d_squared = d_vec.norm_squared();
         if d_squared >= reach * reach {
             // d ≥ r_A + r_B: no overlap beyond the touching band.
-            separated(history, in_contact, ledger, c.law.as_ref(), velocity_back, dt);
+            separated(
+                history,
+                in_contact,
+                ledger,
+                c.law.as_ref(),
+                velocity_back,
+                dt,
+            );
             return Ok(None);
         }
         let (normal, depth) = sphere_sphere_normal(&d_vec, d_squared, reach);
         if !(depth > c.touch && depth > 0.0) {
-            separated(history, in_contact, ledger, c.law.as_ref(), velocity_back, dt);
+            separated(
+                history,
+                in_contact,
+                ledger,
+                c.law.as_ref(),
+                velocity_back,
+                dt,
+            );
             return Ok(None);
         }
         let Some(law) = &c.law else {
@@ -380,12 +394,26 @@ impl PairContext<'_> {
         let velocity_back = |x: &Point| k.velocity_back_at(x, dt) - wall.velocity;
         let height = wall.height(&k.position);
         if height >= p.radius {
-            separated(history, in_contact, ledger, c.law.as_ref(), velocity_back, dt);
+            separated(
+                history,
+                in_contact,
+                ledger,
+                c.law.as_ref(),
+                velocity_back,
+                dt,
+            );
             return Ok(None);
         }
         let depth = p.radius - height;
         if !(depth > c.touch && depth > 0.0) {
-            separated(history, in_contact, ledger, c.law.as_ref(), velocity_back, dt);
+            separated(
+                history,
+                in_contact,
+                ledger,
+                c.law.as_ref(),
+                velocity_back,
+                dt,
+            );
             return Ok(None);
         }
         let Some(law) = &c.law else {

@@ -34,6 +34,9 @@ pub(super) struct Found {
     /// The first error of a body pair, and of a wall pair.
     pub(super) error: Option<StepError>,
     pub(super) wall_error: Option<StepError>,
+    /// The ledger's terms summed in pair order by a block whose slots are `in_order`
+    /// ([`LedgerPart::in_order`]; not merged: only the one block of a serial pair loop sums them).
+    pub(super) work: ContactWork,
 }
 
 impl Found {
@@ -73,6 +76,14 @@ impl Found {
 
     pub(super) fn failed(&self) -> bool {
         self.error.is_some() || self.wall_error.is_some()
+    }
+
+    /// Adds a pair's ledger terms to the sums in pair order.
+    #[inline(always)]
+    fn add_work(&mut self, w: &ContactWork) {
+        self.work.damping += w.damping;
+        self.work.friction += w.friction;
+        self.work.stiffness += w.stiffness;
     }
 
     /// Counts an overlapping pair with overlap `depth` (m) and `ratio` (over the smaller diameter), and
@@ -317,6 +328,9 @@ pub(super) struct BlockPart<'a> {
 /// The ledger's slots of a run of pairs and of body–wall pairs ([`super::ledger::PairLedger`]).
 #[derive(Default)]
 pub(super) struct LedgerPart<'a> {
+    /// Whether the pair loop sums the terms itself as it goes (the one block of a serial pair loop: it
+    /// visits every pair in pair order), into [`Found::work`]; the work slots are then empty.
+    pub(super) in_order: bool,
     pub(super) last: &'a mut [LastContact],
     pub(super) work: &'a mut [ContactWork],
     pub(super) wall_last: &'a mut [LastContact],
@@ -340,6 +354,7 @@ impl<'a> LedgerPart<'a> {
             front
         };
         LedgerPart {
+            in_order: false,
             last: split(&mut self.last, pairs),
             work: split_work(&mut self.work, pairs),
             wall_last: split(&mut self.wall_last, walls),
@@ -452,6 +467,8 @@ impl PairBlocks<'_> {
             self.wall_start[first] as usize,
         );
         let mut found = Found::scattered();
+        // A pair's terms when the loop sums them in pair order (`ledger.in_order`).
+        let mut work = ContactWork::default();
         force.fill(Vector::zeros());
         torque.fill(Vector::zeros());
         let ctx = &self.ctx;
@@ -476,12 +493,20 @@ impl PairBlocks<'_> {
                 let slot = if LEDGER {
                     Some(LedgerSlot {
                         last: &mut ledger.last[k],
-                        work: &mut ledger.work[k],
+                        work: if ledger.in_order {
+                            &mut work
+                        } else {
+                            &mut ledger.work[k]
+                        },
                     })
                 } else {
                     None
                 };
-                match ctx.body_pair(i, j, reach[k], c, history, flag, out, slot) {
+                let evaluated = ctx.body_pair(i, j, reach[k], c, history, flag, out, slot);
+                if LEDGER && ledger.in_order {
+                    found.add_work(&std::mem::take(&mut work));
+                }
+                match evaluated {
                     Ok(None) => {}
                     Ok(Some(ratio)) => {
                         if own(i) {
@@ -517,12 +542,20 @@ impl PairBlocks<'_> {
                 let slot = if LEDGER {
                     Some(LedgerSlot {
                         last: &mut ledger.wall_last[k],
-                        work: &mut ledger.wall_work[k],
+                        work: if ledger.in_order {
+                            &mut work
+                        } else {
+                            &mut ledger.wall_work[k]
+                        },
                     })
                 } else {
                     None
                 };
-                match ctx.wall_pair(wall as usize, i, c, history, flag, out, slot) {
+                let evaluated = ctx.wall_pair(wall as usize, i, c, history, flag, out, slot);
+                if LEDGER && ledger.in_order {
+                    found.add_work(&std::mem::take(&mut work));
+                }
+                match evaluated {
                     Ok(None) => {}
                     Ok(Some(ratio)) => {
                         if own(i) {

@@ -28,9 +28,9 @@ use super::super::step::{StepError, StepReport};
 use super::blocks::Blocks;
 use super::crew::Crew;
 use super::fused::Fused;
+use super::ledger::OldWalls;
 use super::neighbours::TopTwo;
 use super::pair::{PairContext, PairOut, WallPlane};
-use super::ledger::OldWalls;
 use super::passes::{
     wall_sums, BlockPart, Drift, Found, Kick, KickPart, LedgerPart, PairBlocks, Rows,
 };
@@ -322,14 +322,15 @@ impl SphereSim {
             ledger: self.params.energy_ledger,
         };
         let pl = &mut self.pair_ledger;
-        let mut ledger = LedgerPart {
-            last: &mut pl.last,
-            work: &mut pl.work,
-            wall_last: &mut pl.wall_last,
-            wall_work: &mut pl.wall_work,
-        };
         if blocks.bodies.len() == 1 {
-            // One block of every sphere: the same pass without the test of which spheres it sums.
+            // One block of every sphere: the same pass without the test of which spheres it sums; it
+            // visits the pairs in pair order, so it sums the ledger's terms itself.
+            let ledger = LedgerPart {
+                in_order: true,
+                last: &mut pl.last,
+                wall_last: &mut pl.wall_last,
+                ..LedgerPart::default()
+            };
             let found = pass.run_all(BlockPart {
                 histories: &mut list.histories,
                 in_contact: &mut list.in_contact,
@@ -341,11 +342,19 @@ impl SphereSim {
                 torque: &mut self.torque,
                 ledger,
             });
+            pl.summed = Some(found.work);
             self.outs_valid = true;
             // Before 2026-11-22 (evening) this returned without joining the wall warnings to the list:
             // a step on one block reported no overlap warning against a wall.
             return found.finish();
         }
+        let mut ledger = LedgerPart {
+            in_order: false,
+            last: &mut pl.last,
+            work: &mut pl.work,
+            wall_last: &mut pl.wall_last,
+            wall_work: &mut pl.wall_work,
+        };
         // Split every array at the boundaries of the blocks and middles; thread k runs block k, then
         // the middle after it (the whole middle: no sharing out when the passes run one by one).
         let mut parts: Vec<Vec<(usize, BlockPart)>> =
