@@ -455,7 +455,11 @@ fn the_flat_sphere_layout_writes_the_same_series_as_the_general_step() {
     let general_scene = general_dir.join("sphere_bounce_zero_damping.toml");
     std::fs::write(
         &general_scene,
-        scene.replacen("[simulation]", "[simulation]\nviscous_damping_rate = 0.0", 1),
+        scene.replacen(
+            "[simulation]",
+            "[simulation]\nviscous_damping_rate = 0.0",
+            1,
+        ),
     )
     .unwrap();
     let general = general_dir.join("out");
