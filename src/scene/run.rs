@@ -4,10 +4,10 @@
 //! Two forms: [`Simulation::run`] hands the simulation to a closure after every step, so it keeps the
 //! world current and takes the general step; [`Simulation::run_observed`] asks a [`RunObserver`] at which
 //! steps it reads the state, and between those the pipeline chooses how to step. A world of free spheres
-//! (every body a dynamic sphere of equal principal moments, no sleeping, no global damping, the energy
-//! ledger off) then runs on the flat sphere layout ([`SphereSim`]: struct-of-arrays, half neighbour
-//! lists, the thread team), the same bits as the general step, written back into the world wherever the
-//! observer reads it.
+//! (every body a dynamic sphere of equal principal moments, no sleeping, no global damping; the energy
+//! ledger on or off) then runs on the flat sphere layout ([`SphereSim`]: struct-of-arrays, half
+//! neighbour lists, the thread team), the same bits as the general step — bodies, loads and ledger —
+//! written back into the world wherever the observer reads it.
 
 use std::ops::ControlFlow;
 use std::time::{Duration, Instant};

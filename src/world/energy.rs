@@ -72,7 +72,7 @@
 //! v_(n+1)·a_(n+1)), which telescopes (measured: fitted order 1.93, same test).
 
 use crate::law::tangential::{release_spring, rotate_into_tangent_plane};
-use crate::law::{ContactModel, ContactResponse, TangentialHistory};
+use crate::law::{ContactResponse, TangentialHistory, TangentialLaw};
 use crate::math::Real;
 use crate::math::Vector;
 
@@ -178,7 +178,7 @@ pub(crate) struct ContactWork {
 impl ContactWork {
     /// The terms of an overlapping contact whose last evaluation applied no force to book (a new
     /// contact): `relative_velocity` is v_B − v_A at the contact point with the half-step velocities.
-    #[inline]
+    #[inline(always)]
     pub fn of_new_contact(
         response: &ContactResponse,
         relative_velocity: &Vector,
@@ -200,7 +200,7 @@ impl ContactWork {
     /// increment of the spring with this step's v (at the new contact point, in the new tangent plane),
     /// corrected by the difference between the work the last spring force did with the integrator's
     /// lever arms, ½ Δt f_s^n·v_prev, and the work the law's increment assumed, −½ k_t^n u_prev·v_t Δt.
-    #[inline]
+    #[inline(always)]
     pub fn of_evaluation(
         previous: &LastForces,
         previous_velocity: &Vector,
@@ -236,14 +236,14 @@ impl ContactWork {
     /// The terms of a contact that opened in this step (its last evaluation overlapped): the forces of
     /// that evaluation acted for the first half kick, with `relative_velocity` at the last contact point
     /// and the last lever arms; the spring is released ([`release_spring`], the law's k_t at zero
-    /// overlap).
+    /// overlap; `tangential` is the tangential slot of the pair's model).
     pub fn of_release(
-        model: &ContactModel,
+        tangential: &TangentialLaw,
         previous: &LastForces,
         relative_velocity: &Vector,
         dt: Real,
     ) -> Self {
-        let (end_stiffness, _) = model.tangential.stiffness_and_friction(0.0);
+        let (end_stiffness, _) = tangential.stiffness_and_friction(0.0);
         let mut history = previous.history;
         let (friction, stiffness) =
             release_spring(end_stiffness, relative_velocity, dt, &mut history);

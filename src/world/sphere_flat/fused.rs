@@ -37,15 +37,19 @@ use crate::dynamics::rotation::SubRotation;
 use crate::law::TangentialHistory;
 use crate::math::{Point, Real, Vector};
 
+use super::super::energy::ContactWork;
 use super::super::step::StepReport;
 use super::super::world::Wall;
 use super::blocks::Blocks;
 use super::crew::Crew;
+use super::ledger::LastContact;
 use super::neighbours::{StaleTest, TopTwo};
 use super::pair::{
     Kinematic, PairConstants, PairContext, PairOut, Props, WallConstants, WallPlane,
 };
-use super::passes::{wall_sums, BlockPart, Drift, Found, Kick, KickPart, PairBlocks, Rows};
+use super::passes::{
+    wall_sums, BlockPart, Drift, Found, Kick, KickPart, LedgerPart, PairBlocks, Rows,
+};
 use super::team::{pieces_of, Barrier, PhaseSlice, TwoEnded};
 use super::{SphereSim, Spin};
 
@@ -137,6 +141,11 @@ impl SphereSim {
             wall_histories: PhaseSlice::new(&mut list.wall_histories),
             wall_in_contact: PhaseSlice::new(&mut list.wall_in_contact),
             wall_out: PhaseSlice::new(&mut self.wall_out),
+            ledger: self.params.energy_ledger,
+            last: PhaseSlice::new(&mut self.pair_ledger.last),
+            work: PhaseSlice::new(&mut self.pair_ledger.work),
+            wall_last: PhaseSlice::new(&mut self.pair_ledger.wall_last),
+            wall_work: PhaseSlice::new(&mut self.pair_ledger.wall_work),
             props: &self.props,
             planes: &self.planes,
             a: &list.a,
@@ -234,6 +243,13 @@ struct Job<'a> {
     wall_histories: PhaseSlice<'a, TangentialHistory>,
     wall_in_contact: PhaseSlice<'a, bool>,
     wall_out: PhaseSlice<'a, PairOut>,
+    /// Whether the pairs book the energy ledger, and its slots (written in the pair phase only; empty
+    /// when it is off).
+    ledger: bool,
+    last: PhaseSlice<'a, LastContact>,
+    work: PhaseSlice<'a, ContactWork>,
+    wall_last: PhaseSlice<'a, LastContact>,
+    wall_work: PhaseSlice<'a, ContactWork>,
     props: &'a [Props],
     planes: &'a [WallPlane],
     a: &'a [u32],
@@ -405,6 +421,17 @@ impl Job<'_> {
         let walls = self.wall_start[bodies.start] as usize..self.wall_start[bodies.end] as usize;
         // SAFETY: the caller's promise.
         let (part, kin) = unsafe {
+            let ledger = if self.ledger {
+                LedgerPart {
+                    in_order: false,
+                    last: self.last.part(pairs.clone()),
+                    work: self.work.part(pairs.clone()),
+                    wall_last: self.wall_last.part(walls.clone()),
+                    wall_work: self.wall_work.part(walls.clone()),
+                }
+            } else {
+                LedgerPart::default()
+            };
             (
                 BlockPart {
                     histories: self.histories.part(pairs.clone()),
@@ -415,6 +442,7 @@ impl Job<'_> {
                     wall_outs: self.wall_out.part(walls),
                     force: self.force.part(bodies.clone()),
                     torque: self.torque.part(bodies.clone()),
+                    ledger,
                 },
                 self.kin.whole(),
             )
@@ -439,6 +467,7 @@ impl Job<'_> {
             gathered: &self.blocks.gathered,
             fraction: self.fraction,
             v3: self.v3,
+            ledger: self.ledger,
         };
         pass.run(bodies.start, part)
     }

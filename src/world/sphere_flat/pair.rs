@@ -23,7 +23,9 @@ use crate::contact::{contact_plane_sphere, contact_sphere_sphere};
 use crate::law::{ContactModel, ContactResponse, PreparedModel, TangentialHistory};
 use crate::math::{Point, Real, Vector};
 
+use super::super::energy::{ContactWork, LastForces};
 use super::super::step::StepError;
+use super::ledger::LastContact;
 
 /// What the pair loop reads of one sphere (written by the drift pass).
 #[derive(Clone, Copy, Debug, Default)]
@@ -39,6 +41,83 @@ impl Kinematic {
     #[inline(always)]
     fn velocity_at(&self, point: &Point) -> Vector {
         self.velocity + self.omega.cross(&(point - self.position))
+    }
+
+    /// Velocity (m/s) at `point` with the lever arm from the centre one step `dt` earlier (x − dt·v):
+    /// the lever arm the last forces were applied with (the general step's `velocity_back_at`).
+    #[inline(always)]
+    fn velocity_back_at(&self, point: &Point, dt: Real) -> Vector {
+        self.velocity_at(&(point + dt * self.velocity))
+    }
+}
+
+/// The ledger's slots of one pair (see [`super::ledger`]): its last contact, read and rewritten, and
+/// this step's terms, written when the pair is evaluated.
+pub(crate) struct LedgerSlot<'s> {
+    pub(crate) last: &'s mut LastContact,
+    pub(crate) work: &'s mut ContactWork,
+}
+
+impl LedgerSlot<'_> {
+    /// The forces of the last evaluation, with `history` the spring it left.
+    #[inline(always)]
+    fn previous(&self, history: &TangentialHistory) -> LastForces {
+        LastForces {
+            damping_force: self.last.damping_force,
+            history: *history,
+        }
+    }
+
+    /// An overlapping pair's terms ([`ContactWork::of_new_contact`] or [`ContactWork::of_evaluation`],
+    /// as the general step's stage 5 chooses) with the forces `previous` of its last evaluation; then
+    /// this evaluation kept as the last. `velocity_back` gives v_B − v_A at a point with the last lever
+    /// arms.
+    #[allow(clippy::too_many_arguments)]
+    #[inline(always)]
+    fn book(
+        self,
+        previous: &LastForces,
+        velocity_back: impl FnOnce(&Point) -> Vector,
+        normal: &Vector,
+        point: Point,
+        response: &ContactResponse,
+        relative_velocity: &Vector,
+        dt: Real,
+    ) {
+        *self.work = if previous.is_zero() {
+            ContactWork::of_new_contact(response, relative_velocity, dt)
+        } else {
+            ContactWork::of_evaluation(
+                previous,
+                &velocity_back(&self.last.point),
+                normal,
+                response,
+                relative_velocity,
+                dt,
+            )
+        };
+        *self.last = LastContact {
+            damping_force: response.damping_force,
+            point,
+        };
+    }
+
+    /// A pair that does not overlap and overlapped at the last evaluation (`history` its spring): the
+    /// release of its last forces ([`ContactWork::of_release`]), and no last contact any more.
+    #[inline(always)]
+    fn release(
+        self,
+        history: &TangentialHistory,
+        law: Option<&PreparedModel>,
+        velocity_back: impl FnOnce(&Point) -> Vector,
+        dt: Real,
+    ) {
+        let previous = self.previous(history);
+        if let (false, Some(law)) = (previous.is_zero(), law) {
+            let v = velocity_back(&self.last.point);
+            *self.work = ContactWork::of_release(&law.tangential, &previous, &v, dt);
+        }
+        *self.last = LastContact::default();
     }
 }
 
@@ -217,6 +296,8 @@ impl PairContext<'_> {
     /// The geometry is [`contact_sphere_sphere`]'s, through its kernels (the distance's square root taken
     /// from the squared distance of the cheap test), and the law is the model's
     /// ([`PreparedModel::respond`]), so the pair gives the bits of the general step's sphere kernel.
+    /// With `ledger` (the energy ledger on), the pair's terms are booked there as the general step's
+    /// stage 5 books them.
     #[allow(clippy::too_many_arguments)]
     #[inline(always)]
     pub(crate) fn body_pair(
@@ -228,18 +309,35 @@ impl PairContext<'_> {
         history: &mut TangentialHistory,
         in_contact: &mut bool,
         out: &mut PairOut,
+        ledger: Option<LedgerSlot<'_>>,
     ) -> Result<Option<Real>, StepError> {
         let (ka, kb) = (&self.kin[a], &self.kin[b]);
+        let dt = self.dt;
+        let velocity_back = |p: &Point| kb.velocity_back_at(p, dt) - ka.velocity_back_at(p, dt);
         let d_vec = kb.position - ka.position;
         let d_squared = d_vec.norm_squared();
         if d_squared >= reach * reach {
             // d ≥ r_A + r_B: no overlap beyond the touching band.
-            separated(history, in_contact);
+            separated(
+                history,
+                in_contact,
+                ledger,
+                c.law.as_ref(),
+                velocity_back,
+                dt,
+            );
             return Ok(None);
         }
         let (normal, depth) = sphere_sphere_normal(&d_vec, d_squared, reach);
         if !(depth > c.touch && depth > 0.0) {
-            separated(history, in_contact);
+            separated(
+                history,
+                in_contact,
+                ledger,
+                c.law.as_ref(),
+                velocity_back,
+                dt,
+            );
             return Ok(None);
         }
         let Some(law) = &c.law else {
@@ -249,6 +347,7 @@ impl PairContext<'_> {
             sphere_sphere_points(&ka.position, c.radius_a, &kb.position, c.radius_b, &normal);
         let point = nalgebra::center(&point_a, &point_b);
         let relative_velocity = kb.velocity_at(&point) - ka.velocity_at(&point);
+        let previous = ledger.as_ref().map(|slot| slot.previous(history));
         let response = law.respond(
             depth,
             &normal,
@@ -259,6 +358,10 @@ impl PairContext<'_> {
             self.dt,
             history,
         );
+        if let (Some(slot), Some(previous)) = (ledger, previous) {
+            let v = &relative_velocity;
+            slot.book(&previous, velocity_back, &normal, point, &response, v, dt);
+        }
         *out = PairOut::overlapping(&response, depth);
         *in_contact = true;
         Ok(Some(depth / c.scale))
@@ -274,6 +377,7 @@ impl PairContext<'_> {
     /// The wall–sphere pair (A = wall `w`, B = sphere `i`) with its constants `c`: the geometry of
     /// [`contact_plane_sphere`] through its kernel, then the model (returns and flags as
     /// [`PairContext::body_pair`], the ratio over the sphere's diameter).
+    #[allow(clippy::too_many_arguments)]
     #[inline(always)]
     pub(crate) fn wall_pair(
         &self,
@@ -283,16 +387,33 @@ impl PairContext<'_> {
         history: &mut TangentialHistory,
         in_contact: &mut bool,
         out: &mut PairOut,
+        ledger: Option<LedgerSlot<'_>>,
     ) -> Result<Option<Real>, StepError> {
         let (k, p, wall) = (&self.kin[i], &self.props[i], &self.walls[w]);
+        let dt = self.dt;
+        let velocity_back = |x: &Point| k.velocity_back_at(x, dt) - wall.velocity;
         let height = wall.height(&k.position);
         if height >= p.radius {
-            separated(history, in_contact);
+            separated(
+                history,
+                in_contact,
+                ledger,
+                c.law.as_ref(),
+                velocity_back,
+                dt,
+            );
             return Ok(None);
         }
         let depth = p.radius - height;
         if !(depth > c.touch && depth > 0.0) {
-            separated(history, in_contact);
+            separated(
+                history,
+                in_contact,
+                ledger,
+                c.law.as_ref(),
+                velocity_back,
+                dt,
+            );
             return Ok(None);
         }
         let Some(law) = &c.law else {
@@ -302,6 +423,7 @@ impl PairContext<'_> {
         let (point_a, point_b) = plane_sphere_points(&k.position, p.radius, &n, height);
         let point = nalgebra::center(&point_a, &point_b);
         let relative_velocity = k.velocity_at(&point) - wall.velocity;
+        let previous = ledger.as_ref().map(|slot| slot.previous(history));
         let response = law.respond(
             depth,
             &n,
@@ -312,6 +434,10 @@ impl PairContext<'_> {
             self.dt,
             history,
         );
+        if let (Some(slot), Some(previous)) = (ledger, previous) {
+            let v = &relative_velocity;
+            slot.book(&previous, velocity_back, &n, point, &response, v, dt);
+        }
         *out = PairOut::overlapping(&response, depth);
         *in_contact = true;
         Ok(Some(depth / (2.0 * p.radius)))
@@ -325,14 +451,27 @@ pub(crate) fn scaled(model: &ContactModel, root_radius: Real) -> ContactModel {
     model.for_root_radius(root_radius)
 }
 
-/// A candidate that does not overlap: the law resets its spring, and it contributes nothing.
+/// A candidate that does not overlap: the law resets its spring, and it contributes no force; with the
+/// ledger, a pair that overlapped at the last evaluation books the release of its last forces
+/// ([`LedgerSlot::release`], `velocity_back` as there).
 ///
 /// A pair that was apart at the last evaluation already holds the cleared spring (`in_contact` false
-/// says so), so it reads and writes nothing but its flag: neither its spring nor its output, whose
-/// records are ~15 times the flag's size (most listed pairs are apart: ~82 % on bed c).
+/// says so; with the ledger, no last contact either), so it reads and writes nothing but its flag:
+/// neither its spring nor its output, whose records are ~15 times the flag's size (most listed pairs are
+/// apart: ~82 % on bed c).
 #[inline(always)]
-fn separated(history: &mut TangentialHistory, in_contact: &mut bool) {
+fn separated(
+    history: &mut TangentialHistory,
+    in_contact: &mut bool,
+    ledger: Option<LedgerSlot<'_>>,
+    law: Option<&PreparedModel>,
+    velocity_back: impl FnOnce(&Point) -> Vector,
+    dt: Real,
+) {
     if *in_contact {
+        if let Some(slot) = ledger {
+            slot.release(history, law, velocity_back, dt);
+        }
         if !history.is_cleared() {
             *history = TangentialHistory::default();
         }

@@ -10,11 +10,15 @@ use crate::dynamics::translation::{
 use crate::law::TangentialHistory;
 use crate::math::{Point, Real, Vector};
 
+use super::super::energy::ContactWork;
 use super::super::step::{first_non_finite, OverlapWarning, StepError};
 use super::super::world::Wall;
 use super::super::ContactKey;
+use super::ledger::LastContact;
 use super::neighbours::TopTwo;
-use super::pair::{Kinematic, PairConstants, PairContext, PairOut, Props, WallConstants};
+use super::pair::{
+    Kinematic, LedgerSlot, PairConstants, PairContext, PairOut, Props, WallConstants,
+};
 use super::Spin;
 
 /// What the pair loop found, summed over its blocks in pair order.
@@ -30,6 +34,9 @@ pub(super) struct Found {
     /// The first error of a body pair, and of a wall pair.
     pub(super) error: Option<StepError>,
     pub(super) wall_error: Option<StepError>,
+    /// The ledger's terms summed in pair order by a block whose slots are `in_order`
+    /// ([`LedgerPart::in_order`]; not merged: only the one block of a serial pair loop sums them).
+    pub(super) work: ContactWork,
 }
 
 impl Found {
@@ -69,6 +76,14 @@ impl Found {
 
     pub(super) fn failed(&self) -> bool {
         self.error.is_some() || self.wall_error.is_some()
+    }
+
+    /// Adds a pair's ledger terms to the sums in pair order.
+    #[inline(always)]
+    fn add_work(&mut self, w: &ContactWork) {
+        self.work.damping += w.damping;
+        self.work.friction += w.friction;
+        self.work.stiffness += w.stiffness;
     }
 
     /// Counts an overlapping pair with overlap `depth` (m) and `ratio` (over the smaller diameter), and
@@ -306,6 +321,46 @@ pub(super) struct BlockPart<'a> {
     pub(super) wall_outs: &'a mut [PairOut],
     pub(super) force: &'a mut [Vector],
     pub(super) torque: &'a mut [Vector],
+    /// The ledger's slots of the block's pairs (empty when the ledger is off).
+    pub(super) ledger: LedgerPart<'a>,
+}
+
+/// The ledger's slots of a run of pairs and of body–wall pairs ([`super::ledger::PairLedger`]).
+#[derive(Default)]
+pub(super) struct LedgerPart<'a> {
+    /// Whether the pair loop sums the terms itself as it goes (the one block of a serial pair loop: it
+    /// visits every pair in pair order), into [`Found::work`]; the work slots are then empty.
+    pub(super) in_order: bool,
+    pub(super) last: &'a mut [LastContact],
+    pub(super) work: &'a mut [ContactWork],
+    pub(super) wall_last: &'a mut [LastContact],
+    pub(super) wall_work: &'a mut [ContactWork],
+}
+
+impl<'a> LedgerPart<'a> {
+    /// The slots of the first `pairs` pairs and `walls` wall pairs, split off the front (the slots are
+    /// empty when the ledger is off: then nothing is split off).
+    pub(super) fn split_front(&mut self, pairs: usize, walls: usize) -> LedgerPart<'a> {
+        let split = |slots: &mut &'a mut [LastContact], n: usize| {
+            let n = n.min(slots.len());
+            let (front, back) = std::mem::take(slots).split_at_mut(n);
+            *slots = back;
+            front
+        };
+        let split_work = |slots: &mut &'a mut [ContactWork], n: usize| {
+            let n = n.min(slots.len());
+            let (front, back) = std::mem::take(slots).split_at_mut(n);
+            *slots = back;
+            front
+        };
+        LedgerPart {
+            in_order: false,
+            last: split(&mut self.last, pairs),
+            work: split_work(&mut self.work, pairs),
+            wall_last: split(&mut self.wall_last, walls),
+            wall_work: split_work(&mut self.wall_work, walls),
+        }
+    }
 }
 
 /// What a block of the pair loop reads.
@@ -325,6 +380,8 @@ pub(super) struct PairBlocks<'a> {
     pub(super) fraction: Real,
     /// Whether to run the x86-64-v3 build ([`super::isa`]; the caller checked the CPU).
     pub(super) v3: bool,
+    /// Whether the pairs book the energy ledger's terms (the parts then hold the ledger's slots).
+    pub(super) ledger: bool,
 }
 
 impl PairBlocks<'_> {
@@ -349,9 +406,12 @@ impl PairBlocks<'_> {
     #[inline(always)]
     fn run_here(&self, first: usize, part: BlockPart<'_>) -> Found {
         let end = first + part.force.len();
-        self.run_summing(first, part, |j| {
-            j < end && !self.gathered.get(j).copied().unwrap_or(false)
-        })
+        let own = |j: usize| j < end && !self.gathered.get(j).copied().unwrap_or(false);
+        if self.ledger {
+            self.run_summing::<true>(first, part, own)
+        } else {
+            self.run_summing::<false>(first, part, own)
+        }
     }
 
     /// The one block of every sphere (the serial pair loop): [`PairBlocks::run`] without the test of
@@ -362,19 +422,35 @@ impl PairBlocks<'_> {
             // SAFETY: `v3` is set only where the CPU has the features (`super::isa::v3`).
             return unsafe { self.run_all_v3(part) };
         }
-        self.run_summing(0, part, |_| true)
+        self.run_all_here(part)
     }
 
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2,bmi1,bmi2,lzcnt,popcnt")]
     fn run_all_v3(&self, part: BlockPart<'_>) -> Found {
-        self.run_summing(0, part, |_| true)
+        self.run_all_here(part)
+    }
+
+    #[inline(always)]
+    fn run_all_here(&self, part: BlockPart<'_>) -> Found {
+        if self.ledger {
+            self.run_summing::<true>(0, part, |_| true)
+        } else {
+            self.run_summing::<false>(0, part, |_| true)
+        }
     }
 
     /// The pair loop of one block, summing the loads of the spheres `own` names, in two halves per
-    /// chunk of pairs ([`PairChunks`]).
+    /// chunk of pairs ([`PairChunks`]); with `LEDGER`, booking each evaluated pair's ledger terms in its
+    /// slot of `part.ledger` (one build of the loop per value, so that the loop without the ledger has
+    /// no test of it).
     #[inline(always)]
-    fn run_summing(&self, first: usize, part: BlockPart<'_>, own: impl Fn(usize) -> bool) -> Found {
+    fn run_summing<const LEDGER: bool>(
+        &self,
+        first: usize,
+        part: BlockPart<'_>,
+        own: impl Fn(usize) -> bool,
+    ) -> Found {
         let BlockPart {
             histories,
             in_contact,
@@ -384,12 +460,15 @@ impl PairBlocks<'_> {
             wall_outs,
             force,
             torque,
+            ledger,
         } = part;
         let (p0, q0) = (
             self.row_start[first] as usize,
             self.wall_start[first] as usize,
         );
         let mut found = Found::scattered();
+        // A pair's terms when the loop sums them in pair order (`ledger.in_order`).
+        let mut work = ContactWork::default();
         force.fill(Vector::zeros());
         torque.fill(Vector::zeros());
         let ctx = &self.ctx;
@@ -411,7 +490,23 @@ impl PairBlocks<'_> {
                 let (i, j) = (a[k] as usize, b[k] as usize);
                 let (c, out) = (&self.constants[p], &mut outs[k]);
                 let (history, flag) = (&mut histories[k], &mut in_contact[k]);
-                match ctx.body_pair(i, j, reach[k], c, history, flag, out) {
+                let slot = if LEDGER {
+                    Some(LedgerSlot {
+                        last: &mut ledger.last[k],
+                        work: if ledger.in_order {
+                            &mut work
+                        } else {
+                            &mut ledger.work[k]
+                        },
+                    })
+                } else {
+                    None
+                };
+                let evaluated = ctx.body_pair(i, j, reach[k], c, history, flag, out, slot);
+                if LEDGER && ledger.in_order {
+                    found.add_work(&std::mem::take(&mut work));
+                }
+                match evaluated {
                     Ok(None) => {}
                     Ok(Some(ratio)) => {
                         if own(i) {
@@ -444,7 +539,23 @@ impl PairBlocks<'_> {
                 let (body, wall) = (wall_body[k], wall_of[k]);
                 let (i, c, out) = (body as usize, &wall_constants[k], &mut wall_outs[k]);
                 let (history, flag) = (&mut wall_histories[k], &mut wall_in_contact[k]);
-                match ctx.wall_pair(wall as usize, i, c, history, flag, out) {
+                let slot = if LEDGER {
+                    Some(LedgerSlot {
+                        last: &mut ledger.wall_last[k],
+                        work: if ledger.in_order {
+                            &mut work
+                        } else {
+                            &mut ledger.wall_work[k]
+                        },
+                    })
+                } else {
+                    None
+                };
+                let evaluated = ctx.wall_pair(wall as usize, i, c, history, flag, out, slot);
+                if LEDGER && ledger.in_order {
+                    found.add_work(&std::mem::take(&mut work));
+                }
+                match evaluated {
                     Ok(None) => {}
                     Ok(Some(ratio)) => {
                         if own(i) {

@@ -28,9 +28,12 @@ use super::super::step::{StepError, StepReport};
 use super::blocks::Blocks;
 use super::crew::Crew;
 use super::fused::Fused;
+use super::ledger::OldWalls;
 use super::neighbours::TopTwo;
 use super::pair::{PairContext, PairOut, WallPlane};
-use super::passes::{wall_sums, BlockPart, Drift, Found, Kick, KickPart, PairBlocks, Rows};
+use super::passes::{
+    wall_sums, BlockPart, Drift, Found, Kick, KickPart, LedgerPart, PairBlocks, Rows,
+};
 use super::team::{for_each_part, split_at_ranges};
 use super::{SphereSim, MIN_PARALLEL_PAIRS};
 
@@ -113,6 +116,13 @@ impl SphereSim {
             }
             None => self.sum_walls(),
         }
+        if self.params.energy_ledger {
+            // The contact terms in pair order, added as the general step's stage 9 adds them.
+            self.step_work = self.pair_ledger.take_sums();
+            self.ledger.dissipated_damping += self.step_work.damping;
+            self.ledger.dissipated_friction += self.step_work.friction;
+            self.ledger.tangential_stiffness_work += self.step_work.stiffness;
+        }
         report.counters.accumulate += t.elapsed();
         self.ledger.external_work += 0.5 * (external_start + self.external_power) * dt;
         self.time += dt;
@@ -172,6 +182,7 @@ impl SphereSim {
         let t = Instant::now();
         if self.list.is_stale(moved.0, moved.1, &self.planes) {
             let parallel = self.parallel_bodies();
+            let old_walls = self.params.energy_ledger.then(|| OldWalls::of(&self.list));
             let centres: Vec<Point> = self.kin.iter().map(|k| k.position).collect();
             self.list.rebuild(
                 &centres,
@@ -181,6 +192,9 @@ impl SphereSim {
                 self.step_index,
                 &|_, _| None,
             );
+            if let Some(old) = &old_walls {
+                self.pair_ledger.carry(&mut self.list, Some(old), None);
+            }
             self.prepare_pairs(parallel);
             report.counters.broad_rebuilds += 1;
         }
@@ -305,9 +319,18 @@ impl SphereSim {
             gathered: &blocks.gathered,
             fraction,
             v3: self.v3,
+            ledger: self.params.energy_ledger,
         };
+        let pl = &mut self.pair_ledger;
         if blocks.bodies.len() == 1 {
-            // One block of every sphere: the same pass without the test of which spheres it sums.
+            // One block of every sphere: the same pass without the test of which spheres it sums; it
+            // visits the pairs in pair order, so it sums the ledger's terms itself.
+            let ledger = LedgerPart {
+                in_order: true,
+                last: &mut pl.last,
+                wall_last: &mut pl.wall_last,
+                ..LedgerPart::default()
+            };
             let found = pass.run_all(BlockPart {
                 histories: &mut list.histories,
                 in_contact: &mut list.in_contact,
@@ -317,12 +340,21 @@ impl SphereSim {
                 wall_outs: &mut self.wall_out,
                 force: &mut self.force,
                 torque: &mut self.torque,
+                ledger,
             });
+            pl.summed = Some(found.work);
             self.outs_valid = true;
             // Formerly this returned without joining the wall warnings to the list:
             // a step on one block reported no overlap warning against a wall.
             return found.finish();
         }
+        let mut ledger = LedgerPart {
+            in_order: false,
+            last: &mut pl.last,
+            work: &mut pl.work,
+            wall_last: &mut pl.wall_last,
+            wall_work: &mut pl.wall_work,
+        };
         // Split every array at the boundaries of the blocks and middles; thread k runs block k, then
         // the middle after it (the whole middle: no sharing out when the passes run one by one).
         let mut parts: Vec<Vec<(usize, BlockPart)>> =
@@ -364,6 +396,7 @@ impl SphereSim {
                         wall_outs: wo1,
                         force: f1,
                         torque: t1,
+                        ledger: ledger.split_front(pairs, walls),
                     },
                 ));
                 // Segments alternate block, middle: a middle closes its thread's list.

@@ -233,7 +233,8 @@ fn release(
             .model(mat_a, world.material_of[b])?
             .for_shapes(shape_a, world.shape(b));
         let relative_velocity = pair.relative_velocity(key, previous_point, pair.dt);
-        out.work = ContactWork::of_release(&model, &previous, &relative_velocity, pair.dt);
+        out.work =
+            ContactWork::of_release(&model.tangential, &previous, &relative_velocity, pair.dt);
     }
     // The law resets the history of a pair that does not overlap.
     *history = Default::default();
