@@ -13,6 +13,13 @@ Simulations from scene files::
     sim.step(100)                           # in Rust, with the GIL released
     sim.positions(), sim.energy()           # numpy copies of the state, the energy ledger
 
+Scenes built in Python, run with the outputs of ``polydem run``::
+
+    scene = polydem.Scene.from_dict({"simulation": {...}, "material": [...], "interaction": [...],
+                                     "shape": [...], "body": polydem.bodies("grain", count=n, shape="ball",
+                                     material="steel", position=xyz), "wall": [...]})
+    polydem.Simulation(scene).run(out="out/run", vtk_interval=0.01, progress=lambda k, n: print(k, n))
+
 Every array the package returns is a copy: the state belongs to the engine and changes at the next step.
 Lengths in metres, times in seconds, SI units throughout. Poses are ``(position[3], quaternion[4])`` with
 the quaternion as (w, x, y, z).
@@ -32,7 +39,10 @@ from ._polydem import (
     __version__,
     contact,
     contact_batch,
+    scene_to_toml,
 )
+from .scene_builder import bodies
+from .validation import find_checkout, validate
 
 __all__ = [
     "CheckpointError",
@@ -47,5 +57,9 @@ __all__ = [
     "StepError",
     "__version__",
     "contact",
+    "bodies",
     "contact_batch",
+    "find_checkout",
+    "scene_to_toml",
+    "validate",
 ]

@@ -1,7 +1,7 @@
 """Type stubs of the polydem package (the native module polydem._polydem)."""
 
 from os import PathLike
-from typing import Callable, Optional, Sequence, Tuple, Union, final
+from typing import Any, Callable, Dict, Mapping, Optional, Sequence, Tuple, Union, final
 
 from typing_extensions import disjoint_base
 
@@ -22,8 +22,15 @@ __all__ = [
     "StepError",
     "__version__",
     "contact",
+    "bodies",
     "contact_batch",
+    "find_checkout",
+    "scene_to_toml",
+    "validate",
 ]
+
+from .scene_builder import bodies as bodies
+from .validation import find_checkout as find_checkout, validate as validate
 
 _ArrayLike = npt.ArrayLike
 _FloatArray = npt.NDArray[np.float64]
@@ -150,6 +157,10 @@ class Scene:
     @staticmethod
     def from_string(text: str, path: _StrPath = ...) -> Scene:
         """Builds a scene from TOML text; `path` (default "<string>") names it in error messages."""
+    @staticmethod
+    def from_dict(scene: Mapping[str, Any], path: _StrPath = ...) -> Scene:
+        """Builds a scene from a dict shaped like the scene file, read as the TOML text scene_to_toml(scene)
+        gives (the same validation and messages as a file); `path` (default "<dict>") names it in errors."""
     @property
     def num_bodies(self) -> int: ...
     @property
@@ -174,9 +185,24 @@ class Simulation:
         until: Optional[float] = None,
         every: Optional[float] = None,
         callback: Optional[Callable[[Simulation], object]] = None,
+        *,
+        progress: Optional[Callable[[int, int], object]] = None,
+        out: Optional[_StrPath] = None,
+        vtk_interval: Optional[float] = None,
+        contacts_interval: Optional[float] = None,
+        checkpoint_interval: Optional[float] = None,
     ) -> None:
         """Runs to `until` (s; default the scene's end time), calling callback(sim) every `every` seconds
-        (whole steps, at least one) and at the end; GIL released except for the callback."""
+        (whole steps, at least one) and at the end, and progress(step, last_step) about every hundredth of
+        the run; with `out`, writes the outputs of `polydem run --out` there (CSV series; VTK frames,
+        contact network, checkpoints at the given intervals in s). GIL released except for the callbacks."""
+    def contacts(self) -> Dict[str, npt.NDArray[Any]]:
+        """The active contacts: `wall` (bool), `a`, `b` (int64 indices; a wall's index for a wall contact),
+        `point`, `normal` (n, 3), `depth` (n,), `force` on b (n, 3); world frame, copies."""
+    def walls(self) -> Dict[str, Any]:
+        """The walls: `names`, and (k, 3) arrays `point`, `normal`, `velocity`, `force` (copies)."""
+    def set_wall_velocity(self, name: str, velocity: _ArrayLike) -> None:
+        """Sets the prescribed velocity (m/s) of the wall `name`; KeyError if there is none."""
     @property
     def time(self) -> float:
         """Simulated time (s)."""
@@ -222,3 +248,7 @@ class Simulation:
     @classmethod
     def from_bytes(cls, data: bytes) -> Simulation:
         """Restores checkpoint bytes."""
+
+def scene_to_toml(scene: Mapping[str, Any]) -> str:
+    """The TOML text of a scene given as a dict shaped like the scene file (None values left out);
+    TypeError naming the key of a value TOML cannot hold."""

@@ -7,8 +7,11 @@ mod arrays;
 mod contact;
 mod contact_batch;
 mod errors;
+mod run_loop;
+mod scene_dict;
 mod shapes;
 mod simulation;
+mod world_arrays;
 
 use pyo3::prelude::*;
 
@@ -23,6 +26,7 @@ fn _polydem(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(contact::contact, m)?)?;
     m.add_function(wrap_pyfunction!(contact_batch::contact_batch, m)?)?;
     m.add_class::<simulation::PyScene>()?;
+    m.add_function(wrap_pyfunction!(scene_dict::scene_to_toml, m)?)?;
     m.add_class::<simulation::PySimulation>()?;
     m.add("SceneError", py.get_type::<errors::PyPolydemSceneError>())?;
     m.add(

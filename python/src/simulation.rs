@@ -6,13 +6,15 @@ use std::path::PathBuf;
 use numpy::PyArray2;
 use polydem::io::checkpoint;
 use polydem::math::Real;
-use polydem::scene::{self, RunObserver, Simulation};
+use polydem::scene::{self, Simulation};
 use polydem::world::Loads;
 use pyo3::exceptions::{PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyBytes, PyDict, PyType};
 
 use crate::errors::{checkpoint_error, run_error, scene_error};
+use crate::run_loop::{self, RunRequest, Unobserved};
+use crate::world_arrays;
 
 /// A scene read and validated by the engine (materials, laws, shapes, bodies, walls, time step). Build a
 /// `Simulation` from it to run it; the scene itself never changes.
@@ -43,6 +45,19 @@ impl PyScene {
         Ok(Self { sim })
     }
 
+    /// Builds a scene from a dict shaped like the scene file (`{"simulation": {...}, "material": [{...}],
+    /// "body": [{...}], ...}`; numpy arrays and scalars are accepted wherever the file has numbers). It is
+    /// written out as TOML text (`polydem.scene_to_toml(scene)`) and read by the engine's scene builder, so
+    /// the validation and the error messages are those of a scene file, with line numbers in that text;
+    /// `path` names it in errors, and relative paths in the scene (`[[body_file]]`) are taken from its
+    /// directory.
+    #[staticmethod]
+    #[pyo3(signature = (scene, path = PathBuf::from("<dict>")))]
+    fn from_dict(py: Python<'_>, scene: &Bound<'_, PyDict>, path: PathBuf) -> PyResult<Self> {
+        let text = crate::scene_dict::scene_to_toml(scene)?;
+        Self::from_string(py, &text, path)
+    }
+
     /// Number of bodies.
     #[getter]
     fn num_bodies(&self) -> usize {
@@ -59,22 +74,6 @@ impl PyScene {
     #[getter]
     fn end_time(&self) -> Real {
         self.sim.end_time
-    }
-}
-
-/// An observer that reads nothing: the run loop then chooses its stepping path freely (the flat sphere
-/// layout where it applies) and writes the state back at the end.
-struct Unobserved;
-
-impl RunObserver for Unobserved {
-    fn wants_state(&self, _step: u64) -> bool {
-        false
-    }
-    fn observe(&mut self, _sim: &Simulation, _step: u64) -> std::io::Result<()> {
-        Ok(())
-    }
-    fn reads_contacts(&self, _step: u64) -> bool {
-        false
     }
 }
 
@@ -112,7 +111,7 @@ fn interval_steps(every: Real, dt: Real) -> PyResult<u64> {
 /// the simulation were dropped). Body rows are in the scene's body order.
 #[pyclass(name = "Simulation", module = "polydem")]
 pub struct PySimulation {
-    sim: Simulation,
+    pub(crate) sim: Simulation,
 }
 
 impl PySimulation {
@@ -171,41 +170,78 @@ impl PySimulation {
 
     /// Runs to the time `until` (s; default: the scene's end time), calling `callback(sim)` every
     /// `every` seconds of simulated time (rounded to whole steps, at least one) and at the end; without
-    /// `every`, once at the end. The steps run in Rust with the GIL released; it is taken again only for
-    /// the callback. An exception raised by the callback stops the run and propagates.
-    #[pyo3(signature = (until = None, every = None, callback = None))]
-    fn run(
-        slf: &Bound<'_, Self>,
+    /// `every`, once at the end. `progress(step, last_step)` is called about every hundredth of the run
+    /// (for a progress bar). With `out`, the run writes the outputs of `polydem run --out` there: the CSV
+    /// series at the scene's output interval, and VTK frames, the contact network and checkpoints at the
+    /// given intervals (s); the directory is locked for the run and its series start afresh. The steps
+    /// run in Rust with the GIL released; it is taken again between stretches for the callbacks and for
+    /// Ctrl-C (`KeyboardInterrupt` stops the run there). An exception raised by a callback stops the run
+    /// and propagates.
+    #[pyo3(signature = (until = None, every = None, callback = None, *, progress = None, out = None,
+                        vtk_interval = None, contacts_interval = None, checkpoint_interval = None))]
+    #[allow(clippy::too_many_arguments)] // Python keywords, each optional
+    fn run<'py>(
+        slf: &Bound<'py, Self>,
         until: Option<Real>,
         every: Option<Real>,
-        callback: Option<Bound<'_, PyAny>>,
+        callback: Option<Bound<'py, PyAny>>,
+        progress: Option<Bound<'py, PyAny>>,
+        out: Option<PathBuf>,
+        vtk_interval: Option<Real>,
+        contacts_interval: Option<Real>,
+        checkpoint_interval: Option<Real>,
     ) -> PyResult<()> {
-        let py = slf.py();
-        let (last, chunk) = {
+        let (last, callback_every) = {
             let mut this = slf.borrow_mut();
             let dt = this.sim.params.dt;
             let last = match until {
                 Some(t) => step_at(&mut this.sim, t)?,
                 None => this.sim.steps,
             };
-            let chunk = every.map(|t| interval_steps(t, dt)).transpose()?;
-            (last, chunk.unwrap_or(u64::MAX))
+            let every = every.map(|t| interval_steps(t, dt)).transpose()?;
+            (last, every.unwrap_or(u64::MAX))
         };
-        loop {
-            let done = slf.borrow().sim.world.step_index;
-            if done >= last {
-                return Ok(());
-            }
-            {
-                let mut this = slf.borrow_mut();
-                let sim = &mut this.sim;
-                py.detach(|| advance(sim, chunk.min(last - done)))
-                    .map_err(|e| run_error(&e))?;
-            }
-            if let Some(callback) = &callback {
-                callback.call1((slf,))?;
-            }
+        if out.is_none()
+            && (vtk_interval, contacts_interval, checkpoint_interval) != (None, None, None)
+        {
+            return Err(PyValueError::new_err(
+                "vtk_interval, contacts_interval and checkpoint_interval need an output directory: give out=",
+            ));
         }
+        let plan = run_loop::plan(vtk_interval, contacts_interval, checkpoint_interval);
+        let request = RunRequest {
+            last,
+            callback_every,
+            callback,
+            progress,
+            out: out.map(|dir| (dir, plan)),
+        };
+        run_loop::run(slf, request)
+    }
+
+    /// The active contacts after the last step, as a dict of new arrays (copies), one row per contact in
+    /// the engine's contact order: `wall` (bool; True for a body–wall contact), `a` and `b` (int64: the
+    /// indices of the two bodies, a < b; for a wall contact `a` is the wall's index in `walls()` and `b`
+    /// the body's), `point` (the contact point c_M, m), `normal` (unit, from a towards b), `depth` (the
+    /// overlap, m) and `force` (the contact force on b, N; a receives its opposite), world frame — the
+    /// rows `contacts.csv` writes.
+    fn contacts<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        world_arrays::contacts(py, &self.sim.world)
+    }
+
+    /// The walls, as a dict: `names` (a list), and new arrays (copies) `point` (a point of each plane now,
+    /// m), `normal` (the unit normal towards the free side), `velocity` (the prescribed velocity, m/s) and
+    /// `force` (the total contact force on the wall from the last evaluation, N; zeros before the first
+    /// step), world frame.
+    fn walls<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        world_arrays::walls(py, &self.sim.world)
+    }
+
+    /// Sets the prescribed velocity (m/s, world frame) of the wall `name` from the next step on: the wall
+    /// moves with it at constant velocity, and the energy ledger books the work its contact forces do.
+    fn set_wall_velocity(&mut self, name: &str, velocity: Bound<'_, PyAny>) -> PyResult<()> {
+        let velocity = crate::arrays::fixed::<3>(&velocity, "velocity")?;
+        world_arrays::set_wall_velocity(&mut self.sim.world, name, velocity)
     }
 
     /// Simulated time (s).

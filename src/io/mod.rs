@@ -8,7 +8,8 @@
 //! - [`output`]: the [`output::Output`] trait a run's outputs share, and [`output::OutputSet`], the
 //!   observer that hands them the state; its implementations: [`csv_series`], [`vtk_frames`],
 //!   [`checkpoint_series`], [`contact_network`]; [`output_lock`], one run per output directory;
-//!   [`run_identity`], which run a directory and a checkpoint belong to.
+//!   [`run_identity`], which run a directory and a checkpoint belong to; [`run_outputs`], the outputs of a
+//!   run opened the same way by every front door.
 
 pub mod checkpoint;
 pub mod checkpoint_series;
@@ -20,6 +21,7 @@ pub mod output;
 pub mod output_lock;
 pub mod pairs_jsonl;
 pub mod run_identity;
+pub mod run_outputs;
 pub mod run_summary;
 pub mod vtk;
 pub mod vtk_frames;

@@ -64,10 +64,11 @@ impl Schedule {
     }
 }
 
-/// The outputs of one run, in the order they write at a step, plus a progress callback.
+/// The outputs of one run, in the order they write at a step, plus a progress callback. It can be sent to
+/// another thread (a front door may run the loop off its own thread, as Python does without the GIL).
 pub struct OutputSet<'a> {
-    outputs: Vec<Box<dyn Output + 'a>>,
-    progress: Box<dyn FnMut(u64) + 'a>,
+    outputs: Vec<Box<dyn Output + Send + 'a>>,
+    progress: Box<dyn FnMut(u64) + Send + 'a>,
     record: OutputRecord,
     lock: Option<DirectoryLock>,
 }
@@ -89,12 +90,12 @@ impl<'a> OutputSet<'a> {
     }
 
     /// Adds an output; outputs write in the order they were added.
-    pub fn push(&mut self, output: impl Output + 'a) {
+    pub fn push(&mut self, output: impl Output + Send + 'a) {
         self.outputs.push(Box::new(output));
     }
 
     /// Called with the number of steps done (from step 0) as the run goes.
-    pub fn on_progress(&mut self, progress: impl FnMut(u64) + 'a) {
+    pub fn on_progress(&mut self, progress: impl FnMut(u64) + Send + 'a) {
         self.progress = Box::new(progress);
     }
 

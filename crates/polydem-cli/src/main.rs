@@ -158,16 +158,8 @@ struct RunArgs {
     quiet: bool,
 }
 
-/// The step interval of an output given in seconds: round(T / Δt), at least one step.
-fn every_steps(flag: &str, interval: Option<f64>, dt: f64) -> Result<Option<u64>> {
-    match interval {
-        None => Ok(None),
-        Some(t) if t.is_finite() && t > 0.0 => Ok(Some(((t / dt).round() as u64).max(1))),
-        Some(t) => bail!("{flag} must be a finite, positive time in seconds, got {t}"),
-    }
-}
-
 fn run(args: &RunArgs) -> Result<()> {
+    use polydem::io::run_outputs::RunStart;
     use polydem::io::run_summary::{summary_json, summary_text, RunOrigin};
 
     let (mut sim, source, run) = match (&args.restart, &args.scene) {
@@ -227,93 +219,26 @@ fn run(args: &RunArgs) -> Result<()> {
     Ok(())
 }
 
-/// How a run starts: from its scene, or from a checkpoint (with the identity of the run that wrote it).
-enum RunStart {
-    Fresh,
-    Restart {
-        checkpoint: PathBuf,
-        run: Option<u64>,
-    },
-}
-
-/// The outputs of `polydem run` in the order they write at a step: CSV series, VTK frames, the contact
-/// network, checkpoints (last, so that the series on disk reach each checkpoint). A restart continues the
-/// series the earlier run left in the same directory.
+/// The outputs of `polydem run`: the engine's [`open_outputs`](polydem::io::run_outputs::open_outputs)
+/// with the command's flags.
 fn run_outputs<'a>(
     args: &RunArgs,
     sim: &polydem::scene::Simulation,
-    start: &RunStart,
+    start: &polydem::io::run_outputs::RunStart,
 ) -> Result<polydem::io::output::OutputSet<'a>> {
-    use polydem::io::checkpoint_series::CheckpointSeries;
-    use polydem::io::contact_network::ContactNetwork;
-    use polydem::io::csv_series::CsvSeries;
-    use polydem::io::output::{OutputSet, Schedule};
-    use polydem::io::run_identity;
-    use polydem::io::vtk::VtkWriter;
-    use polydem::io::vtk_frames::VtkFrames;
-
-    let dt = sim.params.dt;
-    let vtk_every = every_steps("--vtk-interval", args.vtk_interval, dt)?;
-    let contacts_every = every_steps("--contacts-interval", args.contacts_interval, dt)?;
-    let checkpoint_every = every_steps("--checkpoint-interval", args.checkpoint_interval, dt)?;
-    let out_dir = args.out.as_path();
-    std::fs::create_dir_all(out_dir)
-        .with_context(|| format!("cannot create output directory {}", out_dir.display()))?;
-    // Taken before any file of the directory is created or rewritten.
-    let lock = polydem::io::output_lock::DirectoryLock::acquire(out_dir)?;
-    let (run, restarted) = match start {
-        RunStart::Fresh => {
-            let run = run_identity::new_run();
-            run_identity::record(out_dir, run)?;
-            (run, false)
-        }
-        RunStart::Restart { checkpoint, run } => {
-            (run_identity::continue_in(out_dir, *run, checkpoint)?, true)
-        }
+    use polydem::io::run_outputs::{open_outputs, IntervalNames, OutputPlan};
+    let plan = OutputPlan {
+        vtk_interval: args.vtk_interval,
+        vtk_encoding: vtk_encoding(args),
+        contacts_interval: args.contacts_interval,
+        checkpoint_interval: args.checkpoint_interval,
     };
-    let schedule = |every: Option<u64>, at_start: bool| Schedule {
-        start_step: sim.world.step_index,
-        last_step: sim.steps,
-        every,
-        at_start,
-        at_end: true,
+    let names = IntervalNames {
+        vtk: "--vtk-interval",
+        contacts: "--contacts-interval",
+        checkpoint: "--checkpoint-interval",
     };
-    let mut outputs = OutputSet::new();
-    outputs.hold(lock);
-    let csv = schedule(Some(sim.output_every), true);
-    outputs.push(if restarted {
-        CsvSeries::continue_at(out_dir, sim.world.time, csv)?
-    } else {
-        CsvSeries::create(out_dir, csv)?
-    });
-    if let Some(every) = vtk_every {
-        let encoding = vtk_encoding(args);
-        let writer = if restarted {
-            VtkWriter::resume(out_dir, &sim.world, encoding).with_context(|| {
-                format!("cannot continue the VTK series in {}", out_dir.display())
-            })?
-        } else {
-            VtkWriter::new(out_dir, &sim.world, encoding)
-                .with_context(|| format!("cannot create {}", out_dir.join("vtk").display()))?
-        };
-        outputs.push(VtkFrames::new(writer, schedule(Some(every), true)));
-    }
-    if let Some(every) = contacts_every {
-        let network = schedule(Some(every), true);
-        outputs.push(if restarted {
-            ContactNetwork::continue_at(out_dir, &sim.world, network)?
-        } else {
-            ContactNetwork::create(out_dir, network)?
-        });
-    }
-    if let Some(every) = checkpoint_every {
-        outputs.push(CheckpointSeries::new(
-            out_dir,
-            run,
-            schedule(Some(every), false),
-        )?);
-    }
-    Ok(outputs)
+    Ok(open_outputs(&args.out, &plan, names, sim, start)?)
 }
 
 fn vtk_encoding(args: &RunArgs) -> polydem::io::vtk::VtkEncoding {
