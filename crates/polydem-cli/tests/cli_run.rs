@@ -1,4 +1,4 @@
-//! The `polydem run SCENE --out DIR` contract (issue 3): `bodies.csv` and `energy.csv` with the documented
+//! The `polydem run SCENE --out DIR` contract: `bodies.csv` and `energy.csv` with the documented
 //! headers, one row per tracked body per output time, a summary on stdout and in `summary.txt`, and a
 //! non-zero exit with the scene file named for a bad scene.
 

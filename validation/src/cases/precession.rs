@@ -1,5 +1,5 @@
-//! Torque-free precession: the rotation integrator against exact solutions, simpler schemes and rapier3d
-//! (issue 3, gate 2). See `validation/cases/precession.toml` for the setup and the sources of every bound.
+//! Torque-free precession: the rotation integrator against exact solutions, simpler schemes and
+//! rapier3d. See `validation/cases/precession.toml` for the setup and the sources of every bound.
 
 use std::time::Instant;
 

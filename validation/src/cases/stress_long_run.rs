@@ -368,7 +368,7 @@ impl Case for StressLongRun {
         ctx.section("Largest changes of the energy error between two samples");
         ctx.text(
             "A discretisation error shrinks with Δt; a change that does not is a jump of the potential. \
-             Diagnosed (2026-11-21, every step with |Δ balance| > 2e-5 E0 logged with the contacts that changed, \
+             A diagnosis (every step with |Δ balance| > 2e-5 E0 logged with the contacts that changed, \
              quick profile): no contact appears with a finite depth and every depth is continuous, so the \
              potential does not jump; what jumps is the force. Slab box, 88 such steps in 60000: 62 have a \
              body–slab contact whose point c_M moves by 2e-2 to 6.5e-2 m in one step with the normal unchanged \
