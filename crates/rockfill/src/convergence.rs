@@ -168,10 +168,10 @@ pub fn run_convergence(
     if params
         .dt_divisors
         .iter()
-        .any(|k| !(k.is_finite() && *k >= 1.0))
+        .any(|k| !(k.is_finite() && *k > 0.0))
     {
         return Err(StudyError::Params(format!(
-            "time-step divisors {:?}: each must be ≥ 1",
+            "time-step divisors {:?}: each must be positive (below 1 coarsens the step)",
             params.dt_divisors
         )));
     }

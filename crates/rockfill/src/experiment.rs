@@ -274,6 +274,9 @@ pub fn run_experiment_with(
         }
     };
     let index = add_projectile(config, &mut world, &projectile)?;
+    if options.start_offset != polydem::math::Vector::zeros() {
+        world.bodies[index].position += options.start_offset;
+    }
     let penetration = penetrate_with(
         config,
         &mut world,

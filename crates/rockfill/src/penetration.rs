@@ -122,6 +122,9 @@ pub struct PenetrationOptions {
     /// Stop after this many steps, whatever the projectile does (benchmarks and regression pins run a
     /// fixed stretch of the impact); `None` runs to the experiment's own end.
     pub max_steps: Option<u64>,
+    /// Shifts the projectile's start (m, world frame): a perturbed initial state, whose spread of results
+    /// measures how chaotic the run is (zero for the experiment).
+    pub start_offset: Vector,
 }
 
 impl Default for PenetrationOptions {
@@ -130,6 +133,7 @@ impl Default for PenetrationOptions {
             dt_divisor: 1.0,
             snapshot_tip_x: Vec::new(),
             max_steps: None,
+            start_offset: Vector::zeros(),
         }
     }
 }

@@ -13,6 +13,7 @@ pub mod precession;
 pub mod projectile_history;
 pub mod restitution;
 pub mod rockfill;
+mod rockfill_dt_spread;
 pub mod single_contact_energy;
 pub mod sphere_bed;
 pub mod stress_impact;

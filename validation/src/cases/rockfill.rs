@@ -16,6 +16,7 @@ use polydem_rockfill::experiment::ExperimentResult;
 use polydem_rockfill::penetration::{MonitorRow, Outcome};
 use polydem_rockfill::study::run_one;
 
+use super::rockfill_dt_spread::{check_pair, SpreadParams};
 use crate::case::{Case, CaseData, Profile, Target};
 use crate::context::CaseContext;
 use crate::error::SuiteError;
@@ -30,7 +31,14 @@ struct Params {
     config: String,
     seeds: Vec<u64>,
     /// Divisors k of the penetration Δt for the time-step sequence (from the first seed's bed); empty: none.
+    /// Must include 1, 2 and `coarse_dt_divisor`, half of it.
     dt_divisors: Vec<Real>,
+    /// A divisor below 1 (a coarse Δt) at which the convergence check must flag the change.
+    coarse_dt_divisor: Real,
+    /// The aim displacement of the perturbed runs, in mean rock sizes.
+    perturbation_size_fraction: Real,
+    /// Number of perturbed runs per judged time step.
+    perturbations: usize,
 }
 
 fn case_error(msg: String) -> SuiteError {
@@ -287,37 +295,37 @@ impl Case for Rockfill {
                     d.map_or("–".into(), |d| format!("{:.3}", d[2])),
                 ]);
             }
-            // Over a fourfold refinement of Δt the successive difference must shrink at least twice (a
-            // first-order scheme shrinks it four times): one halving alone is not enough, since the first
-            // differences of a many-contact run can be of one size before the sequence settles.
-            for (k, w) in diffs.windows(3).enumerate() {
-                let tag = format!(
-                    "{}_{}_over_{}_{}",
-                    seq[k + 2].parameter,
-                    seq[k + 3].parameter,
-                    seq[k].parameter,
-                    seq[k + 1].parameter
-                );
-                ctx.check(
-                    &format!("dt_residual_difference_ratio_{tag}"),
-                    difference_ratio(w[0][0], w[2][0]),
-                    Target::at_most(0.5),
-                    "1",
-                );
-                ctx.check(
-                    &format!("dt_axis_deflection_difference_ratio_{tag}"),
-                    difference_ratio(w[0][2], w[2][2]),
-                    Target::at_most(0.5),
-                    "1",
-                );
+            // Judged against the spread over perturbed initial states (see `rockfill_dt_spread`).
+            let spread_params = SpreadParams {
+                size_fraction: p.perturbation_size_fraction,
+                count: p.perturbations,
+                tolerance: data.tolerance("rockfill", "dt_change_over_spread")?.value,
+            };
+            let mut spread_rows = Vec::new();
+            let coarse = p.coarse_dt_divisor;
+            for (pair, converged) in [((1.0, 2.0), true), ((coarse, 2.0 * coarse), false)] {
+                check_pair(
+                    ctx,
+                    &config,
+                    bed,
+                    &seq,
+                    pair,
+                    converged,
+                    &spread_params,
+                    &mut spread_rows,
+                )?;
             }
             ctx.section("Time-step convergence of the penetration run");
             ctx.text(&format!(
                 "Seed {seed}'s packed bed (engine checkpoint, so every run starts from the same state bit for bit), \
-                 penetration at Δt/k. A converging sequence has successive differences that shrink; the checks \
-                 above divide the difference after a fourfold refinement of Δt by the one before it (≤ 0.5; a \
-                 first-order scheme gives 0.25). One halving is not judged alone: the first differences of a \
-                 many-contact run can stay of one size before they shrink."
+                 penetration at Δt/k (k < 1: a coarser step). The result of a many-contact penetration moves \
+                 with its initial state, so a time step is judged against that motion: Δt/k is converged when \
+                 halving it changes the result by at most {tol} of the result's range over {n} runs at Δt/k \
+                 whose aim is displaced by {frac} rock sizes around the flight axis. The shipped Δt (k = 1) \
+                 must pass; the coarse step k = {coarse} must be flagged, which shows the check can fail.",
+                tol = spread_params.tolerance,
+                n = p.perturbations,
+                frac = p.perturbation_size_fraction,
             ));
             ctx.table(
                 Some("time_step"),
@@ -333,6 +341,18 @@ impl Case for Rockfill {
                     "|Δ axis deflection| to previous (°)",
                 ],
                 &trows,
+            )?;
+            ctx.table(
+                Some("time_step_spread"),
+                &[
+                    "time steps",
+                    "result",
+                    "|change|",
+                    "range under aim displacements",
+                    "change / range",
+                    "verdict",
+                ],
+                &spread_rows,
             )?;
             let point = |q: usize| -> Vec<(Real, Real)> {
                 seq.iter()
@@ -445,26 +465,5 @@ impl Case for Rockfill {
             caption: "Angle between the velocity and the initial direction, and between the axis and the initial axis.".into(),
         })?;
         Ok(())
-    }
-}
-
-/// The later of two time-step differences over the earlier (0 when both are 0).
-fn difference_ratio(earlier: Real, later: Real) -> Real {
-    if later == 0.0 {
-        0.0
-    } else {
-        later / earlier
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::difference_ratio;
-
-    #[test]
-    fn a_difference_ratio_is_the_later_over_the_earlier_and_zero_only_for_no_difference() {
-        assert_eq!(difference_ratio(0.4, 0.1), 0.25);
-        assert_eq!(difference_ratio(0.0, 0.0), 0.0);
-        assert!(difference_ratio(0.0, 1e-3).is_infinite());
     }
 }
