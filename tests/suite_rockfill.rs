@@ -6,8 +6,8 @@ use polydem_validation::{run_case_in_memory, Profile};
 
 #[test]
 fn rockfill_case_passes_every_check() {
-    let report = run_case_in_memory("rockfill", Profile::Quick)
-        .expect("rockfill case is registered");
+    let report =
+        run_case_in_memory("rockfill", Profile::Quick).expect("rockfill case is registered");
     assert!(
         report.error.is_none(),
         "rockfill case failed to complete: {:?}",

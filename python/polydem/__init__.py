@@ -39,6 +39,7 @@ from ._polydem import (
     __version__,
     contact,
     contact_batch,
+    rockfill,
     scene_to_toml,
 )
 from .scene_builder import bodies
@@ -60,6 +61,7 @@ __all__ = [
     "bodies",
     "contact_batch",
     "find_checkout",
+    "rockfill",
     "scene_to_toml",
     "validate",
 ]

@@ -25,6 +25,7 @@ __all__ = [
     "bodies",
     "contact_batch",
     "find_checkout",
+    "rockfill",
     "scene_to_toml",
     "validate",
 ]
@@ -252,3 +253,15 @@ class Simulation:
 def scene_to_toml(scene: Mapping[str, Any]) -> str:
     """The TOML text of a scene given as a dict shaped like the scene file (None values left out);
     TypeError naming the key of a value TOML cannot hold."""
+
+def rockfill(
+    out: _StrPath,
+    config: Optional[Union[str, _StrPath]] = None,
+    *,
+    size_mm: Optional[float] = None,
+    seed: Optional[int] = None,
+    bed: Optional[_StrPath] = None,
+    progress: Optional[Callable[[str, str], object]] = None,
+) -> Dict[str, Any]:
+    """The paper's rockfill experiment (`polydem rockfill`) with its outputs in `out`: "quick", "paper" or an
+    experiment file; returns the penetration's figures and `monitors`, a dict of per-step arrays."""

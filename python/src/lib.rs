@@ -7,6 +7,7 @@ mod arrays;
 mod contact;
 mod contact_batch;
 mod errors;
+mod rockfill;
 mod run_loop;
 mod scene_dict;
 mod shapes;
@@ -27,6 +28,7 @@ fn _polydem(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(contact_batch::contact_batch, m)?)?;
     m.add_class::<simulation::PyScene>()?;
     m.add_function(wrap_pyfunction!(scene_dict::scene_to_toml, m)?)?;
+    m.add_function(wrap_pyfunction!(rockfill::rockfill, m)?)?;
     m.add_class::<simulation::PySimulation>()?;
     m.add("SceneError", py.get_type::<errors::PyPolydemSceneError>())?;
     m.add(
