@@ -196,11 +196,7 @@ fn run_variant(
     comparison.plots(ctx)?;
     let runs = SpeedRuns {
         variant,
-        ours: &ours,
-        yade: &yade,
-        liggghts: &liggghts,
-        fresh_yade: fresh_yade.as_ref(),
-        fresh_liggghts: fresh_liggghts.as_ref(),
+        runs: &comparison,
     };
     runs.report(p, limits, threads, ctx, speed_rows)?;
     Ok(summary)

@@ -3,6 +3,7 @@
 
 use polydem::math::Real;
 
+use super::compare::Comparison;
 use super::polydem_run::{run_polydem, Run};
 use super::recorded::{rerun_reference, Recorded};
 use super::{fail, Limits, Params, Variant};
@@ -105,14 +106,10 @@ impl ThreadRounds {
     }
 }
 
-/// What the speed rows of a variant are made of.
+/// What the speed rows of a variant are made of: the runs it compared.
 pub(super) struct SpeedRuns<'a> {
     pub(super) variant: &'a Variant,
-    pub(super) ours: &'a Run,
-    pub(super) yade: &'a Recorded,
-    pub(super) liggghts: &'a Recorded,
-    pub(super) fresh_yade: Option<&'a Recorded>,
-    pub(super) fresh_liggghts: Option<&'a Recorded>,
+    pub(super) runs: &'a Comparison<'a>,
 }
 
 impl SpeedRuns<'_> {
@@ -127,13 +124,17 @@ impl SpeedRuns<'_> {
         rows: &mut Vec<Vec<String>>,
     ) -> Result<(Vec<Real>, Vec<Real>), SuiteError> {
         let v = &self.variant.name;
-        let ours_rate = our_rate(self.ours);
-        let mut lig = vec![ours_rate / rate(self.fresh_liggghts.unwrap_or(self.liggghts))];
-        let mut yade = vec![ours_rate / rate(self.fresh_yade.unwrap_or(self.yade))];
-        let codes: Vec<&str> = [("yade", self.fresh_yade), ("liggghts", self.fresh_liggghts)]
-            .into_iter()
-            .filter_map(|(code, fresh)| fresh.map(|_| code))
-            .collect();
+        let ours_rate = our_rate(self.runs.ours);
+        let mut lig =
+            vec![ours_rate / rate(self.runs.fresh_liggghts.unwrap_or(self.runs.liggghts))];
+        let mut yade = vec![ours_rate / rate(self.runs.fresh_yade.unwrap_or(self.runs.yade))];
+        let codes: Vec<&str> = [
+            ("yade", self.runs.fresh_yade),
+            ("liggghts", self.runs.fresh_liggghts),
+        ]
+        .into_iter()
+        .filter_map(|(code, fresh)| fresh.map(|_| code))
+        .collect();
         if codes.is_empty() {
             return Ok((lig, yade));
         }
@@ -145,7 +146,7 @@ impl SpeedRuns<'_> {
             );
             let again = run_polydem(self.variant, ctx, 1)?;
             threads.round(self.variant, &again, ctx)?;
-            if again.history.z != self.ours.history.z {
+            if again.history.z != self.runs.ours.history.z {
                 return Err(fail(format!(
                     "{v}: polydem's timing run {} did not repeat the compared run's trajectory",
                     k + 1
@@ -199,15 +200,18 @@ impl SpeedRuns<'_> {
                 "recorded"
             }
         };
-        let (yade_source, lig_source) = (source(self.fresh_yade), source(self.fresh_liggghts));
-        rows.push(polydem_row(v, "polydem (this run)".into(), self.ours));
+        let (yade_source, lig_source) = (
+            source(self.runs.fresh_yade),
+            source(self.runs.fresh_liggghts),
+        );
+        rows.push(polydem_row(v, "polydem (this run)".into(), self.runs.ours));
         let fresh_rows = [
-            self.fresh_yade.map(|r| ("YADE (this run)", r)),
-            self.fresh_liggghts.map(|r| ("LIGGGHTS (this run)", r)),
+            self.runs.fresh_yade.map(|r| ("YADE (this run)", r)),
+            self.runs.fresh_liggghts.map(|r| ("LIGGGHTS (this run)", r)),
         ];
         for (code, r) in [
-            ("YADE (recorded)", self.yade),
-            ("LIGGGHTS (recorded)", self.liggghts),
+            ("YADE (recorded)", self.runs.yade),
+            ("LIGGGHTS (recorded)", self.runs.liggghts),
         ]
         .into_iter()
         .chain(fresh_rows.into_iter().flatten())
