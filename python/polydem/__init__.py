@@ -39,6 +39,7 @@ from ._polydem import (
     __version__,
     contact,
     contact_batch,
+    contact_oracle,
     rockfill,
     scene_to_toml,
 )
@@ -60,6 +61,7 @@ __all__ = [
     "contact",
     "bodies",
     "contact_batch",
+    "contact_oracle",
     "find_checkout",
     "rockfill",
     "scene_to_toml",

@@ -24,6 +24,7 @@ __all__ = [
     "contact",
     "bodies",
     "contact_batch",
+    "contact_oracle",
     "find_checkout",
     "rockfill",
     "scene_to_toml",
@@ -265,3 +266,7 @@ def rockfill(
 ) -> Dict[str, Any]:
     """The paper's rockfill experiment (`polydem rockfill`) with its outputs in `out`: "quick", "paper" or an
     experiment file; returns the penetration's figures and `monitors`, a dict of per-step arrays."""
+
+def contact_oracle(a: Shape, b: Shape, pose_a: Optional[_Pose] = None, pose_b: Optional[_Pose] = None) -> ContactResult:
+    """The separating-axis oracle's exact answer for two ConvexPolyhedron shapes (slow; the reference the
+    engine's GJK/EPA is verified against); ValueError for other shapes."""

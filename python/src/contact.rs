@@ -153,3 +153,27 @@ pub fn exact_query(
         &mut QueryCounters::default(),
     )
 }
+
+/// The exact answer of the separating-axis oracle for two convex polyhedra (every face normal of either
+/// and every cross product of an edge of each): the reference the engine's GJK/EPA is verified against.
+/// Slow (O(E_a E_b V)); poses as for `contact`. Raises `ValueError` unless both shapes are
+/// `ConvexPolyhedron`s.
+#[pyfunction]
+#[pyo3(signature = (a, b, pose_a = None, pose_b = None))]
+pub fn contact_oracle(
+    py: Python<'_>,
+    a: PyRef<'_, PyShape>,
+    b: PyRef<'_, PyShape>,
+    pose_a: Option<&Bound<'_, PyAny>>,
+    pose_b: Option<&Bound<'_, PyAny>>,
+) -> PyResult<PyContactResult> {
+    let pos1 = arrays::pose(pose_a, "pose_a")? * a.frame;
+    let pos2 = arrays::pose(pose_b, "pose_b")? * b.frame;
+    let (Shape::Polyhedron(p1), Shape::Polyhedron(p2)) = (&a.shape, &b.shape) else {
+        return Err(PyValueError::new_err(
+            "contact_oracle: the separating-axis oracle takes two ConvexPolyhedron shapes",
+        ));
+    };
+    let geometry = py.detach(|| polydem::contact::sat_polyhedra(&pos1, p1, &pos2, p2));
+    Ok(PyContactResult { geometry })
+}

@@ -25,6 +25,7 @@ fn _polydem(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<shapes::PyEllipsoid>()?;
     m.add_class::<contact::PyContactResult>()?;
     m.add_function(wrap_pyfunction!(contact::contact, m)?)?;
+    m.add_function(wrap_pyfunction!(contact::contact_oracle, m)?)?;
     m.add_function(wrap_pyfunction!(contact_batch::contact_batch, m)?)?;
     m.add_class::<simulation::PyScene>()?;
     m.add_function(wrap_pyfunction!(scene_dict::scene_to_toml, m)?)?;
