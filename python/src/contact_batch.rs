@@ -2,10 +2,9 @@
 //! (rayon) with the GIL released. Each pair is the query of `polydem.contact`, so a batch equals the
 //! single answers bit for bit.
 
-use numpy::{PyArray1, PyArray2};
-use polydem::contact::{ContactGeometry, EpaScratch};
+use numpy::{PyArray1, PyArray2, PyArrayMethods};
+use polydem::contact::{ContactGeometry, ContactKind, EpaScratch};
 use polydem::math::{Pose, Real, Vector};
-use polydem::shape::Shape;
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -15,14 +14,11 @@ use crate::arrays;
 use crate::contact::{exact_query, kind_name, solver_name};
 use crate::shapes::PyShape;
 
-/// The shapes of one side: a single shape for every pair, or a sequence of `n` shapes.
-fn side_shapes(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<Vec<(Shape, Pose)>> {
-    let one = |s: &Bound<'_, PyShape>| {
-        let s = s.get();
-        (s.shape.clone(), s.frame)
-    };
+/// The shapes of one side: a single shape for every pair, or a sequence of `n` shapes. The Python objects
+/// are kept (not their engine shapes copied): the queries borrow them while the GIL is released.
+fn side_shapes<'py>(obj: &Bound<'py, PyAny>, what: &str) -> PyResult<Vec<Bound<'py, PyShape>>> {
     if let Ok(shape) = obj.cast::<PyShape>() {
-        return Ok(vec![one(shape)]);
+        return Ok(vec![shape.clone()]);
     }
     obj.try_iter()
         .map_err(|_| {
@@ -37,7 +33,7 @@ fn side_shapes(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<Vec<(Shape, Pose)
                     item.get_type()
                 ))
             })?;
-            Ok(one(shape))
+            Ok(shape.clone())
         })
         .collect()
 }
@@ -109,7 +105,9 @@ pub fn contact_batch<'py>(
     pose_a: Option<&Bound<'py, PyAny>>,
     pose_b: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let (shapes_a, shapes_b) = (side_shapes(a, "a")?, side_shapes(b, "b")?);
+    let (objects_a, objects_b) = (side_shapes(a, "a")?, side_shapes(b, "b")?);
+    let shapes_a: Vec<&PyShape> = objects_a.iter().map(Bound::get).collect();
+    let shapes_b: Vec<&PyShape> = objects_b.iter().map(Bound::get).collect();
     let (poses_a, poses_b) = (side_poses(pose_a, "pose_a")?, side_poses(pose_b, "pose_b")?);
     let n = pair_count(&[
         (shapes_a.len(), "a", a.cast::<PyShape>().is_err()),
@@ -132,10 +130,11 @@ pub fn contact_batch<'py>(
         (0..n)
             .into_par_iter()
             .map_init(EpaScratch::default, |scratch, i| {
-                let (s1, f1) = pick(&shapes_a, i);
-                let (s2, f2) = pick(&shapes_b, i);
-                let (p1, p2) = (engine_pose(&poses_a, f1, i), engine_pose(&poses_b, f2, i));
-                exact_query(&p1, s1, &p2, s2, scratch).map_err(|e| format!("pair {i}: {e}"))
+                let (s1, s2) = (pick(&shapes_a, i), pick(&shapes_b, i));
+                let p1 = engine_pose(&poses_a, &s1.frame, i);
+                let p2 = engine_pose(&poses_b, &s2.frame, i);
+                exact_query(&p1, &s1.shape, &p2, &s2.shape, scratch)
+                    .map_err(|e| format!("pair {i}: {e}"))
             })
             .collect::<Result<Vec<ContactGeometry>, String>>()
     });
@@ -143,23 +142,52 @@ pub fn contact_batch<'py>(
     batch_dict(py, &answers)
 }
 
-fn batch_dict<'py>(py: Python<'py>, answers: &[ContactGeometry]) -> PyResult<Bound<'py, PyDict>> {
+/// Strings of a few kinds as a numpy array: the names indexed by each answer's code (one vectorised
+/// gather instead of one Python string per answer).
+fn names_array<'py>(
+    py: Python<'py>,
+    names: &[&str],
+    codes: Vec<i64>,
+) -> PyResult<Bound<'py, PyAny>> {
     let numpy = py.import("numpy")?;
-    let strings = |f: fn(&ContactGeometry) -> &'static str| {
-        numpy.call_method1("array", (answers.iter().map(f).collect::<Vec<_>>(),))
-    };
+    numpy
+        .call_method1("array", (names.to_vec(),))?
+        .call_method1("take", (PyArray1::from_vec(py, codes),))
+}
+
+fn batch_dict<'py>(py: Python<'py>, answers: &[ContactGeometry]) -> PyResult<Bound<'py, PyDict>> {
+    let kinds = [
+        ContactKind::Overlap,
+        ContactKind::Touching,
+        ContactKind::Separated,
+    ];
+    let kind_code =
+        |g: &ContactGeometry| kinds.iter().position(|k| *k == g.kind).unwrap_or(0) as i64;
+    let mut solvers: Vec<&'static str> = Vec::new();
+    let solver_codes: Vec<i64> = answers
+        .iter()
+        .map(|g| {
+            let name = solver_name(g.status);
+            let code = solvers.iter().position(|s| *s == name).unwrap_or_else(|| {
+                solvers.push(name);
+                solvers.len() - 1
+            });
+            code as i64
+        })
+        .collect();
     let scalars =
         |f: fn(&ContactGeometry) -> Real| PyArray1::from_vec(py, answers.iter().map(f).collect());
     let vectors = |f: fn(&ContactGeometry) -> [Real; 3]| -> PyResult<Bound<'py, PyArray2<Real>>> {
-        if answers.is_empty() {
-            return Ok(PyArray2::zeros(py, [0, 3], false));
-        }
-        let rows: Vec<Vec<Real>> = answers.iter().map(|g| f(g).to_vec()).collect();
-        Ok(PyArray2::from_vec2(py, &rows)?)
+        let flat: Vec<Real> = answers.iter().flat_map(f).collect();
+        PyArray1::from_vec(py, flat).reshape([answers.len(), 3])
     };
     let d = PyDict::new(py);
-    d.set_item("status", strings(|g| kind_name(g.kind))?)?;
-    d.set_item("solver", strings(|g| solver_name(g.status))?)?;
+    let kind_names: Vec<&str> = kinds.iter().map(|k| kind_name(*k)).collect();
+    d.set_item(
+        "status",
+        names_array(py, &kind_names, answers.iter().map(kind_code).collect())?,
+    )?;
+    d.set_item("solver", names_array(py, &solvers, solver_codes)?)?;
     d.set_item("depth", scalars(|g| g.depth))?;
     d.set_item("distance", scalars(|g| g.distance))?;
     d.set_item("normal", vectors(|g| g.normal.into())?)?;
