@@ -1,4 +1,4 @@
-//! Throughput of the step on 1 and 2 threads (issue 4): the quiet-machine re-measurement.
+//! Throughput of the step on 1 and 2 threads: the quiet-machine re-measurement.
 //!
 //! Three seeded scenes of 10^4 bodies in a box of five walls (built by `tests/support/bed.rs`, the same
 //! builder as the engine tests and `benches/step.rs`), dropped from a tight lattice with random velocities
@@ -443,7 +443,7 @@ fn write_scenes(dir: &std::path::Path, o: &Options) -> Result<(), String> {
         let steps = o.warm_up + o.steps;
         let _ = writeln!(
             t,
-            "# Perf scene '{name}' of issue 4, written by `cargo run --release --example perf_threads -- \
+            "# Perf scene '{name}', written by `cargo run --release --example perf_threads -- \
              --write-scenes DIR` from the seeded builder of tests/support/bed.rs (do not edit; regenerate).\n\
              # {} bodies; {steps} steps of the given time step. Run: RAYON_NUM_THREADS=1 polydem run THIS.toml --out OUT\n\
              [simulation]\ngravity = {}\nend_time = {:?}\noutput_interval = {:?}\ntime_step = {:?}\nskin = {:?}\n",

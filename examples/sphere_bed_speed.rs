@@ -1,4 +1,4 @@
-//! Single-thread speed of the sphere-bed penetration scenes (issue 7): the quiet-machine re-measurement.
+//! Single-thread speed of the sphere-bed penetration scenes: the quiet-machine re-measurement.
 //!
 //! Runs the scene files of `validation/src/cases/sphere_bed.rs` (`scenes/sphere_bed_*.toml`: 3000 settled
 //! spheres, Hertz–Mindlin or linear spring–dashpot with friction and damping, a steel projectile) for the

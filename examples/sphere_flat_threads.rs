@@ -1,7 +1,7 @@
-//! Throughput of the flat sphere path (`polydem::world::SphereSim`) on 1 and 2 threads (issue 7 target:
+//! Throughput of the flat sphere path (`polydem::world::SphereSim`) on 1 and 2 threads (target:
 //! ≥ 1.8× its one-thread speed on 2 threads), on the scene `spheres` of `examples/perf_threads.rs` (10^4
 //! spheres dropped from a lattice into a box of five walls, `tests/support/bed.rs`) and on the sphere
-//! beds of issue 7 (`scenes/sphere_bed_*.toml`).
+//! beds (`scenes/sphere_bed_*.toml`).
 //!
 //! Each scene is warmed up on the flat path (so that the lattice is in contact); then, `--repeat` times,
 //! each variant (a thread count and a split of the team's work, `SphereSim::set_team_split`)

@@ -1,4 +1,4 @@
-//! Issue 3, gate 4 (cube part): a cube resting on an incline sticks for tan θ < μ and slides with
+//! Gate (cube part): a cube resting on an incline sticks for tan θ < μ and slides with
 //! a = g (sin θ − μ cos θ) otherwise, also close to the friction angle (tan θ = 0.9 μ). The incline is a horizontal wall with gravity tilted by θ (the same
 //! problem in the wall's frame); contact through the contact core's polyhedron–plane path, linear normal
 //! law with restitution damping, incremental tangential spring with Coulomb cap, body integrator.

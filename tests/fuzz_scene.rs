@@ -1,4 +1,4 @@
-//! Property-based fuzzing of scene parsing (issue 5, "stability stress tests"): `polydem::scene::parse_scene`
+//! Property-based fuzzing of scene parsing: `polydem::scene::parse_scene`
 //! on random valid scenes and on adversarial mutations of them — a number replaced by NaN, ±inf, 1e±308,
 //! subnormals, zero, negatives or integers beyond i64; lines deleted, duplicated or swapped; a table
 //! duplicated; a character inserted; the text truncated; the hull points of a shape made coplanar or

@@ -1,4 +1,4 @@
-//! Checkpoint/restart (issue 4): a run of N steps and a run of N/2 steps, written to a checkpoint file, read
+//! Checkpoint/restart: a run of N steps and a run of N/2 steps, written to a checkpoint file, read
 //! back and continued for N/2 steps end in the same state bit for bit — every body, the contact store with
 //! its tangential springs, the walls, the broad phase and the energy ledger. Damaged, foreign and future
 //! files are each refused with their own typed error.

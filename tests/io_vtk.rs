@@ -1,4 +1,4 @@
-//! VTK output (issue 4): the frames parse back with an independent VTK reader (vtkio), the point and face
+//! VTK output: the frames parse back with an independent VTK reader (vtkio), the point and face
 //! counts are those of the shapes, every vertex is the world pose of the shape's vertex (to 1e-12 of the
 //! body size; the ASCII numbers are round-trip exact, so in practice to the bit), the per-body fields are
 //! the world's values, the walls are drawn on their planes, and the `.pvd` collections list every frame

@@ -141,7 +141,7 @@ fn damped_collision_restitution_converges_to_the_input() {
                 dts.push(1.0 / per_contact);
                 errors.push((outcome.restitution - target).abs() / target);
             }
-            // Gate 3 of issue 3: within 1 % at a usual resolution (t_c/200).
+            // Gate 3: within 1 % at a usual resolution (t_c/200).
             assert!(
                 errors[1] < 1e-2,
                 "n = {exponent}, e = {target}: restitution off by {} (relative) at dt = t_c/200, tolerance 1e-2; errors {errors:?}",

@@ -1,4 +1,4 @@
-//! Issue 3, gate 1 as `cargo test` gates: single-contact energy conservation of the Minkowski-overlap normal
+//! `cargo test` gates of single-contact energy conservation of the Minkowski-overlap normal
 //! law for polyhedra. The scenes and the measurement live in the validation case
 //! `polydem_validation::cases::single_contact_energy` (documented there); the case's report adds the plots.
 

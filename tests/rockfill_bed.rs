@@ -1,4 +1,4 @@
-//! The packed bed saved as an engine checkpoint (issue 6: "the packed bed saved as a checkpoint so each
+//! The packed bed saved as an engine checkpoint ("the packed bed saved as a checkpoint so each
 //! penetration run starts from it"): the penetration run from the saved bed is the run straight after
 //! packing, every monitor row bitwise equal, and takes the experiment file's contact laws (a changed rock
 //! density is refused); the study and convergence drivers write their tables; the ZY section of a cube is

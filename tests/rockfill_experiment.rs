@@ -1,4 +1,4 @@
-//! The rockfill chain on a small bed (issue 6): packing keeps every rock in the container and the ledger
+//! The rockfill chain on a small bed: packing keeps every rock in the container and the ledger
 //! closed to the measured level, the saved bed reloads to the same state, and the penetration run ends
 //! with the projectile through the layer, finite state and a closed ledger.
 

@@ -1,4 +1,4 @@
-//! Rock generation (paper section 4.1, issue 6): the Voronoi tessellation tiles the box, the cells are convex
+//! Rock generation (paper section 4.1): the Voronoi tessellation tiles the box, the cells are convex
 //! and the shrunk rocks disjoint (exact SAT oracle), and the realised sizes follow the requested distribution.
 
 use polydem::contact::{sat_polyhedra, ContactKind};

@@ -1,4 +1,4 @@
-//! `polydem rockfill sensitivity` (issue 6: the paper's claim that stiffness and friction matter little and
+//! `polydem rockfill sensitivity` (the paper's claim that stiffness and friction matter little and
 //! restitution much, measured from one bed): parameters and values are parsed and checked before any run,
 //! each varied run is the run of the file with that one value changed, from the same bed, bit for bit,
 //! and the table and CSV hold one row per run.

@@ -1,7 +1,7 @@
-//! Sleeping in the rockfill penetration run (issues 4 and 6): the small rockfill bed is packed once, saved,
+//! Sleeping in the rockfill penetration run: the small rockfill bed is packed once, saved,
 //! and the penetration is run from it without and with sleeping (`sleeping.penetration`: the bed starts
 //! asleep and wakes locally, with the wake limit `wake_contact_fraction` = 0.03 of the rocks' contact forces).
-//! - The projectile's residual speed agrees within 0.5 % (issue 4's gate), and its final velocity
+//! - The projectile's residual speed agrees within 0.5 %, and its final velocity
 //!   deflection within 0.1°.
 //! - Some rock-steps are spent asleep (sleeping did something), and the run from the saved bed with
 //!   sleeping is bitwise the run with sleeping straight after packing (the sleeping state is a function of

@@ -1,4 +1,4 @@
-//! Gates of the rotation integrator (issue 3, gate 2 "torque-free precession", unit-test part): the DLM
+//! Gates of the rotation integrator (torque-free precession, unit-test part): the DLM
 //! splitting of paper eqs. 18–25 against the exact torque-free solutions of `polydem::dynamics::analytic`.
 
 use polydem::dynamics::analytic::{AsymmetricTop, Regime, SymmetricTop};

@@ -1,7 +1,7 @@
 //! The flat sphere path (`src/world/sphere_flat/`) steps a world of free spheres to the same bits as the
 //! general step, on one and two threads.
 //!
-//! The scenes are the sphere-bed penetrations of issue 7 (`scenes/sphere_bed_a_hertz_5ms.toml`:
+//! The scenes are the sphere-bed penetrations (`scenes/sphere_bed_a_hertz_5ms.toml`:
 //! Hertz–Mindlin with the tangential dashpot, friction and the force limit; `scenes/sphere_bed_c_linear_5ms.toml`:
 //! the linear spring–dashpot; 3000 settled spheres in an open box of five walls, a steel ball striking at
 //! 5 m/s), run for their first 300 steps: the ball lands at step ~50, so the runs have new, persistent and

@@ -1,4 +1,4 @@
-//! Sphere impacts against closed-form answers (issue 3, gates 3 and 5, sphere part): Hertz elastic impact
+//! Sphere impacts against closed-form answers: Hertz elastic impact
 //! (peak force, peak overlap, contact duration), restitution against a wall, and an oblique impact in gross
 //! sliding against the rigid-body impulse solution. Laws from `polydem::law::hertz_mindlin`, integration by
 //! the body integrator through the shared driver `polydem_validation::sim::two_body`; sphere–sphere and

@@ -1,4 +1,4 @@
-//! Gate: the quick profile of the `chung_ooi` validation case (issue 3, gate 5) — every checked row must
+//! Gate: the quick profile of the `chung_ooi` validation case — every checked row must
 //! pass. The case itself documents the setup and the source of every bound (validation/cases/chung_ooi.toml).
 
 use polydem_validation::{run_case_in_memory, Profile};

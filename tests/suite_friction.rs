@@ -1,4 +1,4 @@
-//! Gate: the quick profile of the `friction` validation case (issue 3, gate 4) — every checked row must
+//! Gate: the quick profile of the `friction` validation case — every checked row must
 //! pass. The case itself documents the setup and the source of every bound (validation/cases/friction.toml).
 
 use polydem_validation::{run_case_in_memory, Profile};

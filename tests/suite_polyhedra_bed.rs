@@ -1,4 +1,4 @@
-//! Gate: the quick profile of the `polyhedra_bed` validation case (issue 7) — the sphere-bed penetration with
+//! Gate: the quick profile of the `polyhedra_bed` validation case — the sphere-bed penetration with
 //! every sphere replaced by a random convex polyhedron of equal volume (variant a, first 4 ms), run beside the
 //! sphere bed. The rows: the polyhedra's volumes, the overlaps of the settled polyhedral bed, finite state,
 //! the energy ledger, the deepest contact and tunnelling. The difference between the beds is reported, not

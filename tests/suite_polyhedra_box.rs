@@ -1,4 +1,4 @@
-//! Gate: the quick profile of the `polyhedra_box` validation case (issue 4) completes, its polydem run
+//! Gate: the quick profile of the `polyhedra_box` validation case completes, its polydem run
 //! has no non-finite state and its energy ledger closes within the case's bound. The speed row (YADE's
 //! CPU time per step over polydem's, target 200×) is a figure of the report, not of this gate: speed
 //! targets live in benchmarks and reports, never in tests on a shared machine.

@@ -1,4 +1,4 @@
-//! Gate: the quick profile of the `restitution` validation case (issue 3, gate 3) — every checked row must
+//! Gate: the quick profile of the `restitution` validation case — every checked row must
 //! pass. The case itself documents the setup and the source of every bound (validation/cases/restitution.toml).
 
 use polydem_validation::{run_case_in_memory, Profile};

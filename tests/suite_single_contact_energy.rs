@@ -1,4 +1,4 @@
-//! Gate: the quick profile of the `single_contact_energy` validation case (issue 3, gate 1) — every checked row must
+//! Gate: the quick profile of the `single_contact_energy` validation case — every checked row must
 //! pass. The case itself documents the setup and the source of every bound (validation/cases/single_contact_energy.toml).
 
 use polydem_validation::{run_case_in_memory, Profile};

@@ -1,4 +1,4 @@
-//! Gate: the quick profile of the `sphere_bed` validation case (issue 7) — polydem's run of the sphere-bed
+//! Gate: the quick profile of the `sphere_bed` validation case — polydem's run of the sphere-bed
 //! penetration (variant b, first 0.6 ms) against the recorded YADE and LIGGGHTS outputs in `reference/`;
 //! every checked row must pass. Needs neither YADE nor LIGGGHTS installed. The case documents the setup and
 //! the source of every bound (validation/cases/sphere_bed.toml); speed is reported, never asserted here.

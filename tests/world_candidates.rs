@@ -1,5 +1,5 @@
 //! The candidate list kept between grid rebuilds, and the per-body inputs written by the drift pass, give
-//! the same step as building them afresh (issue 4).
+//! the same step as building them afresh.
 //!
 //! Stage 3 keeps the previous step's candidate list while the broad phase's lists and every body's dynamic
 //! flag stay the same, and reads the centres and flags that the drift pass wrote

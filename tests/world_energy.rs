@@ -1,4 +1,4 @@
-//! Issue 4 gate: two polyhedra colliding vertex-to-face, elastically, through the whole engine
+//! Gate: two polyhedra colliding vertex-to-face, elastically, through the whole engine
 //! (`scenes/two_polyhedra_elastic.toml`, `World::step`): the energy ledger's balance stays within 1e-4 of
 //! the initial energy at Δt = t_c/200, the collision really happens (the bodies separate spinning), and the
 //! total linear momentum is conserved.

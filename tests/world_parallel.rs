@@ -1,4 +1,4 @@
-//! The parallel step gives bit-identical results for any thread count (issue 4).
+//! The parallel step gives bit-identical results for any thread count.
 //!
 //! A bed of 288 bodies (six random hulls and every fourth body a sphere) in a box of five walls, with
 //! friction (μ = 0.5), contact damping (e = 0.3) and gravity, starts with random velocities and spins from a

@@ -1,4 +1,4 @@
-//! Issue 4 gate: a sphere dropped on a wall through the whole engine (`scenes/sphere_bounce.toml`,
+//! Gate: a sphere dropped on a wall through the whole engine (`scenes/sphere_bounce.toml`,
 //! linear spring–dashpot) rebounds with the restitution given in the scene, within 1 %, at each bounce.
 
 use std::path::Path;

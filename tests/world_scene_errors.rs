@@ -1,4 +1,4 @@
-//! Bad scenes give errors that name the file, the line and the field (issue 4: bad input never panics).
+//! Bad scenes give errors that name the file, the line and the field (bad input never panics).
 //! Each case edits one line of a valid scene; the expected line number is found in the text, not typed.
 
 use std::path::PathBuf;

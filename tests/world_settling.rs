@@ -1,4 +1,4 @@
-//! Issue 4 gates on a many-body scene, `scenes/settling_box.toml` (20 random polyhedra falling into a box of
+//! Gates on a many-body scene, `scenes/settling_box.toml` (20 random polyhedra falling into a box of
 //! five walls):
 //! - the run ends at rest, with no non-finite state (a step error would fail the run) and no body below the
 //!   floor;

@@ -7,7 +7,7 @@
 //! rock, a known problem in the README. A disordered sphere bed keeps rolling for the same reason of budget.) A steel sphere (radius 0.05 m, 5 m/s downwards) starts above the
 //! bed so that it arrives after ~500 steps, and the run continues while it ploughs into the bed. With
 //! sleeping on, the bed falls asleep before the impact and the projectile's island wakes when it touches it.
-//! - The projectile's velocity at the end agrees with the run without sleeping within 0.5 % (issue 4).
+//! - The projectile's velocity at the end agrees with the run without sleeping within 0.5 %.
 //! - Sleeping evaluates fewer contact candidates over the run.
 //! - The run with sleeping is bit-identical for 1 and 2 threads.
 //! - While the bed sleeps, the floor carries its weight (the frozen contacts keep their forces).

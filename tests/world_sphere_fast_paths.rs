@@ -1,6 +1,6 @@
 //! The work a sphere run can leave out changes nothing else, bit for bit.
 //!
-//! The scene is the sphere-bed penetration of issue 7 (`scenes/sphere_bed_a_hertz_5ms.toml`: 3000 settled
+//! The scene is the sphere-bed penetration (`scenes/sphere_bed_a_hertz_5ms.toml`: 3000 settled
 //! spheres, Hertz–Mindlin with the tangential dashpot, friction and the force limit, an open box of five
 //! walls, a steel ball striking at 5 m/s), run for its first 300 steps: the ball lands at step ~50, so the
 //! run has new, persistent and opening contacts between spheres and against the walls.

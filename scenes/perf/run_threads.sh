@@ -1,5 +1,5 @@
 #!/usr/bin/env sh
-# Throughput of the step on 1 and 2 threads on the perf scenes of issue 4 (10^4 polyhedra settling, the
+# Throughput of the step on 1 and 2 threads on the perf scenes (10^4 polyhedra settling, the
 # same bed struck by a steel sphere at 10 m/s, 10^4 spheres); see examples/perf_threads.rs for the scenes
 # and what is printed (wall and CPU time, particle-steps/s, contacts/s, stage timers, load average, and
 # whether 2 threads end in the bit-identical state). Run from the repository root on a quiet machine:

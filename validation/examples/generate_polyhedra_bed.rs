@@ -1,4 +1,4 @@
-//! Generates the polyhedral sphere-bed of issue 7 and writes its settled state
+//! Generates the polyhedral sphere-bed and writes its settled state
 //! (`reference/sphere_bed/polyhedra_bed.csv`), or writes a runnable scene file of it.
 //!
 //! ```sh
