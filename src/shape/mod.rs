@@ -27,6 +27,7 @@ mod support;
 pub mod surface_mesh;
 
 pub use aabb::Aabb;
+pub use hull::{MAX_EXTENT, MIN_EXTENT};
 pub use convex::{ConvexShape, SurfaceMesh};
 pub use ellipsoid::Ellipsoid;
 pub use error::ShapeError;

@@ -24,6 +24,7 @@ pub mod sphere_flat;
 pub mod step;
 pub mod timing;
 pub mod tunnelling;
+mod material_presence;
 mod wall;
 #[allow(clippy::module_inception)]
 pub mod world;
@@ -36,4 +37,4 @@ pub use sleeping::{SleepParams, SleepState};
 pub use sphere_flat::{NotSphereOnly, SphereSim, StepFlatError};
 pub use step::sphere::applies as sphere_step_applies;
 pub use step::{step, StepCounters, StepError, StepParams, StepReport, StepScratch};
-pub use world::{Loads, MaterialTable, Wall, World, WorldError};
+pub use world::{Loads, MaterialTable, SetupStats, Wall, World, WorldError};
