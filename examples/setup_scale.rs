@@ -48,7 +48,11 @@ impl Case {
     }
 
     fn name(&self) -> String {
-        let kind = if self.polyhedra { "polyhedra" } else { "spheres" };
+        let kind = if self.polyhedra {
+            "polyhedra"
+        } else {
+            "spheres"
+        };
         format!("{kind}_{}", self.bodies)
     }
 }

@@ -47,7 +47,9 @@ fn distinct_points_below_the_smallest_extent_are_refused_with_the_range_not_as_c
                 );
                 assert_eq!((min, max), (MIN_EXTENT, MAX_EXTENT), "size {size:e}");
             }
-            other => panic!("tetrahedron of size {size:e}: expected ExtentOutOfRange, got {other:?}"),
+            other => {
+                panic!("tetrahedron of size {size:e}: expected ExtentOutOfRange, got {other:?}")
+            }
         }
     }
 }

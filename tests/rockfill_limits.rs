@@ -43,7 +43,10 @@ fn a_sample_above_the_rock_limit_is_refused_before_generation() {
                 "{rocks} rocks against the limit {limit}: {message}"
             );
             for part in ["12 mm", "GB", "--max-rocks", "limits.max_rocks"] {
-                assert!(message.contains(part), "the message names '{part}': {message}");
+                assert!(
+                    message.contains(part),
+                    "the message names '{part}': {message}"
+                );
             }
         }
         Err(other) => panic!("12 mm rocks: expected TooManyRocks, got {other}"),
@@ -59,15 +62,30 @@ fn a_penetration_step_too_small_is_refused_with_its_step_count() {
     config.impact.travel_per_step = 1e-12;
     let mut quiet = |_: &str, _: String| {};
     let options = PenetrationOptions::default();
-    match run_experiment_with(&config, BedSource::Generate { save: None }, &options, &mut quiet) {
-        Err(ExperimentError::Limit(e @ LimitError::TooManySteps { stage, steps, limit, .. })) => {
+    match run_experiment_with(
+        &config,
+        BedSource::Generate { save: None },
+        &options,
+        &mut quiet,
+    ) {
+        Err(ExperimentError::Limit(
+            e @ LimitError::TooManySteps {
+                stage,
+                steps,
+                limit,
+                ..
+            },
+        )) => {
             let message = e.to_string();
             assert!(
                 stage == "penetration" && steps > limit as f64,
                 "{stage}: {steps:e} steps, limit {limit}: {message}"
             );
             for part in ["impact.travel_per_step", "--max-steps", "GB"] {
-                assert!(message.contains(part), "the message names '{part}': {message}");
+                assert!(
+                    message.contains(part),
+                    "the message names '{part}': {message}"
+                );
             }
         }
         Err(other) => panic!("travel_per_step = 1e-12: expected TooManySteps, got {other}"),
@@ -87,7 +105,12 @@ fn packing_and_penetration_check_their_steps_once_the_time_step_is_known() {
     tight.limits.max_steps = 1000;
     // A short impact, so that its bound known before generation (~2 steps) passes and the packing's is hit.
     tight.impact.max_time = 1e-5;
-    match run_experiment_with(&tight, BedSource::Generate { save: None }, &options, &mut quiet) {
+    match run_experiment_with(
+        &tight,
+        BedSource::Generate { save: None },
+        &options,
+        &mut quiet,
+    ) {
         Err(ExperimentError::Packing(PackingError::Limit(LimitError::TooManySteps {
             stage: "packing",
             ..
@@ -96,8 +119,13 @@ fn packing_and_penetration_check_their_steps_once_the_time_step_is_known() {
         Ok(_) => panic!("max_steps 1000: expected the packing's refusal"),
     }
     let config = small();
-    let run = run_experiment_with(&config, BedSource::Generate { save: Some(&dir) }, &options, &mut quiet)
-        .unwrap();
+    let run = run_experiment_with(
+        &config,
+        BedSource::Generate { save: Some(&dir) },
+        &options,
+        &mut quiet,
+    )
+    .unwrap();
     let steps = run.penetration.steps;
     let mut short = small();
     // Below the penetration's bound max_time / Δt but above what the travel bound alone allows.
@@ -128,8 +156,13 @@ fn a_bed_of_another_rock_size_is_refused_naming_both_sizes() {
         ..PenetrationOptions::default()
     };
     let config = small();
-    run_experiment_with(&config, BedSource::Generate { save: Some(&dir) }, &options, &mut quiet)
-        .unwrap();
+    run_experiment_with(
+        &config,
+        BedSource::Generate { save: Some(&dir) },
+        &options,
+        &mut quiet,
+    )
+    .unwrap();
     let mut other = small();
     other.rock.mean_size = 0.2;
     let got = run_experiment_with(&other, BedSource::Load(&dir), &options, &mut quiet);
@@ -139,7 +172,10 @@ fn a_bed_of_another_rock_size_is_refused_naming_both_sizes() {
         Err(e @ ExperimentError::BedSize { .. }) => {
             let message = e.to_string();
             for part in ["290 mm", "200 mm", "--size 290"] {
-                assert!(message.contains(part), "the message names '{part}': {message}");
+                assert!(
+                    message.contains(part),
+                    "the message names '{part}': {message}"
+                );
             }
         }
         Err(other) => panic!("200 mm run on a 290 mm bed: expected BedSize, got {other}"),

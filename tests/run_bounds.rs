@@ -40,14 +40,21 @@ fn refusal(text: &str, what: &str) -> (String, String) {
     match load(text) {
         Err(SceneError::Invalid { field, message, .. }) => (field, message),
         Err(other) => panic!("{what}: expected an invalid value, got {other}"),
-        Ok(sim) => panic!("{what}: expected a refusal, got a scene of {} steps", sim.steps),
+        Ok(sim) => panic!(
+            "{what}: expected a refusal, got a scene of {} steps",
+            sim.steps
+        ),
     }
 }
 
 #[test]
 fn step_counts_beyond_the_counter_are_refused_at_set_up_not_saturated() {
     let cases = [
-        ("end_time = 1e300", edit("end_time", "end_time = 1e300"), "derived"),
+        (
+            "end_time = 1e300",
+            edit("end_time", "end_time = 1e300"),
+            "derived",
+        ),
         (
             "time_step = 1e-300",
             edit("steps_per_contact", "time_step = 1e-300"),
@@ -94,8 +101,14 @@ fn a_run_above_the_step_limit_is_refused_unless_max_steps_raises_it() {
         &format!("end_time = 1e4\nmax_steps = {steps}"),
     );
     let sim = load(&raised).unwrap_or_else(|e| panic!("with max_steps = {steps}: {e}"));
-    assert_eq!(sim.steps, steps, "the run covers the steps the message stated");
-    let short = raised.replace(&format!("max_steps = {steps}"), &format!("max_steps = {}", steps - 1));
+    assert_eq!(
+        sim.steps, steps,
+        "the run covers the steps the message stated"
+    );
+    let short = raised.replace(
+        &format!("max_steps = {steps}"),
+        &format!("max_steps = {}", steps - 1),
+    );
     refusal(&short, "max_steps one below the count");
     let zero = raised.replace(&format!("max_steps = {steps}"), "max_steps = 0");
     let (field, message) = refusal(&zero, "max_steps = 0");
@@ -112,9 +125,15 @@ fn a_later_end_time_is_held_to_the_same_limits() {
     }
     match sim.set_end_time(1e4) {
         Err(EndTimeError::Steps(StepCountError::AboveLimit { steps, limit, .. })) => {
-            assert!(steps > limit && limit == DEFAULT_MAX_STEPS, "{steps} steps, limit {limit}");
+            assert!(
+                steps > limit && limit == DEFAULT_MAX_STEPS,
+                "{steps} steps, limit {limit}"
+            );
             sim.set_end_time_within(1e4, steps).unwrap();
-            assert_eq!(sim.steps, steps, "raised limit: the run covers the stated steps");
+            assert_eq!(
+                sim.steps, steps,
+                "raised limit: the run covers the stated steps"
+            );
         }
         other => panic!("end time 1e4: expected the limit refusal, got {other:?}"),
     }

@@ -40,7 +40,10 @@ fn wall(k: usize, material: u32) -> Wall {
     Wall {
         name: format!("w{k}"),
         plane: Plane::new(Vector::z(), 0.0).unwrap(),
-        pose: Pose::from_parts(Vector::new(0.0, 0.0, -(k as Real)).into(), Rotation::identity()),
+        pose: Pose::from_parts(
+            Vector::new(0.0, 0.0, -(k as Real)).into(),
+            Rotation::identity(),
+        ),
         velocity: Vector::zeros(),
         material,
     }
@@ -127,7 +130,11 @@ fn material_checks_report_the_missing_law_of_the_full_scan() {
         let holes: Vec<(u32, u32)> = (0..rng.random_range(0..4))
             .map(|_| (rng.random_range(0..5), rng.random_range(0..5)))
             .collect();
-        let missing = |a: u32, b: u32| holes.iter().any(|&(x, y)| (x, y) == (a, b) || (y, x) == (a, b));
+        let missing = |a: u32, b: u32| {
+            holes
+                .iter()
+                .any(|&(x, y)| (x, y) == (a, b) || (y, x) == (a, b))
+        };
         let table = materials(5, missing);
         let mut world = World::new(Vector::zeros(), table.clone(), 0.001);
         let shape = world.add_shape(Shape::Sphere(Sphere::new(0.01).unwrap()));
@@ -149,7 +156,10 @@ fn material_checks_report_the_missing_law_of_the_full_scan() {
             let name = format!("b{i}");
             let want = scan_reference(&table, &bodies, &walls, m, &name);
             let got = world.add_body(&name, shape, m, sphere_body(i)).map(|_| ());
-            assert_eq!(got, want, "case {case}, body {i} of material {m}, holes {holes:?}");
+            assert_eq!(
+                got, want,
+                "case {case}, body {i} of material {m}, holes {holes:?}"
+            );
             if got.is_ok() {
                 bodies.push(m);
                 accepted += 1;

@@ -18,10 +18,14 @@ pub const DEFAULT_MAX_STEPS: u64 = 1_000_000_000;
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum StepCountError {
     /// end_time / Δt does not fit the step counter (or is not a number).
-    #[error("end time {end_time:e} s at Δt = {dt:e} s is {steps:e} steps, beyond the step counter's range ({} steps); shorten the end time or lengthen the step", u64::MAX)]
-    Overflow { end_time: Real, dt: Real, steps: Real },
+    #[error("end time {end_time:?} s at Δt = {dt:?} s is {steps:e} steps, beyond the step counter's range ({} steps); shorten the end time or lengthen the step", u64::MAX)]
+    Overflow {
+        end_time: Real,
+        dt: Real,
+        steps: Real,
+    },
     /// The run is longer than the limit.
-    #[error("end time {end_time:e} s at Δt = {dt:e} s is {steps} steps, above the limit of {limit} steps; raise the limit explicitly (simulation.max_steps in a scene, --max-steps on the command line) to run it")]
+    #[error("end time {end_time:?} s at Δt = {dt:?} s is {steps} steps, above the limit of {limit} steps; raise the limit explicitly (simulation.max_steps in a scene, --max-steps on the command line) to run it")]
     AboveLimit {
         end_time: Real,
         dt: Real,
@@ -34,8 +38,8 @@ pub enum StepCountError {
 /// a whole number of steps is not rounded up by one more), refused above `limit`.
 pub fn step_count(end_time: Real, dt: Real, limit: u64) -> Result<u64, StepCountError> {
     let ratio = end_time / dt;
-    // `u64::MAX as Real` is 2^64: every f64 below it converts to u64 without saturating (NaN fails too).
-    if !(ratio < u64::MAX as Real) {
+    // `u64::MAX as Real` is 2^64: every f64 below it converts to u64 without saturating.
+    if ratio.is_nan() || ratio >= u64::MAX as Real {
         return Err(StepCountError::Overflow {
             end_time,
             dt,

@@ -27,10 +27,10 @@ mod support;
 pub mod surface_mesh;
 
 pub use aabb::Aabb;
-pub use hull::{MAX_EXTENT, MIN_EXTENT};
 pub use convex::{ConvexShape, SurfaceMesh};
 pub use ellipsoid::Ellipsoid;
 pub use error::ShapeError;
+pub use hull::{MAX_EXTENT, MIN_EXTENT};
 pub use mass::MassProperties;
 pub use plane::Plane;
 pub use polyhedron::ConvexPolyhedron;

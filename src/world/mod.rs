@@ -14,6 +14,7 @@ mod body_inputs;
 pub mod broad_phase;
 pub mod contact_store;
 pub mod energy;
+mod material_presence;
 pub mod parallel;
 pub mod region_profile;
 mod separation_bound;
@@ -24,7 +25,6 @@ pub mod sphere_flat;
 pub mod step;
 pub mod timing;
 pub mod tunnelling;
-mod material_presence;
 mod wall;
 #[allow(clippy::module_inception)]
 pub mod world;

@@ -248,7 +248,12 @@ impl World {
     /// also with every wall and itself (walls never touch each other). The bodies' materials are read from
     /// the presence table ([`super::material_presence`]), one look-up per distinct material; a missing law
     /// is reported for the first body, then the first wall, that lacks one, as a scan of every body would.
-    fn check_material(&mut self, owner: &str, material: u32, is_wall: bool) -> Result<(), WorldError> {
+    fn check_material(
+        &mut self,
+        owner: &str,
+        material: u32,
+        is_wall: bool,
+    ) -> Result<(), WorldError> {
         if material as usize >= self.materials.len() {
             return Err(WorldError::UnknownMaterial {
                 owner: owner.to_owned(),

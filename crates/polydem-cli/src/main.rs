@@ -192,9 +192,7 @@ fn run(args: &RunArgs) -> Result<()> {
         (None, None) => bail!("give a scene file or --restart FILE"),
     };
     if let Some(t) = args.end_time {
-        let limit = args
-            .max_steps
-            .unwrap_or(polydem::scene::DEFAULT_MAX_STEPS);
+        let limit = args.max_steps.unwrap_or(polydem::scene::DEFAULT_MAX_STEPS);
         sim.set_end_time_within(t, limit)
             .with_context(|| format!("--end-time {t}"))?;
     }

@@ -107,7 +107,7 @@ pub fn check_penetration_steps(
         "Δt = min(the rocks' Δt,"
     };
     let reason = format!(
-        "impact.max_time = {} s over Δt, {rule} impact.travel_per_step {} × rock.mean_size {} m / impact.speed {} m/s{}; one monitor row per step, {rows_gb:.3e} GB",
+        "impact.max_time = {:?} s over Δt, {rule} impact.travel_per_step {:?} × rock.mean_size {:?} m / impact.speed {:?} m/s{}; one monitor row per step, {rows_gb:.3e} GB",
         imp.max_time,
         imp.travel_per_step,
         config.rock.mean_size,
@@ -121,8 +121,7 @@ pub fn check_penetration_steps(
 /// to the layer at `compaction_speed`, `hold_time` and `restore_time`, over Δt; refused above the limit.
 pub fn check_packing_steps(config: &ExperimentConfig, dt: Real) -> Result<(), LimitError> {
     let p = &config.packing;
-    let compaction =
-        (p.generation_height_factor - 1.0) * config.layer.height / p.compaction_speed;
+    let compaction = (p.generation_height_factor - 1.0) * config.layer.height / p.compaction_speed;
     let restore = p.restore_time.unwrap_or(0.0);
     let time = p.max_deposition_time + compaction + p.hold_time + restore;
     let reason = format!(

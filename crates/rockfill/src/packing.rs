@@ -66,8 +66,8 @@ use std::time::{Duration, Instant};
 
 use super::collapse::CollapseReport;
 use super::config::{ConfigError, DepositionDamping, ExperimentConfig};
-use super::limits::{check_packing_steps, LimitError};
 use super::grading::Rock;
+use super::limits::{check_packing_steps, LimitError};
 use polydem::dynamics::{BodyError, PrincipalInertia, RigidBody, ViscousDamping};
 use polydem::math::{Point, Pose, Real, Rotation, Vector};
 use polydem::scene::time_step::{contact_time_and_limit, PairEstimate};

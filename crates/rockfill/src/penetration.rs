@@ -342,7 +342,10 @@ pub fn penetrate_with(
     let imp = &config.impact;
     let dt = penetration_time_step(config, world)? / options.dt_divisor;
     // A run stopped after `max_steps` (a benchmark's stretch) is bounded by that.
-    if options.max_steps.is_none_or(|m| m > config.limits.max_steps) {
+    if options
+        .max_steps
+        .is_none_or(|m| m > config.limits.max_steps)
+    {
         check_penetration_steps(config, dt, false)?;
     }
     let mut params = StepParams::new(dt);

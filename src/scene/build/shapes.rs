@@ -160,7 +160,11 @@ impl Named<'_> {
             self.ctx.invalid(
                 span,
                 self.field(field),
-                format!("shape '{}' ({}): {e}", self.s.name.get_ref(), self.used_by()),
+                format!(
+                    "shape '{}' ({}): {e}",
+                    self.s.name.get_ref(),
+                    self.used_by()
+                ),
             )
         })?;
         Ok((Shape::Polyhedron(Arc::new(p)), frame))

@@ -41,11 +41,7 @@ pub(super) fn step_count(
 ) -> Result<u64, SceneError> {
     let limit = match &sim.max_steps {
         Some(m) if *m.get_ref() == 0 => {
-            return Err(ctx.invalid(
-                m.span(),
-                "simulation.max_steps",
-                "must be at least 1",
-            ))
+            return Err(ctx.invalid(m.span(), "simulation.max_steps", "must be at least 1"))
         }
         Some(m) => *m.get_ref(),
         None => DEFAULT_MAX_STEPS,
@@ -53,7 +49,7 @@ pub(super) fn step_count(
     let dt = time_step.dt;
     let origin = if time_step.derived {
         format!(
-            "derived: shortest contact time {:e} s / steps_per_contact",
+            "derived: t_c / steps_per_contact, t_c = {:?} s the shortest contact time of the laws and the lightest bodies",
             time_step.contact_time
         )
     } else {
@@ -62,12 +58,12 @@ pub(super) fn step_count(
     run_length::step_count(run.end_time, dt, limit).map_err(|e| {
         let message = match e {
             StepCountError::Overflow { steps, .. } => format!(
-                "{:e} s at Δt = {dt:e} s ({origin}) is {steps:e} steps, beyond the step counter's range ({} steps): shorten end_time or lengthen the step",
+                "{:?} s at Δt = {dt:?} s ({origin}) is {steps:e} steps, beyond the step counter's range ({} steps): shorten end_time or lengthen the step",
                 run.end_time,
                 u64::MAX
             ),
             StepCountError::AboveLimit { steps, limit, .. } => format!(
-                "{:e} s at Δt = {dt:e} s ({origin}) is {steps} steps, above the limit of {limit} steps: set simulation.max_steps to at least {steps} to run it",
+                "{:?} s at Δt = {dt:?} s ({origin}) is {steps} steps, above the limit of {limit} steps: set simulation.max_steps to at least {steps} to run it",
                 run.end_time
             ),
         };
