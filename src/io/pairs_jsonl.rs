@@ -11,7 +11,8 @@
 //! than 4 points, a non-finite coordinate, a degenerate hull) yields `{"id", "line", "error"}` instead, where
 //! `id` is present only when it could be read and `line` is the 1-based line number in the input; the other
 //! lines are still answered. Lines that are empty or whitespace only are skipped and produce no output, but
-//! still count for line numbers. The full description is `docs/contact-jsonl.md`.
+//! still count for line numbers. A UTF-8 byte-order mark at the start of the input is skipped. The full
+//! description is `docs/contact-jsonl.md`.
 //!
 //! Everything here is pure (reader in, writer out); the query itself is passed in.
 
@@ -198,6 +199,9 @@ pub fn error_json(id: Option<Value>, line: usize, error: &LineError) -> String {
         .unwrap_or_else(|e| format!("{{\"line\":{line},\"error\":\"serialisation failed: {e}\"}}"))
 }
 
+/// The UTF-8 encoding of U+FEFF, the byte-order mark.
+const UTF8_BOM: &[u8] = b"\xEF\xBB\xBF";
+
 /// Answers every line of `input`, writing one output line per non-blank input line. Only I/O failures of
 /// the reader or writer abort the run; every problem with a line's content becomes that line's error record.
 pub fn answer_stream<R, W, Q>(
@@ -219,7 +223,12 @@ where
             break;
         }
         line_number += 1;
-        let answer = match std::str::from_utf8(&buffer) {
+        // A byte-order mark some editors put at the start of a UTF-8 file is not part of the first line.
+        let text = match buffer.strip_prefix(UTF8_BOM) {
+            Some(rest) if line_number == 1 => rest,
+            _ => &buffer[..],
+        };
+        let answer = match std::str::from_utf8(text) {
             Ok(line) => answer_line(line, line_number, query),
             Err(_) => Some(Err(error_json(None, line_number, &LineError::NotUtf8))),
         };

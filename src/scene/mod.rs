@@ -10,11 +10,13 @@ pub mod body_file;
 pub mod build;
 pub mod orientation;
 pub mod run;
+pub mod run_length;
 pub mod schema;
 pub mod simulation;
 pub mod time_step;
 
 pub use build::{load_scene, parse_scene, SceneError};
 pub use run::{EndTimeError, RunError, RunObserver, RunSummary, StepPath, PROGRESS_STEPS};
+pub use run_length::{step_count, StepCountError, DEFAULT_MAX_STEPS};
 pub use simulation::Simulation;
 pub use time_step::TimeStepInfo;

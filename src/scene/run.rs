@@ -17,7 +17,8 @@ use crate::world::{
     step, SphereSim, StepCounters, StepError, StepFlatError, StepReport, StepScratch,
 };
 
-use super::simulation::{steps_to, Simulation};
+use super::run_length::{step_count, StepCountError, DEFAULT_MAX_STEPS};
+use super::simulation::Simulation;
 
 /// What a run hands the state to: outputs, frames, checkpoints, progress.
 pub trait RunObserver {
@@ -199,13 +200,23 @@ impl Simulation {
     }
 
     /// Moves the end of the run to `end_time` (s), e.g. to continue a restored checkpoint further: the run
-    /// then covers ⌈end_time / Δt⌉ steps in total (counted from step 0, as the scene's own end time is).
+    /// then covers ⌈end_time / Δt⌉ steps in total (counted from step 0, as the scene's own end time is),
+    /// at most [`DEFAULT_MAX_STEPS`] (see [`Self::set_end_time_within`]).
     pub fn set_end_time(&mut self, end_time: Real) -> Result<(), EndTimeError> {
+        self.set_end_time_within(end_time, DEFAULT_MAX_STEPS)
+    }
+
+    /// [`Self::set_end_time`] with the limit `max_steps` on the run's total number of steps.
+    pub fn set_end_time_within(
+        &mut self,
+        end_time: Real,
+        max_steps: u64,
+    ) -> Result<(), EndTimeError> {
         let dt = self.params.dt;
         if !(end_time.is_finite() && end_time > 0.0) {
             return Err(EndTimeError::NotPositive { end_time });
         }
-        let steps = steps_to(end_time, dt);
+        let steps = step_count(end_time, dt, max_steps)?;
         if steps < self.world.step_index {
             return Err(EndTimeError::BeforeNow {
                 end_time,
@@ -230,6 +241,8 @@ pub enum EndTimeError {
         time: Real,
         step: u64,
     },
+    #[error(transparent)]
+    Steps(#[from] StepCountError),
 }
 
 impl std::fmt::Display for RunSummary {

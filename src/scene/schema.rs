@@ -42,6 +42,9 @@ pub struct SimulationSection {
     pub end_time: Spanned<f64>,
     /// Interval between output rows (s); rounded to a whole number of steps (at least one).
     pub output_interval: Spanned<f64>,
+    /// The most steps the run may take (end_time / Δt); absent = `crate::scene::DEFAULT_MAX_STEPS`. A
+    /// longer run is refused unless this is raised.
+    pub max_steps: Option<Spanned<u64>>,
     /// A given time step (s), refused when above the stability limit. Exclusive with `steps_per_contact`.
     pub time_step: Option<Spanned<f64>>,
     /// N in Δt = t_c,min / N (see the docs for t_c). Exclusive with `time_step`.

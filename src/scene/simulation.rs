@@ -30,9 +30,3 @@ impl Simulation {
         self.world.bodies[i].orientation * self.frames[i].rotation.inverse()
     }
 }
-
-/// The number of steps of size `dt` that covers `end_time` (at least one; an end time within 1e-9 steps
-/// of a whole number of steps is not rounded up by one more).
-pub(crate) fn steps_to(end_time: Real, dt: Real) -> u64 {
-    (end_time / dt - 1e-9).ceil().max(1.0) as u64
-}

@@ -45,7 +45,7 @@ pub(crate) const HULL_REL_TOL: Real = 1e-10;
 /// particle far from the origin has coordinates rounded at a larger fraction of its size).
 pub(crate) fn hull_tolerance(points: &[Point], extent: Real) -> Real {
     let largest = points.iter().map(|p| p.coords.amax()).fold(0.0, Real::max);
-    HULL_REL_TOL * extent + 64.0 * Real::EPSILON * largest
+    HULL_REL_TOL * extent + COORDINATE_ROUNDING * largest
 }
 
 /// Relative thickness below which a cloud is rejected as collinear or coplanar. A face of width w and
@@ -61,7 +61,9 @@ pub(crate) struct PolygonMesh {
     pub faces: Vec<Vec<u32>>,
 }
 
-/// Checks the count and finiteness of `points` and returns their extent (diagonal of the bounding box).
+/// Checks the count and finiteness of `points` and returns their extent (diagonal of the bounding box),
+/// refusing a cloud whose points coincide, whose extent lies outside [`MIN_EXTENT`, `MAX_EXTENT`], or
+/// whose extent is below what the round-off of its coordinates resolves (see [`COORDINATE_ROUNDING`]).
 pub(crate) fn validate_points(points: &[Point]) -> Result<Real, ShapeError> {
     if points.len() < 4 {
         return Err(ShapeError::TooFewPoints {
@@ -84,14 +86,59 @@ pub(crate) fn validate_points(points: &[Point]) -> Result<Real, ShapeError> {
         mins = mins.inf(p);
         maxs = maxs.sup(p);
     }
-    let extent = (maxs - mins).norm();
-    if !extent.is_finite() {
-        return Err(ShapeError::HullFailed {
-            reason: format!("extent of the cloud overflows ({extent})"),
+    let extent = diagonal(&(maxs - mins));
+    if extent == 0.0 {
+        return Err(ShapeError::Coincident { extent });
+    }
+    if !(MIN_EXTENT..=MAX_EXTENT).contains(&extent) {
+        return Err(ShapeError::ExtentOutOfRange {
+            extent,
+            min: MIN_EXTENT,
+            max: MAX_EXTENT,
+        });
+    }
+    let largest = points.iter().map(|p| p.coords.amax()).fold(0.0, Real::max);
+    let rounding = COORDINATE_ROUNDING * largest;
+    if rounding > ROUND_OFF_FRACTION * extent {
+        return Err(ShapeError::BelowRoundOff {
+            extent,
+            largest,
+            rounding,
+            min_extent: rounding / ROUND_OFF_FRACTION,
         });
     }
     Ok(extent)
 }
+
+/// The length of `d` without overflow or underflow of its squares: the largest component times the length
+/// of `d` scaled by it (a box 1e-300 across has a diagonal of 1.7e-300, not 0).
+fn diagonal(d: &Vector) -> Real {
+    let side = d.amax();
+    if side == 0.0 || !side.is_finite() {
+        return side;
+    }
+    side * (d / side).norm()
+}
+
+/// The smallest extent (m) of a cloud the hull builder takes. The mass properties of a solid scale with
+/// the fifth power of its size (principal moments per unit density, m⁵), and they must stay normal f64
+/// numbers (above 2.2e-308): (1e-60)⁵ = 1e-300 leaves eight orders of magnitude for the density and the
+/// shape's proportions.
+pub const MIN_EXTENT: Real = 1e-60;
+
+/// The largest extent (m): (1e60)⁵ = 1e300, eight orders of magnitude below the f64 overflow at 1.8e308.
+pub const MAX_EXTENT: Real = 1e60;
+
+/// The round-off the coordinates carry, as a multiple of the largest coordinate magnitude (64 ε, the term of
+/// [`hull_tolerance`]).
+const COORDINATE_ROUNDING: Real = 64.0 * Real::EPSILON;
+
+/// The largest part of a cloud's extent its coordinates' round-off may be: beyond 1e-3 the hull tolerance
+/// (which includes that round-off) is a visible fraction of the shape, faces a tenth of a percent apart
+/// merge, and a 1 mm cube 1e11 m from the origin lost its faces altogether. A cloud smaller than
+/// [`COORDINATE_ROUNDING`] / 1e-3 = 1.4e-11 times its largest coordinate is refused with the size it would
+/// need there.
+const ROUND_OFF_FRACTION: Real = 1e-3;
 
 /// Finds four points spanning a tetrahedron of non-negligible thickness, or reports the cloud as coincident,
 /// collinear or coplanar. Returns the indices of the four points.
@@ -629,6 +676,8 @@ mod tests {
         );
     }
 
+    /// Coordinates of 1e200 span an extent beyond [`MAX_EXTENT`]: refused with the range, before any
+    /// product of coordinates can overflow.
     #[test]
     fn overflowing_coordinates_are_a_typed_error() {
         let points = vec![
@@ -637,9 +686,10 @@ mod tests {
             Point::new(0.0, 1e200, 0.0),
             Point::new(0.0, 0.0, 1e200),
         ];
-        assert!(matches!(
-            convex_hull(&points),
-            Err(ShapeError::HullFailed { .. })
-        ));
+        let got = convex_hull(&points);
+        assert!(
+            matches!(got, Err(ShapeError::ExtentOutOfRange { .. })),
+            "extent 1.7e200: expected ExtentOutOfRange, got {got:?}"
+        );
     }
 }

@@ -30,6 +30,7 @@ pub use aabb::Aabb;
 pub use convex::{ConvexShape, SurfaceMesh};
 pub use ellipsoid::Ellipsoid;
 pub use error::ShapeError;
+pub use hull::{MAX_EXTENT, MIN_EXTENT};
 pub use mass::MassProperties;
 pub use plane::Plane;
 pub use polyhedron::ConvexPolyhedron;

@@ -21,6 +21,8 @@ use crate::shape::Shape;
 use super::broad_phase::BroadPhase;
 use super::contact_store::ContactStore;
 use super::energy::{EnergyLedger, EnergyReport};
+use super::material_presence::MaterialPresence;
+pub use super::material_presence::SetupStats;
 use super::sleep_state::SleepState;
 
 pub use super::wall::Wall;
@@ -151,6 +153,9 @@ pub struct World {
     /// Simulated time (s) and completed steps.
     pub time: Real,
     pub step_index: u64,
+    /// The materials the bodies use, for the set-up checks (rebuilt after a checkpoint is read).
+    #[serde(skip)]
+    presence: MaterialPresence,
 }
 
 impl World {
@@ -173,6 +178,7 @@ impl World {
             sleep: SleepState::default(),
             time: 0.0,
             step_index: 0,
+            presence: MaterialPresence::default(),
         }
     }
 
@@ -239,8 +245,15 @@ impl World {
     }
 
     /// The material exists and has a law with the material of every body already present, and, for a body,
-    /// also with every wall and itself (walls never touch each other).
-    fn check_material(&self, owner: &str, material: u32, is_wall: bool) -> Result<(), WorldError> {
+    /// also with every wall and itself (walls never touch each other). The bodies' materials are read from
+    /// the presence table ([`super::material_presence`]), one look-up per distinct material; a missing law
+    /// is reported for the first body, then the first wall, that lacks one, as a scan of every body would.
+    fn check_material(
+        &mut self,
+        owner: &str,
+        material: u32,
+        is_wall: bool,
+    ) -> Result<(), WorldError> {
         if material as usize >= self.materials.len() {
             return Err(WorldError::UnknownMaterial {
                 owner: owner.to_owned(),
@@ -248,26 +261,41 @@ impl World {
                 count: self.materials.len(),
             });
         }
-        let body_only: Vec<u32> = if is_wall {
-            Vec::new()
-        } else {
-            self.walls
-                .iter()
-                .map(|w| w.material)
-                .chain(std::iter::once(material))
-                .collect()
-        };
-        let others = self.material_of.iter().copied().chain(body_only);
-        for other in others {
-            if self.materials.model(material, other).is_none() {
-                return Err(WorldError::MissingLaw {
-                    owner: owner.to_owned(),
-                    a: self.materials.name(material).to_owned(),
-                    b: self.materials.name(other).to_owned(),
-                });
-            }
+        self.presence.record(&self.material_of);
+        let mut lookups = 0;
+        let mut walls_read = 0;
+        let lacks = |other: u32| self.materials.model(material, other).is_none();
+        let mut missing = self.presence.present().iter().copied().find(|&other| {
+            lookups += 1;
+            lacks(other)
+        });
+        if missing.is_none() && !is_wall {
+            missing = self.walls.iter().map(|w| w.material).find(|&other| {
+                walls_read += 1;
+                lookups += 1;
+                lacks(other)
+            });
         }
-        Ok(())
+        if missing.is_none() && !is_wall {
+            lookups += 1;
+            missing = lacks(material).then_some(material);
+        }
+        let stats = &mut self.presence.stats;
+        stats.law_lookups += lookups;
+        stats.walls_read += walls_read;
+        match missing {
+            None => Ok(()),
+            Some(other) => Err(WorldError::MissingLaw {
+                owner: owner.to_owned(),
+                a: self.materials.name(material).to_owned(),
+                b: self.materials.name(other).to_owned(),
+            }),
+        }
+    }
+
+    /// The work the set-up checks of this world have done since it was made (or read from a checkpoint).
+    pub fn setup_stats(&self) -> SetupStats {
+        self.presence.stats
     }
 
     /// The pose of body `i` (body frame = the shape's principal frame → world).

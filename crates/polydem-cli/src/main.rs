@@ -134,6 +134,10 @@ struct RunArgs {
     /// Simulated end time (s), replacing the scene's or the checkpoint's.
     #[arg(long, value_name = "T", allow_negative_numbers = true)]
     end_time: Option<f64>,
+    /// The most steps the run may cover with --end-time (default 1e9; a scene sets its own with
+    /// simulation.max_steps).
+    #[arg(long, value_name = "N", requires = "end_time")]
+    max_steps: Option<u64>,
     /// Write VTK frames every T seconds of simulated time (and at the start and the end).
     #[arg(long, value_name = "T", allow_negative_numbers = true)]
     vtk_interval: Option<f64>,
@@ -180,7 +184,9 @@ fn run(args: &RunArgs) -> Result<()> {
         (None, None) => bail!("give a scene file or --restart FILE"),
     };
     if let Some(t) = args.end_time {
-        sim.set_end_time(t).context("--end-time")?;
+        let limit = args.max_steps.unwrap_or(polydem::scene::DEFAULT_MAX_STEPS);
+        sim.set_end_time_within(t, limit)
+            .with_context(|| format!("--end-time {t}"))?;
     }
     let restarted = matches!(run, RunStart::Restart { .. });
     let origin = RunOrigin {

@@ -95,6 +95,14 @@ pub struct ExperimentArgs {
     /// Override the file's `sleeping.packing`.
     #[arg(long, value_name = "true|false")]
     pub sleep_packing: Option<bool>,
+    /// The most rocks generation may make (the file's `limits.max_rocks`; default 200000): a larger sample
+    /// is refused before generation with its rock count and memory estimate.
+    #[arg(long, value_name = "N")]
+    pub max_rocks: Option<usize>,
+    /// The most steps of the packing and of the penetration run, each (the file's `limits.max_steps`;
+    /// default 1e7): a longer stage is refused before it starts with its step count.
+    #[arg(long, value_name = "N")]
+    pub max_steps: Option<u64>,
 }
 
 impl ExperimentArgs {
@@ -105,6 +113,14 @@ impl ExperimentArgs {
         }
         if let Some(on) = self.sleep_packing {
             config.sleeping.packing = on;
+        }
+        if let Some(n) = self.max_rocks {
+            anyhow::ensure!(n > 0, "--max-rocks {n}: must be at least 1");
+            config.limits.max_rocks = n;
+        }
+        if let Some(n) = self.max_steps {
+            anyhow::ensure!(n > 0, "--max-steps {n}: must be at least 1");
+            config.limits.max_steps = n;
         }
         Ok((config, name))
     }

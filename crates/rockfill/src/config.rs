@@ -9,6 +9,7 @@
 
 use std::path::Path;
 
+pub use super::limits::RunLimits;
 use super::projectile::ProjectileParams;
 use polydem::law::{ContactModel, DampingLaw, LawError, NormalLaw, TangentialLaw};
 use polydem::math::Real;
@@ -224,6 +225,9 @@ pub struct ExperimentConfig {
     /// Optional (see [`SleepingConfig`]).
     #[serde(default)]
     pub sleeping: SleepingConfig,
+    /// Optional: the most rocks and steps the run may take (see [`RunLimits`]).
+    #[serde(default)]
+    pub limits: RunLimits,
 }
 
 /// The full-scale experiment (the file `scenes/rockfill/paper.toml`, compiled in).
@@ -393,6 +397,13 @@ impl ExperimentConfig {
             if !(value.is_finite() && value >= 0.0) {
                 return Err(invalid(field, value, "must be finite and non-negative"));
             }
+        }
+        if self.limits.max_rocks == 0 || self.limits.max_steps == 0 {
+            return Err(invalid(
+                "limits.max_rocks / limits.max_steps",
+                0.0,
+                "must be at least 1",
+            ));
         }
         if self.packing.generation_height_factor < 1.0 {
             return Err(invalid(

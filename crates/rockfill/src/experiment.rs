@@ -9,6 +9,7 @@ use super::bed::{
 use super::collapse::{collapse, CollapseParams};
 use super::config::ExperimentConfig;
 use super::generation::{generate, GenerationError, GenerationParams, Sample};
+use super::limits::{check_penetration_steps, check_rock_count, LimitError};
 use super::packing::{
     empty_world, load_bed, loose_world, pack, save_bed, PackingError, PackingReport,
 };
@@ -48,6 +49,18 @@ pub enum ExperimentError {
         bed: Real,
         config: Real,
     },
+    #[error(
+        "bed {dir} was packed from {bed_mm} mm rocks (its bed_info.json), but the run asks for {config_mm} mm \
+         (--size or rock.mean_size): the size sets the penetration's time step and the unit of the disturbed \
+         zone, so the run would be labelled and stepped as another bed; run with --size {bed_mm}, or pack a new bed"
+    )]
+    BedSize {
+        dir: String,
+        bed_mm: Real,
+        config_mm: Real,
+    },
+    #[error(transparent)]
+    Limit(#[from] LimitError),
 }
 
 /// Where the bed comes from.
@@ -97,6 +110,11 @@ pub type Progress<'a> = &'a mut dyn FnMut(&str, String);
 /// Generates the graded sample of `config` in the region above the layer (x ∈ [0, L], y ∈ [0, W],
 /// z ∈ [0, H · generation_height_factor]).
 pub fn generate_sample(config: &ExperimentConfig) -> Result<Sample, ExperimentError> {
+    Ok(generate(&generation_params(config)?)?)
+}
+
+/// What [`generate_sample`] generates from `config`.
+pub fn generation_params(config: &ExperimentConfig) -> Result<GenerationParams, ExperimentError> {
     let l = &config.layer;
     let region = Region::new(
         Point::origin(),
@@ -109,7 +127,36 @@ pub fn generate_sample(config: &ExperimentConfig) -> Result<Sample, ExperimentEr
     let mut params = GenerationParams::new(region, config.rock.mean_size, config.rock.seed);
     params.sigma_fraction = config.rock.sigma_fraction;
     params.range_fraction = config.rock.range_fraction;
-    Ok(generate(&params)?)
+    Ok(params)
+}
+
+/// The limits that can be checked before any rock is generated: the rock count, and the penetration's
+/// steps at the largest Δt the projectile's travel per step allows.
+pub fn check_limits_before_generation(config: &ExperimentConfig) -> Result<(), ExperimentError> {
+    check_rock_count(&generation_params(config)?, config.limits.max_rocks)?;
+    let imp = &config.impact;
+    let dt_bound = imp.travel_per_step * config.rock.mean_size / imp.speed;
+    check_penetration_steps(config, dt_bound, true)?;
+    Ok(())
+}
+
+/// A bed recorded at one rock size is refused for a run at another (a bed without `bed_info.json` has no
+/// recorded size).
+fn check_bed_size(
+    config: &ExperimentConfig,
+    dir: &Path,
+    info: Option<&BedInfo>,
+) -> Result<(), ExperimentError> {
+    let Some(info) = info else { return Ok(()) };
+    let (bed, asked) = (info.mean_size, config.rock.mean_size);
+    if (bed - asked).abs() > 1e-9 * bed.abs().max(asked.abs()) {
+        return Err(ExperimentError::BedSize {
+            dir: dir.display().to_string(),
+            bed_mm: bed * 1e3,
+            config_mm: asked * 1e3,
+        });
+    }
+    Ok(())
 }
 
 /// A bed read from its checkpoint keeps its rocks (shapes, masses, state) and takes the contact laws of
@@ -166,6 +213,8 @@ pub fn run_experiment_with(
     let projectile = Projectile::new(config.projectile)?;
     let (mut world, generation, packing, bed_info, from_checkpoint) = match bed {
         BedSource::Load(dir) => {
+            let info = load_bed_info(dir)?;
+            check_bed_size(config, dir, info.as_ref())?;
             let mut checkpoint = has_checkpoint(dir);
             let mut world = if checkpoint {
                 match load_bed_checkpoint(dir) {
@@ -202,9 +251,10 @@ pub fn run_experiment_with(
                     if checkpoint { "checkpoint" } else { "CSV" }
                 ),
             );
-            (world, None, None, load_bed_info(dir)?, checkpoint)
+            (world, None, None, info, checkpoint)
         }
         BedSource::Generate { save } => {
+            check_limits_before_generation(config)?;
             let start = std::time::Instant::now();
             let sample = generate_sample(config)?;
             let (requested_mean, var) = sample.sizes.bin_mean_and_variance();

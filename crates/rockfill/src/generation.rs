@@ -79,8 +79,10 @@ pub struct Sample {
     pub grading_time: Duration,
 }
 
-/// Generates a graded sample (see the module docs).
-pub fn generate(params: &GenerationParams) -> Result<Sample, GenerationError> {
+/// The size law of `params` and the mean cell radius r of eq. 28 (m) it gives.
+pub fn size_law_and_cell_radius(
+    params: &GenerationParams,
+) -> Result<(SizeDistribution, Real), GenerationError> {
     let sizes = SizeDistribution::truncated_normal(
         params.mean_size,
         params.sigma_fraction,
@@ -88,6 +90,12 @@ pub fn generate(params: &GenerationParams) -> Result<Sample, GenerationError> {
         params.bins,
     )?;
     let cell_radius = 0.5 * params.cell_to_rock_ratio * sizes.max_size();
+    Ok((sizes, cell_radius))
+}
+
+/// Generates a graded sample (see the module docs).
+pub fn generate(params: &GenerationParams) -> Result<Sample, GenerationError> {
+    let (sizes, cell_radius) = size_law_and_cell_radius(params)?;
     let count = seed_count(params.region.volume(), cell_radius)?;
     let mut rng = ChaCha8Rng::seed_from_u64(params.seed);
     let seeds = random_seeds(&params.region, count, &mut rng);

@@ -10,6 +10,7 @@
 //! - [`statistics`]: realised size distribution and shape statistics;
 //! - [`projectile`]: the ogive-nosed projectile with its internal cavity (mass properties solid − cavity);
 //! - [`config`]: the experiment's parameters as data (Table 1 and what the paper does not state), the laws;
+//! - [`limits`]: the most rocks and steps a run may take, checked before the work starts;
 //! - [`collapse`]: the geometric pre-collapse of the loose sample (rocks moved straight down until nearly
 //!   supported) that the packing starts from;
 //! - [`packing`]: the container, deposition under gravity, compaction by a moving top wall, hold, bed CSV;
@@ -26,6 +27,7 @@ pub mod convergence;
 pub mod experiment;
 pub mod generation;
 pub mod grading;
+pub mod limits;
 pub mod packing;
 pub mod penetration;
 pub mod projectile;

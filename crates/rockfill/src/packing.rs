@@ -67,6 +67,7 @@ use std::time::{Duration, Instant};
 use super::collapse::CollapseReport;
 use super::config::{ConfigError, DepositionDamping, ExperimentConfig};
 use super::grading::Rock;
+use super::limits::{check_packing_steps, LimitError};
 use polydem::dynamics::{BodyError, PrincipalInertia, RigidBody, ViscousDamping};
 use polydem::math::{Point, Pose, Real, Rotation, Vector};
 use polydem::scene::time_step::{contact_time_and_limit, PairEstimate};
@@ -103,6 +104,8 @@ pub enum PackingError {
     UnstableStep { dt: Real, limit: Real },
     #[error("bed file {path}: {message}")]
     BedFile { path: String, message: String },
+    #[error(transparent)]
+    Limit(#[from] LimitError),
 }
 
 /// The world of the experiment: materials (rock, steel, wall) with Table 1's laws, gravity −9.81 e_z.
@@ -473,6 +476,7 @@ pub fn pack(
         set_rock_density(world, config.rock.density * scale)?;
     }
     let (dt, contact_time) = packing_time_step(config, world)?;
+    check_packing_steps(config, dt)?;
     let mut params = StepParams::new(dt);
     let local_alpha = match p.deposition_damping {
         Some(DepositionDamping::Local) => p.local_damping,

@@ -22,6 +22,7 @@
 use std::time::{Duration, Instant};
 
 use super::config::ExperimentConfig;
+use super::limits::{check_penetration_steps, LimitError};
 use super::packing::{rock_time_step, top_wall_height, PackingError, KEPT_WALLS, STEEL};
 use super::projectile::Projectile;
 use polydem::dynamics::{Motion, RigidBody, ViscousDamping};
@@ -43,6 +44,8 @@ pub enum PenetrationError {
     Step(#[from] StepError),
     #[error("the bed has only {walls} walls; a packed bed has {expected}")]
     NotABed { walls: usize, expected: usize },
+    #[error(transparent)]
+    Limit(#[from] LimitError),
 }
 
 /// One row of the monitor time series.
@@ -342,6 +345,13 @@ pub fn penetrate_with(
     let start = Instant::now();
     let imp = &config.impact;
     let dt = penetration_time_step(config, world)? / options.dt_divisor;
+    // A run stopped after `max_steps` (a benchmark's stretch) is bounded by that.
+    if options
+        .max_steps
+        .is_none_or(|m| m > config.limits.max_steps)
+    {
+        check_penetration_steps(config, dt, false)?;
+    }
     let mut params = StepParams::new(dt);
     params.damping = ViscousDamping::None;
     params.sleeping = config.sleeping.params(config.sleeping.penetration);

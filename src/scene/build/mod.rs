@@ -22,7 +22,6 @@ mod walls;
 use std::path::{Path, PathBuf};
 
 use super::schema::SceneFile;
-use super::simulation::steps_to;
 pub use super::simulation::Simulation;
 use ctx::Ctx;
 
@@ -88,6 +87,7 @@ fn build(ctx: &Ctx, file: &SceneFile) -> Result<Simulation, SceneError> {
     body_files::read(ctx, file, &materials, &mut shapes, &mut bodies)?;
     let walls = walls::read(ctx, file, &materials)?;
     let time_step = step_size::choose(ctx, sim, &materials.table, &shapes, &bodies, &walls)?;
+    let steps = simulation::step_count(ctx, sim, &run, &time_step)?;
     let damping = simulation::viscous_damping(ctx, sim)?;
     let skin = simulation::skin(ctx, sim, &shapes)?;
     let assembled = assemble::world(
@@ -100,7 +100,6 @@ fn build(ctx: &Ctx, file: &SceneFile) -> Result<Simulation, SceneError> {
         walls,
     )?;
     let params = simulation::step_params(ctx, sim, time_step.dt, damping)?;
-    let steps = steps_to(run.end_time, time_step.dt);
     let output_every = ((run.output_interval / time_step.dt).round() as u64).max(1);
     Ok(Simulation {
         world: assembled.world,

@@ -98,23 +98,7 @@ fn build_shape(
             ));
         }
     }
-    let users: Vec<&str> = file
-        .bodies
-        .iter()
-        .filter(|b| b.shape.get_ref() == s.name.get_ref())
-        .map(|b| b.name.get_ref().as_str())
-        .collect();
-    let used_by = if users.is_empty() {
-        String::from("not used by any body")
-    } else {
-        format!("used by body '{}'", users.join("', '"))
-    };
-    let named = Named {
-        ctx,
-        k,
-        s,
-        used_by: &used_by,
-    };
+    let named = Named { ctx, file, k, s };
     builder(&named)
 }
 
@@ -131,13 +115,30 @@ fn expected_kinds() -> String {
 /// A `[[shape]]` being built, with what its error messages name.
 struct Named<'a> {
     ctx: &'a Ctx<'a>,
+    /// The scene, whose bodies a hull error names.
+    file: &'a SceneFile,
     k: usize,
     s: &'a ShapeSection,
-    /// Which bodies use the shape (a hull error names them).
-    used_by: &'a str,
 }
 
 impl Named<'_> {
+    /// Which bodies use the shape; read only for an error message, so that building the shapes does not
+    /// scan every body once per shape.
+    fn used_by(&self) -> String {
+        let users: Vec<&str> = self
+            .file
+            .bodies
+            .iter()
+            .filter(|b| b.shape.get_ref() == self.s.name.get_ref())
+            .map(|b| b.name.get_ref().as_str())
+            .collect();
+        if users.is_empty() {
+            String::from("not used by any body")
+        } else {
+            format!("used by body '{}'", users.join("', '"))
+        }
+    }
+
     fn field(&self, name: &str) -> String {
         format!("shape[{}].{name}", self.k)
     }
@@ -159,7 +160,11 @@ impl Named<'_> {
             self.ctx.invalid(
                 span,
                 self.field(field),
-                format!("shape '{}' ({}): {e}", self.s.name.get_ref(), self.used_by),
+                format!(
+                    "shape '{}' ({}): {e}",
+                    self.s.name.get_ref(),
+                    self.used_by()
+                ),
             )
         })?;
         Ok((Shape::Polyhedron(Arc::new(p)), frame))

@@ -7,7 +7,9 @@ use crate::dynamics::ViscousDamping;
 use crate::math::{Real, Vector};
 use crate::world::StepParams;
 
+use super::super::run_length::{self, StepCountError, DEFAULT_MAX_STEPS};
 use super::super::schema::SimulationSection;
+use super::super::time_step::TimeStepInfo;
 use super::shapes::Shapes;
 use super::{Ctx, SceneError};
 
@@ -26,6 +28,47 @@ impl RunLength {
             output_interval: ctx.positive(&sim.output_interval, "simulation.output_interval")?,
         })
     }
+}
+
+/// The run's number of steps, end_time / Δt, refused above `simulation.max_steps` (absent =
+/// [`DEFAULT_MAX_STEPS`]) or beyond the step counter, with the count, where Δt came from, the limit and how
+/// to raise it.
+pub(super) fn step_count(
+    ctx: &Ctx,
+    sim: &SimulationSection,
+    run: &RunLength,
+    time_step: &TimeStepInfo,
+) -> Result<u64, SceneError> {
+    let limit = match &sim.max_steps {
+        Some(m) if *m.get_ref() == 0 => {
+            return Err(ctx.invalid(m.span(), "simulation.max_steps", "must be at least 1"))
+        }
+        Some(m) => *m.get_ref(),
+        None => DEFAULT_MAX_STEPS,
+    };
+    let dt = time_step.dt;
+    let origin = if time_step.derived {
+        format!(
+            "derived: t_c / steps_per_contact, t_c = {:?} s the shortest contact time of the laws and the lightest bodies",
+            time_step.contact_time
+        )
+    } else {
+        "given by simulation.time_step".to_owned()
+    };
+    run_length::step_count(run.end_time, dt, limit).map_err(|e| {
+        let message = match e {
+            StepCountError::Overflow { steps, .. } => format!(
+                "{:?} s at Δt = {dt:?} s ({origin}) is {steps:e} steps, beyond the step counter's range ({} steps): shorten end_time or lengthen the step",
+                run.end_time,
+                u64::MAX
+            ),
+            StepCountError::AboveLimit { steps, limit, .. } => format!(
+                "{:?} s at Δt = {dt:?} s ({origin}) is {steps} steps, above the limit of {limit} steps: set simulation.max_steps to at least {steps} to run it",
+                run.end_time
+            ),
+        };
+        ctx.invalid(sim.end_time.span(), "simulation.end_time", message)
+    })
 }
 
 /// `simulation.viscous_damping_rate`: absent = none.
