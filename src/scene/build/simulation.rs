@@ -5,7 +5,7 @@ use crate::contact::pair_smoothing::PairSmoothing;
 use crate::contact::wall_depth::WallDepth;
 use crate::dynamics::ViscousDamping;
 use crate::math::{Real, Vector};
-use crate::world::StepParams;
+use crate::world::{StepParams, TimeStepCheck};
 
 use super::super::schema::SimulationSection;
 use super::shapes::Shapes;
@@ -78,7 +78,26 @@ pub(super) fn step_params(
     params.tolerances.wall_depth = wall_depth(ctx, sim)?;
     params.tolerances.pair_smoothing = pair_smoothing(ctx, sim)?;
     params.energy_ledger = sim.energy_ledger.as_ref().is_none_or(|l| *l.get_ref());
+    params.time_step_check = time_step_check(ctx, sim)?;
     Ok(params)
+}
+
+/// `simulation.time_step_check`: what the run does when its check finds the motion too fast for the
+/// step (see `crate::world::step::guard`); absent = stop.
+fn time_step_check(ctx: &Ctx, sim: &SimulationSection) -> Result<TimeStepCheck, SceneError> {
+    let Some(value) = &sim.time_step_check else {
+        return Ok(TimeStepCheck::default());
+    };
+    match value.get_ref().as_str() {
+        "stop" => Ok(TimeStepCheck::Stop),
+        "warn" => Ok(TimeStepCheck::Warn),
+        "off" => Ok(TimeStepCheck::Off),
+        other => Err(ctx.invalid(
+            value.span(),
+            "simulation.time_step_check",
+            format!("must be \"stop\", \"warn\" or \"off\", got \"{other}\""),
+        )),
+    }
 }
 
 /// `simulation.wall_depth` and `simulation.wall_depth_band`: how a polyhedron–wall contact turns the vertex
