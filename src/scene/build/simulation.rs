@@ -2,10 +2,12 @@
 //! the global viscous damping, the Verlet skin, and the tolerances of the step.
 
 use crate::contact::pair_smoothing::PairSmoothing;
-use crate::contact::wall_depth::WallDepth;
+use crate::contact::wall_depth::{WallDepth, MAX_BAND};
 use crate::dynamics::ViscousDamping;
 use crate::math::{Real, Vector};
 use crate::world::{StepParams, TimeStepCheck};
+
+use toml::Spanned;
 
 use super::super::schema::SimulationSection;
 use super::shapes::Shapes;
@@ -104,7 +106,10 @@ fn time_step_check(ctx: &Ctx, sim: &SimulationSection) -> Result<TimeStepCheck, 
 /// depths into the law's overlap. A band given with the deepest-vertex rule is refused (it would be ignored).
 fn wall_depth(ctx: &Ctx, sim: &SimulationSection) -> Result<WallDepth, SceneError> {
     let band = match &sim.wall_depth_band {
-        Some(b) => Some((ctx.positive(b, "simulation.wall_depth_band")?, b.span())),
+        Some(b) => Some((
+            smoothing_band(ctx, b, "simulation.wall_depth_band")?,
+            b.span(),
+        )),
         None => None,
     };
     let rule = sim
@@ -128,11 +133,26 @@ fn wall_depth(ctx: &Ctx, sim: &SimulationSection) -> Result<WallDepth, SceneErro
     }
 }
 
+/// A smoothing band (fraction of the particle size): positive and at most [`MAX_BAND`], where the
+/// smoothing's derivation holds (see [`MAX_BAND`]).
+fn smoothing_band(ctx: &Ctx, band: &Spanned<f64>, field: &str) -> Result<Real, SceneError> {
+    let value = ctx.positive(band, field)?;
+    if value > MAX_BAND {
+        return Err(ctx.invalid(band.span(), field, format!(
+            "{value} exceeds {MAX_BAND}: the band should be about the scene's overlap (static overlap under load, or the peak overlap of the impacts), and overlaps beyond {MAX_BAND} of the particle size are already deep overlaps; a wider band lets the smoothed depth fall short of the true one by up to 0.22 × band × the particle size, so bodies sink into walls or each other unreported"
+        )));
+    }
+    Ok(value)
+}
+
 /// `simulation.pair_smoothing` and `simulation.pair_smoothing_band`: the overlap a polyhedron–polyhedron
 /// contact hands to the law. A band given with the exact overlap is refused (it would be ignored).
 fn pair_smoothing(ctx: &Ctx, sim: &SimulationSection) -> Result<PairSmoothing, SceneError> {
     let band = match &sim.pair_smoothing_band {
-        Some(b) => Some((ctx.positive(b, "simulation.pair_smoothing_band")?, b.span())),
+        Some(b) => Some((
+            smoothing_band(ctx, b, "simulation.pair_smoothing_band")?,
+            b.span(),
+        )),
         None => None,
     };
     let rule = sim
