@@ -299,25 +299,27 @@ fn body_at_a_million_metres_per_second_stops_instead_of_passing_through() {
             body,
             speed: found,
             displacement,
-            smallest_size,
+            closing,
+            smallest_radius,
             ..
         } = *finding
         else {
             panic!("{path}: expected a tunnelling finding, got {finding:?}");
         };
         assert_eq!((step, body), (1, 0), "{path}: {finding:?}");
+        // The other body is still: the closing bound is the fast body's own move.
         assert!(
             (found - speed).abs() <= 1e-12 * speed
-                && displacement > smallest_size
-                && smallest_size == 2.0 * RADIUS,
-            "{path}: speed {found} m/s (expected {speed}), move {displacement} m, smallest size {smallest_size} m (expected {})",
-            2.0 * RADIUS
+                && closing == displacement
+                && displacement > smallest_radius
+                && smallest_radius == RADIUS,
+            "{path}: speed {found} m/s (expected {speed}), move {displacement} m, closing bound {closing} m, smallest radius {smallest_radius} m (expected {RADIUS})"
         );
     }
 }
 
 /// Bodies that move more than half the skin in one step are counted (as "dangerous builds"), one per
-/// body and step, and are not a finding while the move stays below the smallest particle size.
+/// body and step, and are not a finding while the two close by less than the smallest radius per step.
 #[test]
 fn moves_beyond_half_the_skin_are_counted_per_body_and_step() {
     let mut sim = impact_at_099_of_the_limit(1.0, 0.05, 0.0, None);
@@ -325,7 +327,7 @@ fn moves_beyond_half_the_skin_are_counted_per_body_and_step() {
     let dt = sim.params.dt;
     // 0.75 of the skin per step: beyond half of it, far below the diameter.
     let speed = 0.75 * skin / dt;
-    assert!(speed * dt < 2.0 * RADIUS, "skin {skin} m, step {dt} s");
+    assert!(2.0 * speed * dt < RADIUS, "skin {skin} m, step {dt} s");
     sim.world.bodies[0].velocity = Vector::new(-speed, 0.0, 0.0);
     sim.world.bodies[1].velocity = Vector::new(speed, 0.0, 0.0);
     let steps = 5;
@@ -367,5 +369,40 @@ fn time_step_check_key_is_read_and_checked_like_every_scene_key() {
             );
         }
         other => panic!("expected an invalid-field error, got {other:?}"),
+    }
+}
+
+/// Two bodies each moving 0.6 of the smallest radius per step towards each other close by 1.2 of it:
+/// a finding at the first step, though neither alone moves a radius; at 0.4 each (closing 0.8) the
+/// run goes on (the pair is still far from listed, so no approach speed is judged either).
+#[test]
+fn two_bodies_closing_by_more_than_the_smallest_radius_per_step_stop() {
+    for (fraction, stops) in [(0.6, true), (0.4, false)] {
+        let mut sim = impact_at_099_of_the_limit(1.0, 1.0, 0.0, None);
+        let speed = fraction * RADIUS / sim.params.dt;
+        sim.world.bodies[0].velocity = Vector::new(speed, 0.0, 0.0);
+        sim.world.bodies[1].velocity = Vector::new(-speed, 0.0, 0.0);
+        for (path, error) in [
+            ("general step", run_general(&mut sim.clone(), 3).0),
+            ("flat layout", run_flat(&sim, 3).0),
+        ] {
+            match (&error, stops) {
+                (Some(StepError::TimeStep { step: 1, finding }), true) => {
+                    let TimeStepFinding::Tunnelling { closing, .. } = **finding else {
+                        panic!("{path}: expected a tunnelling finding, got {finding:?}");
+                    };
+                    let want = 2.0 * fraction * RADIUS;
+                    assert!(
+                        (closing - want).abs() <= 1e-12 * want,
+                        "{path}: closing bound {closing} m, expected {want} m"
+                    );
+                }
+                (None, false) => {}
+                _ => panic!(
+                    "{path}: each body {fraction} of the radius per step: expected {}, got {error:?}",
+                    if stops { "a stop at step 1" } else { "no finding" }
+                ),
+            }
+        }
     }
 }

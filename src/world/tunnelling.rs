@@ -1,6 +1,11 @@
 //! Tunnelling detection: an observer that, after every step, finds bodies whose path during the step
 //! went through another body or through a wall.
 //!
+//! This is the exact test, O(N²) per step, for verification runs. Every run takes its cheap form, the
+//! check of the time step (`world::step::guard`): when two bodies can close by more than the smallest
+//! particle radius in one step, which a crossing of kind [`CrossingKind::Missed`] needs, it is a
+//! finding there (the run stops by default).
+//!
 //! # Definition
 //! Let step n → n+1 move every body's centre of mass from x_i(n) to x_i(n+1) and turn it from R_i(n) to
 //! R_i(n+1). For a dynamic body i and an obstacle:

@@ -21,10 +21,15 @@
 //!    body has between list builds) are counted ([`super::StepCounters::dangerous_moves`]). The lists
 //!    are checked every step, so no pair is missed at the evaluated positions; a count above zero says
 //!    the skin no longer saves list builds, and how often bodies move by large steps.
-//! 3. **Tunnelling.** A body whose move in one step exceeds the smallest particle size (bounding
-//!    diameter) can pass through a body between two evaluated positions with no pair ever overlapping
-//!    (the exact, O(N²) test of this is [`crate::world::tunnelling`]): a finding, named with its speed
-//!    and move.
+//! 3. **Tunnelling.** Two bodies apart at one step (centres at least r_A + r_B apart for spheres) can
+//!    have a centre inside the other at the next only if they closed by more than the radius of the one
+//!    that entered; no two bodies close by more than (v₁ + v₂) Δt in one step (v₁, v₂ the two largest
+//!    body speeds; v₁ plus the fastest wall's speed against a wall). When that exceeds the smallest
+//!    particle radius (bounding radius: the inradius of a sphere, more than that of a polyhedron), a
+//!    centre can pass into another body between two contact queries with no pair ever overlapping (the
+//!    exact, O(N²) test of this is [`crate::world::tunnelling`]): a finding, named with the fastest
+//!    body, its speed and its move. Two bodies far apart that each move half the smallest radius per
+//!    step are flagged as well: the bound does not look at where they are.
 //!
 //! A finding stops the step with [`StepError::TimeStep`] ([`TimeStepCheck::Stop`], the default), is
 //! reported in [`super::StepReport::time_step_findings`] ([`TimeStepCheck::Warn`]), or the check is not
@@ -74,15 +79,18 @@ pub enum TimeStepFinding {
         /// The step (s).
         dt: Real,
     },
-    /// A body moves farther in one step than the smallest particle size.
+    /// Two bodies (or a body and a wall) can close by more than the smallest particle radius in one step.
     Tunnelling {
+        /// The fastest body.
         body: usize,
         name: String,
-        /// |v| (m/s) and |v| Δt (m).
+        /// Its speed |v| (m/s) and move |v| Δt (m).
         speed: Real,
         displacement: Real,
-        /// The smallest bounding diameter of the scene (m).
-        smallest_size: Real,
+        /// The bound on how far two bodies, or a body and a wall, close in one step (m).
+        closing: Real,
+        /// The smallest bounding radius of the scene (m).
+        smallest_radius: Real,
     },
 }
 
@@ -105,18 +113,18 @@ impl std::fmt::Display for TimeStepFinding {
                 name,
                 speed,
                 displacement,
-                smallest_size,
-                ..
+                closing,
+                smallest_radius,
             } => write!(
                 f,
-                "body {body} ('{name}') moves {displacement:.4e} m in one step (speed {speed:.4e} m/s), more than the smallest particle size {smallest_size:.4e} m: it can pass through another body with no contact tested (shorten the step)"
+                "body {body} ('{name}') moves {displacement:.4e} m in one step (speed {speed:.4e} m/s); bodies can close by up to {closing:.4e} m in one step, more than the smallest particle radius {smallest_radius:.4e} m: a body can pass into another with no contact tested (shorten the step)"
             ),
         }
     }
 }
 
 /// What the check keeps of a world between steps: the pair estimates of the load-time guard, the
-/// critical approach speed of the step, and the smallest particle size; formed again when the world's
+/// critical approach speed of the step, and the smallest particle radius; formed again when the world's
 /// size or the step changes.
 #[derive(Clone, Debug, Default)]
 pub(crate) struct Guard {
@@ -124,7 +132,7 @@ pub(crate) struct Guard {
     estimates: Vec<PairEstimate>,
     kappa: Real,
     critical_speed: Real,
-    smallest_size: Real,
+    smallest_radius: Real,
 }
 
 impl Guard {
@@ -159,7 +167,7 @@ impl Guard {
         self.critical_speed = critical_speed(&estimates, kappa, dt);
         self.estimates = estimates;
         self.kappa = kappa;
-        self.smallest_size = 2.0 * world.radii.iter().copied().fold(Real::INFINITY, Real::min);
+        self.smallest_radius = world.radii.iter().copied().fold(Real::INFINITY, Real::min);
         self.key = Some(key);
     }
 }
@@ -235,7 +243,8 @@ where
         .iter()
         .map(|w| w.velocity.norm())
         .fold(0.0, Real::max);
-    if top.first + top.second.max(wall_speed) > guard.critical_speed {
+    let closing_speed = top.first + top.second.max(wall_speed);
+    if closing_speed > guard.critical_speed {
         if let Some((key, speed)) = fastest_approach(bodies, pairs()) {
             if speed > guard.critical_speed {
                 found.push(TimeStepFinding::FastApproach {
@@ -249,13 +258,14 @@ where
             }
         }
     }
-    if top.first * dt > guard.smallest_size {
+    if closing_speed * dt > guard.smallest_radius {
         found.push(TimeStepFinding::Tunnelling {
             body: top.body,
             name: bodies.names[top.body].clone(),
             speed: top.first,
             displacement: top.first * dt,
-            smallest_size: guard.smallest_size,
+            closing: closing_speed * dt,
+            smallest_radius: guard.smallest_radius,
         });
     }
     match (mode, found.is_empty()) {
