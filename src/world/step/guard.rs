@@ -37,6 +37,11 @@
 //!
 //! Cost: one pass over the bodies' velocities per step (a read of each velocity, a squared norm and two
 //! comparisons), and a pass over the listed pairs only in the steps where the speed bound exceeds v_c.
+//! Folding the pair scan into every step's pair loop would cost every pair every step for a test that
+//! normal runs never need; the speed bound decides in O(1) after the body pass. Measured (callgrind, one
+//! thread, `examples/sphere_bed_speed.rs --check stop|off`, sphere bed a, 3001 spheres): 13 instructions
+//! per sphere and step, +1.05 % of a flat-layout step without the ledger (500 steps) and +0.39 % of a
+//! general step with the ledger (200 steps).
 //! The rotation of the bodies is left out of the approach speed (the load-time guard also takes the
 //! impact speed as the speed of the centres).
 
