@@ -12,6 +12,7 @@
 //! ```text
 //! cargo run --release --example sphere_bed_speed -- [--steps N] [--path flat|general] [--threads N]
 //!     [--ledger on|off|scene] [--skin M] [--orientation on|off] [--wide on|off] [--driver run|step]
+//!     [--check stop|warn|off]
 //!     [SCENE.toml ...]
 //! ```
 //! Default: 5000 steps (0.01 s of the bed) of the three variants a, b, c, on the flat sphere path
@@ -25,7 +26,8 @@
 //! `SphereSim::set_wide_instructions`; the same bits either way); `--driver` how the flat steps are
 //! driven: `run` (default) by `SphereSim::run_steps`, as the suite's `sphere_bed` case drives them (on
 //! several threads the pool's threads are held for the run), `step` by `SphereSim::step` once per step
-//! (each step's team job a rayon broadcast; the same bits, slower on two threads).
+//! (each step's team job a rayon broadcast; the same bits, slower on two threads); `--check` the run-time
+//! check of the time step (`simulation.time_step_check`; default: the scene's; the same bits either way).
 
 use polydem::host::{core_round_trip_text, load_average, thread_cpu_time};
 use std::ops::ControlFlow;
@@ -34,7 +36,7 @@ use std::time::Instant;
 
 use polydem::scene::{load_scene, RunSummary};
 use polydem::world::broad_phase::BroadPhase;
-use polydem::world::SphereSim;
+use polydem::world::{SphereSim, TimeStepCheck};
 
 struct Options {
     steps: u64,
@@ -45,6 +47,7 @@ struct Options {
     orientation: bool,
     wide: bool,
     step_by_step: bool,
+    check: Option<TimeStepCheck>,
     scenes: Vec<PathBuf>,
 }
 
@@ -58,6 +61,7 @@ fn parse() -> Result<Options, String> {
         orientation: false,
         wide: true,
         step_by_step: false,
+        check: None,
         scenes: Vec::new(),
     };
     let mut args = std::env::args().skip(1);
@@ -101,6 +105,14 @@ fn parse() -> Result<Options, String> {
                     v => return Err(format!("--driver: '{v}' is not run or step")),
                 }
             }
+            "--check" => {
+                o.check = Some(match value()?.as_str() {
+                    "stop" => TimeStepCheck::Stop,
+                    "warn" => TimeStepCheck::Warn,
+                    "off" => TimeStepCheck::Off,
+                    v => return Err(format!("--check: '{v}' is not stop, warn or off")),
+                })
+            }
             "--threads" => o.threads = value()?.parse().map_err(|e| format!("--threads: {e}"))?,
             "--skin" => o.skin = Some(value()?.parse().map_err(|e| format!("--skin: {e}"))?),
             s if s.starts_with("--") => return Err(format!("unknown option {s}")),
@@ -129,6 +141,9 @@ fn main() -> anyhow::Result<()> {
         }
         if o.flat {
             sim.params.energy_ledger = false;
+        }
+        if let Some(check) = o.check {
+            sim.params.time_step_check = check;
         }
         if let Some(skin) = o.skin {
             sim.world.broad_phase = BroadPhase::new(skin);
@@ -172,10 +187,11 @@ fn main() -> anyhow::Result<()> {
             o.threads
         );
         println!(
-            "  {} particles, {} steps, ledger {}, skin {:.3e} m: CPU {} s, wall {:.3} s; particle-steps/s {} (CPU), {:.3e} (wall)",
+            "  {} particles, {} steps, ledger {}, time-step check {:?}, skin {:.3e} m: CPU {} s, wall {:.3} s; particle-steps/s {} (CPU), {:.3e} (wall)",
             particles,
             summary.steps,
             if sim.params.energy_ledger { "on" } else { "off" },
+            sim.params.time_step_check,
             sim.world.broad_phase.skin(),
             cpu.map_or("n/a".into(), |c| format!("{c:.3}")),
             wall,

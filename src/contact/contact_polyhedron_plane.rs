@@ -42,11 +42,7 @@ pub fn contact_plane_polytope<B: Polytope + ?Sized>(
     b: &B,
     tol: &ContactTolerances,
 ) -> ContactGeometry {
-    let n = pos1.rotation * normal1;
-    let o = offset1 + n.dot(&pos1.translation.vector);
-    // Work in B's frame: n2 = R2ᵀ n, o2 = o − n·t2.
-    let n2 = pos2.rotation.inverse_transform_vector(&n);
-    let o2 = o - n.dot(&pos2.translation.vector);
+    let (n, n2, o2) = plane_in_frame_of(pos1, normal1, offset1, pos2);
     let verts = b.vertices();
     // The heights n2·v of the vertices, computed once (up to `STACK_BAND` vertices) and read by the
     // smoothing below: the same values in the same order as computing them where they are used.
@@ -107,6 +103,41 @@ pub fn contact_plane_polytope<B: Polytope + ?Sized>(
         point_b,
         SolverStatus::Exact,
     )
+}
+
+/// The plane (A: pose `pos1`, local outward normal `normal1`, offset `offset1`) in the frame of B at
+/// `pos2`: the world normal n, B's local normal n2 = R2ᵀ n and offset o2 = o − n·t2.
+#[inline]
+fn plane_in_frame_of(
+    pos1: &Pose,
+    normal1: &Vector,
+    offset1: Real,
+    pos2: &Pose,
+) -> (Vector, Vector, Real) {
+    let n = pos1.rotation * normal1;
+    let o = offset1 + n.dot(&pos1.translation.vector);
+    let n2 = pos2.rotation.inverse_transform_vector(&n);
+    (n, n2, o - n.dot(&pos2.translation.vector))
+}
+
+/// The exact overlap of the polytope `b` at `pos2` with the plane (arguments of
+/// [`contact_plane_polytope`]): the depth of its deepest vertex, max_i d_i, 0 when apart. What
+/// [`WallDepth::DeepestVertex`] hands to the law, and what the step's overlap statistic measures with
+/// either rule (the smoothed depth falls short of it by up to 0.22 h; see [`super::wall_depth`]).
+pub fn plane_polytope_depth<B: Polytope + ?Sized>(
+    pos1: &Pose,
+    normal1: &Vector,
+    offset1: Real,
+    pos2: &Pose,
+    b: &B,
+) -> Real {
+    let (_, n2, o2) = plane_in_frame_of(pos1, normal1, offset1, pos2);
+    let lowest = b
+        .vertices()
+        .iter()
+        .map(|v| n2.dot(&v.coords))
+        .fold(Real::INFINITY, Real::min);
+    (o2 - lowest).max(0.0)
 }
 
 /// [`smoothed_point`] from the vertex heights `heights[i]` = n2·v_i (at most `STACK_BAND` vertices),

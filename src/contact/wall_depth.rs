@@ -71,6 +71,18 @@
 
 use crate::math::Real;
 
+/// The largest band (a fraction of the particle size L) the scene accepts for this smoothing and for the
+/// pair smoothing of [`super::pair_smoothing`]: 0.05.
+///
+/// The derivation above holds for h ≈ the characteristic overlap of the scene (its rule), and a sound DEM
+/// scene has no overlap near 0.05 L: the step reports a contact that deep as a deep overlap
+/// (`world::DEFAULT_OVERLAP_WARNING_FRACTION`), its stiffness or step being wrong for the scene. Beyond
+/// that no overlap the rule could match exists, and what the band does instead is let the law's depth
+/// fall short of the true one by up to 0.22 h — at h = L a body rests with most of its volume in the
+/// wall, the law seeing a small overlap. At 0.05 the shortfall stays below 0.011 L, and a tilt of 2h/L
+/// = 0.1 rad already returns a face to the exact deepest-vertex depth.
+pub const MAX_BAND: Real = 0.05;
+
 /// How the polyhedron–plane contact turns the vertex depths into the overlap the law sees.
 #[derive(Copy, Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub enum WallDepth {

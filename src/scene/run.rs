@@ -73,6 +73,10 @@ pub struct RunSummary {
     /// Steps that reported a contact deeper than the warning fraction, and the first such step.
     pub steps_with_deep_overlap: u64,
     pub first_deep_overlap_step: Option<u64>,
+    /// Steps in which the check of the time step found the motion too fast for it (with
+    /// `time_step_check = "warn"`), and the first finding with its step.
+    pub steps_with_time_step_findings: u64,
+    pub first_time_step_finding: Option<(u64, String)>,
     /// The path the steps took.
     pub path: StepPath,
 }
@@ -85,6 +89,11 @@ impl RunSummary {
         if !report.overlap_warnings.is_empty() {
             self.steps_with_deep_overlap += 1;
             self.first_deep_overlap_step.get_or_insert(step_index);
+        }
+        if let Some(finding) = report.time_step_findings.first() {
+            self.steps_with_time_step_findings += 1;
+            self.first_time_step_finding
+                .get_or_insert_with(|| (step_index, finding.to_string()));
         }
     }
 }
@@ -266,6 +275,13 @@ impl std::fmt::Display for RunSummary {
                 .map(|s| format!(" (first at step {s})"))
                 .unwrap_or_default()
         )?;
+        if let Some((step, finding)) = &self.first_time_step_finding {
+            writeln!(
+                f,
+                "time-step check: {} steps found the motion too fast for the step; first at step {step}: {finding}",
+                self.steps_with_time_step_findings
+            )?;
+        }
         write!(f, "{}", self.counters)
     }
 }

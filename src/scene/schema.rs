@@ -69,6 +69,9 @@ pub struct SimulationSection {
     /// Whether the step books the per-contact terms of the energy ledger; absent = true (see
     /// `crate::world::StepParams::energy_ledger`).
     pub energy_ledger: Option<Spanned<bool>>,
+    /// What the run does when the motion outruns the time step (`crate::world::TimeStepCheck`):
+    /// `"stop"` (absent = stop), `"warn"` or `"off"`.
+    pub time_step_check: Option<Spanned<String>>,
 }
 
 /// `[[material]]`.

@@ -40,8 +40,11 @@
 //!   k_n δ^n / h at lever arms up to r_b; it stays within the bound above while the band h is at least the
 //!   overlap (its documented rule). A band far below the overlaps of a scene needs a smaller step.
 
+use crate::law::pair::contact_radius;
 use crate::law::ContactModel;
 use crate::math::Real;
+use crate::shape::Shape;
+use crate::world::MaterialTable;
 
 /// How the time step was chosen.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -97,6 +100,146 @@ pub fn contact_time_and_limit(
             .min(2.0 / omega_tangential);
     }
     Ok((t_c, limit))
+}
+
+/// What the estimate reads of one body.
+#[derive(Clone, Copy, Debug)]
+pub struct BodyFacts<'a> {
+    pub material: u32,
+    pub dynamic: bool,
+    /// Mass (kg).
+    pub mass: Real,
+    /// Smallest principal moment of inertia (kg·m²).
+    pub smallest_moment: Real,
+    /// Bounding radius r_b (m).
+    pub bounding_radius: Real,
+    /// The shape, for its contact radius (asked only of the lightest body of each material).
+    pub shape: &'a Shape,
+}
+
+/// The pairs that can meet, with the rotational factor κ: per material the lightest dynamic body's
+/// mass and contact radius, and whether a wall (`wall_materials`) or a non-dynamic body of it exists;
+/// then the law and effective mass of every way two materials' bodies can meet (module docs). Shared
+/// by the scene's guard at load and the step's check during the run.
+pub fn pair_estimates<'a>(
+    table: &MaterialTable,
+    bodies: impl IntoIterator<Item = BodyFacts<'a>>,
+    wall_materials: impl IntoIterator<Item = u32>,
+) -> (Vec<PairEstimate>, Real) {
+    let lightest = Lightest::of(table.len(), bodies, wall_materials);
+    (estimates_of(table, &lightest), lightest.kappa)
+}
+
+/// The largest approach speed (m/s) at which the step `dt` stays within the stability limit of
+/// [`contact_time_and_limit`] (the speed-dependent laws' limit falls as the impact speed grows; a
+/// speed-independent limit is met or not at any speed): ∞ when no speed reaches it, 0 when even a
+/// vanishing speed does. Found by bisection in log space (the limit is non-increasing in the speed).
+pub fn critical_speed(pairs: &[PairEstimate], kappa: Real, dt: Real) -> Real {
+    let limit = |v: Real| match contact_time_and_limit(pairs, kappa, Some(v)) {
+        Ok((_, limit)) => limit,
+        Err(_) => Real::INFINITY,
+    };
+    let (mut lo, mut hi): (Real, Real) = (1e-12, 1e12);
+    if limit(hi) >= dt {
+        return Real::INFINITY;
+    }
+    if limit(lo) < dt {
+        return 0.0;
+    }
+    for _ in 0..200 {
+        let mid = (lo * hi).sqrt();
+        if limit(mid) >= dt {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+        if hi <= lo * (1.0 + 1e-12) {
+            break;
+        }
+    }
+    lo
+}
+
+/// The stability limit Δt_max (s) of [`contact_time_and_limit`] at the approach speed `speed` (m/s).
+pub fn limit_at(pairs: &[PairEstimate], kappa: Real, speed: Real) -> Real {
+    contact_time_and_limit(pairs, kappa, Some(speed)).map_or(Real::INFINITY, |(_, limit)| limit)
+}
+
+/// Per material: the lightest dynamic body's mass and contact radius, and whether a wall or a non-dynamic
+/// body of it exists; the rotational factor κ over all dynamic bodies.
+struct Lightest {
+    mass: Vec<Real>,
+    /// Contact radius of the lightest body of each material (for laws that scale with R*).
+    radius: Vec<Real>,
+    has_obstacle: Vec<bool>,
+    /// κ = max (1 + m r_b²/J_min) of the module docs.
+    kappa: Real,
+}
+
+impl Lightest {
+    fn of<'a>(
+        n_mat: usize,
+        bodies: impl IntoIterator<Item = BodyFacts<'a>>,
+        wall_materials: impl IntoIterator<Item = u32>,
+    ) -> Self {
+        let mut l = Lightest {
+            mass: vec![Real::INFINITY; n_mat],
+            radius: vec![Real::INFINITY; n_mat],
+            has_obstacle: vec![false; n_mat],
+            kappa: 1.0,
+        };
+        for b in bodies {
+            let mat = b.material as usize;
+            if b.dynamic {
+                if b.mass < l.mass[mat] {
+                    l.mass[mat] = b.mass;
+                    l.radius[mat] = contact_radius(b.shape).unwrap_or(Real::INFINITY);
+                }
+                let r = b.bounding_radius;
+                l.kappa = l.kappa.max(1.0 + b.mass * r * r / b.smallest_moment);
+            } else {
+                l.has_obstacle[mat] = true;
+            }
+        }
+        for m in wall_materials {
+            l.has_obstacle[m as usize] = true;
+        }
+        l
+    }
+}
+
+/// The law and effective mass of every way two materials' bodies can meet.
+fn estimates_of(table: &MaterialTable, l: &Lightest) -> Vec<PairEstimate> {
+    let n_mat = table.len();
+    let mut estimates = Vec::new();
+    for a in 0..n_mat {
+        for b in a..n_mat {
+            let Some(model) = table.model(a as u32, b as u32) else {
+                continue;
+            };
+            let (ma, mb) = (l.mass[a], l.mass[b]);
+            let (ra, rb) = (l.radius[a], l.radius[b]);
+            // (m*, R*) of each way the pair can meet; a wall or fixed body counts as flat (R* = R, the
+            // stiffest Hertz contact of that body).
+            let mut candidates = Vec::new();
+            if ma.is_finite() && mb.is_finite() {
+                candidates.push((ma * mb / (ma + mb), ra * rb / (ra + rb)));
+            }
+            if ma.is_finite() && l.has_obstacle[b] {
+                candidates.push((ma, ra));
+            }
+            if mb.is_finite() && l.has_obstacle[a] {
+                candidates.push((mb, rb));
+            }
+            for (m, r) in candidates {
+                estimates.push(PairEstimate {
+                    model: model.for_root_radius(r.sqrt()),
+                    effective_mass: m,
+                });
+            }
+        }
+    }
+    estimates
 }
 
 /// f(n) of the module docs: the fraction of 2/ω at which a stiffening power law f = k δ^n (n ≥ 1) stays

@@ -36,5 +36,8 @@ pub use skips::Skips;
 pub use sleeping::{SleepParams, SleepState};
 pub use sphere_flat::{NotSphereOnly, SphereSim, StepFlatError};
 pub use step::sphere::applies as sphere_step_applies;
-pub use step::{step, StepCounters, StepError, StepParams, StepReport, StepScratch};
+pub use step::{
+    step, StepCounters, StepError, StepParams, StepReport, StepScratch, TimeStepCheck,
+    TimeStepFinding,
+};
 pub use world::{Loads, MaterialTable, SetupStats, Wall, World, WorldError};

@@ -2,10 +2,12 @@
 //! the global viscous damping, the Verlet skin, and the tolerances of the step.
 
 use crate::contact::pair_smoothing::PairSmoothing;
-use crate::contact::wall_depth::WallDepth;
+use crate::contact::wall_depth::{WallDepth, MAX_BAND};
 use crate::dynamics::ViscousDamping;
 use crate::math::{Real, Vector};
-use crate::world::StepParams;
+use crate::world::{StepParams, TimeStepCheck};
+
+use toml::Spanned;
 
 use super::super::run_length::{self, StepCountError, DEFAULT_MAX_STEPS};
 use super::super::schema::SimulationSection;
@@ -121,14 +123,36 @@ pub(super) fn step_params(
     params.tolerances.wall_depth = wall_depth(ctx, sim)?;
     params.tolerances.pair_smoothing = pair_smoothing(ctx, sim)?;
     params.energy_ledger = sim.energy_ledger.as_ref().is_none_or(|l| *l.get_ref());
+    params.time_step_check = time_step_check(ctx, sim)?;
     Ok(params)
+}
+
+/// `simulation.time_step_check`: what the run does when its check finds the motion too fast for the
+/// step (see `crate::world::step::guard`); absent = stop.
+fn time_step_check(ctx: &Ctx, sim: &SimulationSection) -> Result<TimeStepCheck, SceneError> {
+    let Some(value) = &sim.time_step_check else {
+        return Ok(TimeStepCheck::default());
+    };
+    match value.get_ref().as_str() {
+        "stop" => Ok(TimeStepCheck::Stop),
+        "warn" => Ok(TimeStepCheck::Warn),
+        "off" => Ok(TimeStepCheck::Off),
+        other => Err(ctx.invalid(
+            value.span(),
+            "simulation.time_step_check",
+            format!("must be \"stop\", \"warn\" or \"off\", got \"{other}\""),
+        )),
+    }
 }
 
 /// `simulation.wall_depth` and `simulation.wall_depth_band`: how a polyhedron–wall contact turns the vertex
 /// depths into the law's overlap. A band given with the deepest-vertex rule is refused (it would be ignored).
 fn wall_depth(ctx: &Ctx, sim: &SimulationSection) -> Result<WallDepth, SceneError> {
     let band = match &sim.wall_depth_band {
-        Some(b) => Some((ctx.positive(b, "simulation.wall_depth_band")?, b.span())),
+        Some(b) => Some((
+            smoothing_band(ctx, b, "simulation.wall_depth_band")?,
+            b.span(),
+        )),
         None => None,
     };
     let rule = sim
@@ -152,11 +176,26 @@ fn wall_depth(ctx: &Ctx, sim: &SimulationSection) -> Result<WallDepth, SceneErro
     }
 }
 
+/// A smoothing band (fraction of the particle size): positive and at most [`MAX_BAND`], where the
+/// smoothing's derivation holds (see [`MAX_BAND`]).
+fn smoothing_band(ctx: &Ctx, band: &Spanned<f64>, field: &str) -> Result<Real, SceneError> {
+    let value = ctx.positive(band, field)?;
+    if value > MAX_BAND {
+        return Err(ctx.invalid(band.span(), field, format!(
+            "{value} exceeds {MAX_BAND}: the band should be about the scene's overlap (static overlap under load, or the peak overlap of the impacts), and overlaps beyond {MAX_BAND} of the particle size are already deep overlaps; a wider band lets the smoothed depth fall short of the true one by up to 0.22 × band × the particle size, so bodies sink into walls or each other unreported"
+        )));
+    }
+    Ok(value)
+}
+
 /// `simulation.pair_smoothing` and `simulation.pair_smoothing_band`: the overlap a polyhedron–polyhedron
 /// contact hands to the law. A band given with the exact overlap is refused (it would be ignored).
 fn pair_smoothing(ctx: &Ctx, sim: &SimulationSection) -> Result<PairSmoothing, SceneError> {
     let band = match &sim.pair_smoothing_band {
-        Some(b) => Some((ctx.positive(b, "simulation.pair_smoothing_band")?, b.span())),
+        Some(b) => Some((
+            smoothing_band(ctx, b, "simulation.pair_smoothing_band")?,
+            b.span(),
+        )),
         None => None,
     };
     let rule = sim

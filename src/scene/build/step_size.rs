@@ -4,12 +4,13 @@
 
 use std::ops::Range;
 
-use crate::law::pair::contact_radius;
 use crate::math::Real;
 use crate::world::{MaterialTable, Wall};
 
 use super::super::schema::SimulationSection;
-use super::super::time_step::{contact_time_and_limit, PairEstimate, TimeStepInfo, TimeStepIssue};
+use super::super::time_step::{
+    contact_time_and_limit, pair_estimates, BodyFacts, TimeStepInfo, TimeStepIssue,
+};
 use super::bodies::Bodies;
 use super::shapes::{bounding_radius, Shapes};
 use super::{Ctx, SceneError};
@@ -28,10 +29,20 @@ pub(super) fn choose(
         .as_ref()
         .map(|v| ctx.positive(v, "simulation.characteristic_speed"))
         .transpose()?;
-    let lightest = Lightest::of(table.len(), shapes, bodies, walls);
-    let estimates = pair_estimates(table, &lightest);
+    let facts = bodies.list.iter().map(|b| {
+        let shape = &shapes.list[b.shape].0;
+        BodyFacts {
+            material: b.material,
+            dynamic: b.body.is_dynamic(),
+            mass: b.body.mass,
+            smallest_moment: b.body.inertia.0.min(),
+            bounding_radius: bounding_radius(shape),
+            shape,
+        }
+    });
+    let (estimates, kappa) = pair_estimates(table, facts, walls.iter().map(|(_, w)| w.material));
     let sim_span = sim.end_time.span();
-    let (contact_time, limit) = match contact_time_and_limit(&estimates, lightest.kappa, speed) {
+    let (contact_time, limit) = match contact_time_and_limit(&estimates, kappa, speed) {
         Ok(x) => x,
         Err(TimeStepIssue::NeedsSpeed) => {
             return Err(ctx.invalid(sim_span, "simulation.characteristic_speed", "a power law with exponent ≠ 1 needs the characteristic impact speed (m/s) for its contact time and stability limit"))
@@ -46,81 +57,6 @@ pub(super) fn choose(
         contact_time,
         stability_limit: limit,
     })
-}
-
-/// Per material: the lightest dynamic body's mass and contact radius, and whether a wall or a non-dynamic
-/// body of it exists; the rotational factor κ over all dynamic bodies.
-struct Lightest {
-    mass: Vec<Real>,
-    /// Contact radius of the lightest body of each material (for laws that scale with R*).
-    radius: Vec<Real>,
-    has_obstacle: Vec<bool>,
-    /// κ = max (1 + m r_b²/J_min) of the module docs of [`crate::scene::time_step`].
-    kappa: Real,
-}
-
-impl Lightest {
-    fn of(n_mat: usize, shapes: &Shapes, bodies: &Bodies, walls: &[(Range<usize>, Wall)]) -> Self {
-        let mut l = Lightest {
-            mass: vec![Real::INFINITY; n_mat],
-            radius: vec![Real::INFINITY; n_mat],
-            has_obstacle: vec![false; n_mat],
-            kappa: 1.0,
-        };
-        for b in &bodies.list {
-            let (body, mat) = (&b.body, b.material as usize);
-            if body.is_dynamic() {
-                let shape = &shapes.list[b.shape].0;
-                if body.mass < l.mass[mat] {
-                    l.mass[mat] = body.mass;
-                    l.radius[mat] = contact_radius(shape).unwrap_or(Real::INFINITY);
-                }
-                let r = bounding_radius(shape);
-                let j_min = body.inertia.0.min();
-                l.kappa = l.kappa.max(1.0 + body.mass * r * r / j_min);
-            } else {
-                l.has_obstacle[mat] = true;
-            }
-        }
-        for (_, w) in walls {
-            l.has_obstacle[w.material as usize] = true;
-        }
-        l
-    }
-}
-
-/// The law and effective mass of every way two materials' bodies can meet.
-fn pair_estimates(table: &MaterialTable, l: &Lightest) -> Vec<PairEstimate> {
-    let n_mat = table.len();
-    let mut estimates = Vec::new();
-    for a in 0..n_mat {
-        for b in a..n_mat {
-            let Some(model) = table.model(a as u32, b as u32) else {
-                continue;
-            };
-            let (ma, mb) = (l.mass[a], l.mass[b]);
-            let (ra, rb) = (l.radius[a], l.radius[b]);
-            // (m*, R*) of each way the pair can meet; a wall or fixed body counts as flat (R* = R, the
-            // stiffest Hertz contact of that body).
-            let mut candidates = Vec::new();
-            if ma.is_finite() && mb.is_finite() {
-                candidates.push((ma * mb / (ma + mb), ra * rb / (ra + rb)));
-            }
-            if ma.is_finite() && l.has_obstacle[b] {
-                candidates.push((ma, ra));
-            }
-            if mb.is_finite() && l.has_obstacle[a] {
-                candidates.push((mb, rb));
-            }
-            for (m, r) in candidates {
-                estimates.push(PairEstimate {
-                    model: model.for_root_radius(r.sqrt()),
-                    effective_mass: m,
-                });
-            }
-        }
-    }
-    estimates
 }
 
 /// `time_step` (checked against `limit`) or `steps_per_contact` (Δt = t_c/N, checked as well): exactly one.

@@ -84,6 +84,7 @@ mod run;
 mod step;
 mod team;
 
+use super::step::guard::Guard;
 use crate::contact::{contact_plane_sphere, contact_sphere_sphere, QueryCounters};
 use crate::dynamics::rotation::{is_isotropic, SubRotation};
 use crate::dynamics::{Motion, RotationScheme, ViscousDamping};
@@ -177,6 +178,8 @@ pub struct SphereSim {
     step_work: ContactWork,
     time: Real,
     step_index: u64,
+    /// What the check of the time step keeps of the world (`super::step::guard`).
+    guard: Guard,
 }
 
 impl SphereSim {
@@ -305,6 +308,7 @@ impl SphereSim {
             step_work: ContactWork::default(),
             time: world.time,
             step_index: world.step_index,
+            guard: Guard::of(world, params.dt),
         };
         // The first build imports the springs of the world's contact store.
         let store = &world.contacts;

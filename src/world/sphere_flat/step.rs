@@ -24,7 +24,9 @@ use std::time::Instant;
 
 use crate::math::{Point, Real};
 
+use super::super::step::guard::{self, TimeStepCheck};
 use super::super::step::{StepError, StepReport};
+use super::super::ContactKey;
 use super::blocks::Blocks;
 use super::crew::Crew;
 use super::fused::Fused;
@@ -128,7 +130,41 @@ impl SphereSim {
         self.time += dt;
         self.step_index += 1;
         report.counters.steps = 1;
+        self.check_time_step(&mut report)?;
         Ok(report)
+    }
+
+    /// The check of the time step after the step (`super::super::step::guard`; reads the state only).
+    fn check_time_step(&self, report: &mut StepReport) -> Result<(), StepError> {
+        let mode = self.params.time_step_check;
+        if mode == TimeStepCheck::Off {
+            return Ok(());
+        }
+        let (kin, props) = (&self.kin, &self.props);
+        let bodies = guard::Bodies {
+            len: kin.len(),
+            state: |i: usize| (kin[i].position, kin[i].velocity, props[i].radius),
+            names: &self.names,
+            walls: &self.walls,
+            margin: 0.5 * self.list.skin(),
+        };
+        let pairs = || {
+            let body = self.body_pairs().map(|(a, b)| ContactKey::Body { a, b });
+            body.chain(
+                self.wall_pairs()
+                    .map(|(body, wall)| ContactKey::Wall { body, wall }),
+            )
+        };
+        guard::check(
+            mode,
+            &self.guard,
+            self.params.dt,
+            self.step_index,
+            &bodies,
+            pairs,
+            &mut report.counters,
+            &mut report.time_step_findings,
+        )
     }
 
     /// What the drift reads.

@@ -50,6 +50,9 @@ pub struct StepCounters {
     pub fell_asleep: u64,
     pub woken: u64,
     pub sleeping_body_steps: u64,
+    /// Bodies that moved more than half the skin in one step, summed over the steps ("dangerous builds";
+    /// see [`super::guard`]).
+    pub dangerous_moves: u64,
     /// Narrow-phase counters (queries by kind, GJK/EPA iterations, fallbacks).
     pub query: QueryCounters,
 }
@@ -75,6 +78,7 @@ impl StepCounters {
         self.fell_asleep += other.fell_asleep;
         self.woken += other.woken;
         self.sleeping_body_steps += other.sleeping_body_steps;
+        self.dangerous_moves += other.dangerous_moves;
         self.query.merge(&other.query);
     }
 
@@ -128,6 +132,13 @@ impl std::fmt::Display for StepCounters {
                 f,
                 "sleeping: frozen pairs {}, bodies fell asleep {}, woken {}, sleeping body-steps {}",
                 self.frozen_pairs, self.fell_asleep, self.woken, self.sleeping_body_steps
+            )?;
+        }
+        if self.dangerous_moves > 0 {
+            writeln!(
+                f,
+                "bodies that moved more than half the skin in one step (body-steps): {}",
+                self.dangerous_moves
             )?;
         }
         write!(f, "{}", self.query)

@@ -70,7 +70,8 @@ pub(super) struct Evaluated {
     pub(super) overlapping: bool,
     /// Whether the pair is frozen (kept from its last evaluation; see [`super::sleeping`]).
     pub(super) frozen: bool,
-    /// Overlap δ_M (m) and δ_M divided by the smaller particle's length scale.
+    /// Overlap δ_M (m) and δ_M divided by the smaller particle's length scale: the exact overlap, also
+    /// for a polyhedron on a wall whose law sees the smoothed depth (stage 4 measures it).
     pub(super) depth: Real,
     pub(super) overlap_ratio: Real,
 }

@@ -43,6 +43,7 @@ mod accumulate;
 mod broad;
 mod checks;
 mod counters;
+pub(crate) mod guard;
 mod integrate;
 mod laws;
 mod ledger;
@@ -55,6 +56,7 @@ pub(super) mod sphere;
 mod sphere_kernel;
 
 pub use counters::StepCounters;
+pub use guard::{TimeStepCheck, TimeStepFinding};
 pub use params::{StepParams, DEFAULT_OVERLAP_WARNING_FRACTION};
 pub use report::{OverlapWarning, StepError, StepReport};
 pub use scratch::StepScratch;
@@ -66,8 +68,42 @@ use super::sleeping;
 use super::world::World;
 use ledger::StepPowers;
 
-/// Advances the world by one step `params.dt` (see the module docs for the stages).
+/// Advances the world by one step `params.dt` (see the module docs for the stages), then checks the step
+/// against the motion it produced ([`guard`]: reads the state only).
 pub fn step(
+    params: &StepParams,
+    world: &mut World,
+    scratch: &mut StepScratch,
+) -> Result<StepReport, StepError> {
+    let mut report = advance(params, world, scratch)?;
+    if params.time_step_check != TimeStepCheck::Off {
+        scratch.guard.ensure(world, params.dt);
+        let bodies = guard::Bodies {
+            len: world.bodies.len(),
+            state: |i: usize| {
+                let b = &world.bodies[i];
+                (b.position, b.velocity, world.radii[i])
+            },
+            names: &world.names,
+            walls: &world.walls,
+            margin: 0.5 * world.broad_phase.skin(),
+        };
+        guard::check(
+            params.time_step_check,
+            &scratch.guard,
+            params.dt,
+            world.step_index,
+            &bodies,
+            || scratch.candidates.iter().copied(),
+            &mut report.counters,
+            &mut report.time_step_findings,
+        )?;
+    }
+    Ok(report)
+}
+
+/// Stages 0–9 of one step (the module docs).
+fn advance(
     params: &StepParams,
     world: &mut World,
     scratch: &mut StepScratch,

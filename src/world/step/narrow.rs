@@ -1,8 +1,9 @@
 //! Stages 4–5: the narrow phase (one contact query per candidate) fused with the laws, in one pass over
 //! the contact store synced to the candidate list.
 
+use crate::contact::contact_polyhedron_plane::plane_polytope_depth;
 use crate::contact::{
-    contact_plane_sphere, contact_sphere_sphere, query_with, ContactError, QueryCounters,
+    contact_plane_sphere, contact_sphere_sphere, query_with, ContactError, QueryCounters, WallDepth,
 };
 use crate::math::Real;
 use crate::shape::Shape;
@@ -160,7 +161,38 @@ fn candidate(
         step: pair.step_index,
         source,
     })?;
-    contact_law(pair, key, state, &previous_point, out)
+    contact_law(pair, key, state, &previous_point, out)?;
+    if out.overlapping {
+        exact_wall_depth(params, pair.world, key, out);
+    }
+    Ok(())
+}
+
+/// The overlap statistic of a polyhedron on a wall with the smoothed depth: the exact depth (deepest
+/// vertex) instead of the smoothed one the law saw, which falls short of it by up to 0.22 h (h the band;
+/// see [`crate::contact::wall_depth`]), so that a body sunk into a wall is reported as sunk.
+#[inline]
+fn exact_wall_depth(params: &StepParams, world: &World, key: ContactKey, out: &mut Evaluated) {
+    let ContactKey::Wall { body, wall } = key else {
+        return;
+    };
+    if !matches!(params.tolerances.wall_depth, WallDepth::Smoothed { .. }) {
+        return;
+    }
+    let body = body as usize;
+    if let Shape::Polyhedron(p) = world.shape(body) {
+        let wall = &world.walls[wall as usize];
+        let pose = world.pose(body);
+        let depth = plane_polytope_depth(
+            &wall.pose,
+            wall.plane.normal(),
+            wall.plane.offset(),
+            &pose,
+            p.as_ref(),
+        );
+        out.depth = depth;
+        out.overlap_ratio = depth / world.length_scale(body);
+    }
 }
 
 /// Stage 4 for one candidate: the contact query between its two shapes (A = body a or the wall, B = body b),

@@ -9,6 +9,7 @@ use super::super::skips::Skips;
 use super::super::sleep_state::SleepParams;
 #[cfg(doc)]
 use super::super::world::World;
+use super::guard::TimeStepCheck;
 #[cfg(doc)]
 use super::StepReport;
 
@@ -44,6 +45,10 @@ pub struct StepParams {
     /// `dissipated_damping`, `dissipated_friction` and `tangential_stiffness_work` stay where they were, so
     /// [`World::energy`]'s balance no longer closes.
     pub energy_ledger: bool,
+    /// What the step does when its check finds the motion too fast for the time step (stop by default;
+    /// see [`super::guard`]). Not stored in checkpoints: a run restarted from one checks with the default.
+    #[serde(skip)]
+    pub time_step_check: TimeStepCheck,
 }
 
 impl StepParams {
@@ -60,6 +65,7 @@ impl StepParams {
             skips: Skips::default(),
             sleeping: SleepParams::default(),
             energy_ledger: true,
+            time_step_check: TimeStepCheck::default(),
         }
     }
 }

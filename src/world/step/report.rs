@@ -6,6 +6,7 @@ use crate::math::Real;
 use super::super::contact_store::ContactKey;
 use super::super::world::World;
 use super::counters::StepCounters;
+use super::guard::TimeStepFinding;
 
 /// A contact deeper than the warning fraction of the particle size.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -26,6 +27,9 @@ pub struct StepReport {
     /// The largest overlap / particle size at the end of the step.
     pub max_overlap_ratio: Real,
     pub overlap_warnings: Vec<OverlapWarning>,
+    /// What the check of the time step found in this step, when it warns instead of stopping (see
+    /// [`super::guard`]).
+    pub time_step_findings: Vec<TimeStepFinding>,
 }
 
 /// Why a step failed.
@@ -48,6 +52,11 @@ pub enum StepError {
     },
     #[error("step {step}: no contact law for materials {a} and {b}")]
     MissingLaw { step: u64, a: u32, b: u32 },
+    #[error("step {step}: {finding} [time-step check; simulation.time_step_check = \"warn\" reports and goes on, \"off\" skips it]")]
+    TimeStep {
+        step: u64,
+        finding: Box<TimeStepFinding>,
+    },
 }
 
 impl StepError {

@@ -31,4 +31,6 @@ pub struct StepScratch {
     /// Set by stage 6 when it left the per-body force sums to the pass of stages 7–8 (the gather fused
     /// with the second half kick); consumed in the same step.
     pub(super) deferred_gather: bool,
+    /// What the check of the time step keeps of the world (see [`super::guard`]).
+    pub(super) guard: super::guard::Guard,
 }
