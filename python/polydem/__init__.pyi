@@ -193,6 +193,7 @@ class Simulation:
         vtk_interval: Optional[float] = None,
         contacts_interval: Optional[float] = None,
         checkpoint_interval: Optional[float] = None,
+        max_steps: Optional[int] = None,
     ) -> None:
         """Runs to `until` (s; default the scene's end time), calling callback(sim) every `every` seconds
         (whole steps, at least one) and at the end, and progress(step, last_step) about every hundredth of
@@ -263,6 +264,8 @@ def rockfill(
     seed: Optional[int] = None,
     bed: Optional[_StrPath] = None,
     progress: Optional[Callable[[str, str], object]] = None,
+    max_rocks: Optional[int] = None,
+    max_steps: Optional[int] = None,
 ) -> Dict[str, Any]:
     """The paper's rockfill experiment (`polydem rockfill`) with its outputs in `out`: "quick", "paper" or an
     experiment file; returns the penetration's figures and `monitors`, a dict of per-step arrays."""

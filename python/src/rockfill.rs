@@ -108,10 +108,14 @@ fn report<'py>(py: Python<'py>, p: &PenetrationReport) -> PyResult<Bound<'py, Py
 /// of the penetration's figures (`outcome`, `residual_speed` in m/s, `dt`, `steps`, `rocks`, deflections
 /// in degrees, …) with `monitors`, a dict of arrays with one row per step (`time`, `position`, `tip`,
 /// `velocity`, `speed`, `force`, `axial_force`, `velocity_deflection`, `axis_deflection`, `contacts`).
-/// `progress(stage, text)` receives the experiment's progress messages. The run holds no GIL; it cannot
+/// `progress(stage, text)` receives the experiment's progress messages. `max_rocks` and `max_steps` raise
+/// the experiment's limits (rocks generated; steps of the packing and of the penetration), beyond which
+/// a run is refused before it starts, with what it would need. The run holds no GIL; it cannot
 /// be interrupted from Python before it ends; an exception raised by `progress` is raised when it does.
 #[pyfunction]
-#[pyo3(signature = (out, config = None, *, size_mm = None, seed = None, bed = None, progress = None))]
+#[pyo3(signature = (out, config = None, *, size_mm = None, seed = None, bed = None, progress = None,
+                    max_rocks = None, max_steps = None))]
+#[allow(clippy::too_many_arguments)] // Python keywords, each optional
 pub fn rockfill<'py>(
     py: Python<'py>,
     out: PathBuf,
@@ -120,6 +124,8 @@ pub fn rockfill<'py>(
     seed: Option<u64>,
     bed: Option<PathBuf>,
     progress: Option<Py<PyAny>>,
+    max_rocks: Option<usize>,
+    max_steps: Option<u64>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let mut config = match &config {
         Some(c) => config_of(c)?,
@@ -135,6 +141,12 @@ pub fn rockfill<'py>(
     }
     if let Some(seed) = seed {
         config.rock.seed = seed;
+    }
+    if let Some(max) = max_rocks {
+        config.limits.max_rocks = max;
+    }
+    if let Some(max) = max_steps {
+        config.limits.max_steps = max;
     }
     let title = format!(
         "{} mm rocks, seed {}",

@@ -88,9 +88,14 @@ fn advance(sim: &mut Simulation, n: u64) -> Result<(), scene::RunError> {
 
 /// The step index at time `t` (s) by the engine's rounding ([`Simulation::set_end_time`]), the
 /// simulation left as it was.
-fn step_at(sim: &mut Simulation, t: Real) -> PyResult<u64> {
+/// `max_steps` bounds the run's total step count (the engine's default limit when `None`).
+fn step_at(sim: &mut Simulation, t: Real, max_steps: Option<u64>) -> PyResult<u64> {
     let (end_time, steps) = (sim.end_time, sim.steps);
-    let result = sim.set_end_time(t).map(|()| sim.steps);
+    let result = match max_steps {
+        Some(max) => sim.set_end_time_within(t, max),
+        None => sim.set_end_time(t),
+    }
+    .map(|()| sim.steps);
     (sim.end_time, sim.steps) = (end_time, steps);
     result.map_err(|e| PyValueError::new_err(format!("until: {e}")))
 }
@@ -176,9 +181,11 @@ impl PySimulation {
     /// given intervals (s); the directory is locked for the run and its series start afresh. The steps
     /// run in Rust with the GIL released; it is taken again between stretches for the callbacks and for
     /// Ctrl-C (`KeyboardInterrupt` stops the run there). An exception raised by a callback stops the run
-    /// and propagates.
+    /// and propagates. A run to `until` longer than the engine's step limit (10⁹ steps) is refused unless
+    /// `max_steps` raises it.
     #[pyo3(signature = (until = None, every = None, callback = None, *, progress = None, out = None,
-                        vtk_interval = None, contacts_interval = None, checkpoint_interval = None))]
+                        vtk_interval = None, contacts_interval = None, checkpoint_interval = None,
+                        max_steps = None))]
     #[allow(clippy::too_many_arguments)] // Python keywords, each optional
     fn run<'py>(
         slf: &Bound<'py, Self>,
@@ -190,12 +197,13 @@ impl PySimulation {
         vtk_interval: Option<Real>,
         contacts_interval: Option<Real>,
         checkpoint_interval: Option<Real>,
+        max_steps: Option<u64>,
     ) -> PyResult<()> {
         let (last, callback_every) = {
             let mut this = slf.borrow_mut();
             let dt = this.sim.params.dt;
             let last = match until {
-                Some(t) => step_at(&mut this.sim, t)?,
+                Some(t) => step_at(&mut this.sim, t, max_steps)?,
                 None => this.sim.steps,
             };
             let every = every.map(|t| interval_steps(t, dt)).transpose()?;

@@ -63,3 +63,21 @@ def test_bodies_from_columns(repo):
         polydem.bodies("grain", count=n, shape="cube", position=xyz[:11])
     with pytest.raises(ValueError, match="a prefix needs count"):
         polydem.bodies("grain", position=xyz)
+
+
+def test_time_step_check_is_a_scene_key():
+    assert polydem.Scene.from_dict({**CUBE_DROP, "simulation": {**CUBE_DROP["simulation"],
+                                                                "time_step_check": "warn"}}).num_bodies == 1
+    with pytest.raises(polydem.SceneError) as err:
+        polydem.Scene.from_dict({**CUBE_DROP, "simulation": {**CUBE_DROP["simulation"], "time_step_check": "maybe"}})
+    assert "time_step_check" in str(err.value), str(err.value)
+
+
+def test_a_run_beyond_the_step_limit_is_refused_unless_raised(repo):
+    sim = polydem.Simulation.from_toml(repo / "scenes/cube_drop.toml")
+    with pytest.raises(ValueError, match="until: .*limit"):
+        sim.run(until=1e9)
+    with pytest.raises(ValueError, match="until: .*limit of 10 steps"):
+        sim.run(until=0.01, max_steps=10)
+    sim.run(until=0.01, max_steps=10**6)
+    assert sim.step_index == round(0.01 / sim.dt) and abs(sim.time - 0.01) <= sim.dt, (sim.step_index, sim.time)
