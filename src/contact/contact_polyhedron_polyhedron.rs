@@ -41,13 +41,16 @@ pub const SCAN_MAX_VERTICES: usize = 64;
 pub struct PairCache {
     /// Last GJK search vector (≈ the point of A ⊖ B closest to the origin), in A's frame; zero if none.
     pub dir: Vector,
-    /// Support-map hints (vertex indices for polyhedra) of A and B.
+    /// Support-map hint (vertex index for polyhedra) of A.
     pub hint_a: u32,
+    /// Support-map hint (vertex index) of B.
     pub hint_b: u32,
     /// The last overlap's EPA normal (A's frame) and the vertex-index pairs (A, B) of its terminal face:
     /// the next query starts EPA from this face (see the module docs). Valid when `has_face`.
     pub normal: Vector,
+    /// Vertex-index pairs (A, B) of the three vertices of the last terminal EPA face.
     pub face: [[u32; 2]; 3],
+    /// Whether `normal` and `face` hold a face from an earlier overlap.
     pub has_face: bool,
 }
 

@@ -29,6 +29,7 @@ use crate::shape::{ConvexShape, SupportMap};
 /// The answer of the generic arm: the geometry the laws use and what the solver knows about it.
 #[derive(Copy, Clone, Debug, PartialEq)]
 pub struct SupportMapContact {
+    /// The contact features the laws use (world frame).
     pub geometry: ContactGeometry,
     /// Bounds `[lower, upper]` on the signed overlap s (m): s = depth when overlapping, −distance when apart.
     pub bounds: [Real; 2],
