@@ -9,11 +9,15 @@ use super::time_step::TimeStepInfo;
 /// A scene ready to run.
 #[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub struct Simulation {
+    /// The world: bodies, walls, materials, contacts.
     pub world: World,
+    /// Parameters of the step.
     pub params: StepParams,
+    /// How the time step was chosen.
     pub time_step: TimeStepInfo,
-    /// Simulated duration (s) and the number of steps that covers it.
+    /// Simulated duration (s).
     pub end_time: Real,
+    /// Number of steps that covers `end_time`.
     pub steps: u64,
     /// Output every this many steps.
     pub output_every: u64,
