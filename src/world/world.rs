@@ -28,24 +28,50 @@ pub use super::wall::Wall;
 /// Why a body, wall or material could not be added.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum WorldError {
+    /// A body refers to a shape index that does not exist.
     #[error("body '{body}': shape index {shape} does not exist ({count} shapes)")]
     UnknownShape {
+        /// Name of the body.
         body: String,
+        /// The shape index given.
         shape: usize,
+        /// Number of shapes in the world.
         count: usize,
     },
+    /// A body was given a plane as its shape.
     #[error("body '{body}': a plane cannot be a body's shape (planes are walls)")]
-    PlaneBody { body: String },
+    PlaneBody {
+        /// Name of the body.
+        body: String,
+    },
+    /// A body or wall refers to a material id that does not exist.
     #[error("'{owner}': material index {material} does not exist ({count} materials)")]
     UnknownMaterial {
+        /// Name of the body or wall.
         owner: String,
+        /// The material id given.
         material: usize,
+        /// Number of materials in the table.
         count: usize,
     },
+    /// Two materials that can meet have no contact law.
     #[error("'{owner}': no contact law for the material pair ('{a}', '{b}')")]
-    MissingLaw { owner: String, a: String, b: String },
+    MissingLaw {
+        /// Name of the body or wall being added.
+        owner: String,
+        /// First material of the pair.
+        a: String,
+        /// Second material of the pair.
+        b: String,
+    },
+    /// A wall's position or velocity is not finite.
     #[error("wall '{wall}': {what} must be finite")]
-    NonFiniteWall { wall: String, what: &'static str },
+    NonFiniteWall {
+        /// Name of the wall.
+        wall: String,
+        /// Which quantity.
+        what: &'static str,
+    },
 }
 
 /// The symmetric table material pair → contact model.
@@ -87,14 +113,17 @@ impl MaterialTable {
             .and_then(|m| m.as_ref())
     }
 
+    /// Number of materials.
     pub fn len(&self) -> usize {
         self.names.len()
     }
 
+    /// Whether the table has no material.
     pub fn is_empty(&self) -> bool {
         self.names.is_empty()
     }
 
+    /// Name of material `id`. Panics if `id` is not a material of the table.
     pub fn name(&self, id: u32) -> &str {
         &self.names[id as usize]
     }
@@ -129,7 +158,9 @@ pub struct Loads {
 /// Every body, wall, shape and material of a simulation, and the state kept between steps.
 #[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub struct World {
+    /// The shapes the bodies refer to (by index).
     pub shapes: Vec<Shape>,
+    /// State of each body (pose, velocities, mass properties, motion).
     pub bodies: Vec<RigidBody>,
     /// Index into `shapes` of each body's shape.
     pub shape_of: Vec<u32>,
@@ -137,19 +168,27 @@ pub struct World {
     pub material_of: Vec<u32>,
     /// Bounding-sphere radius of each body about its centre of mass (m).
     pub radii: Vec<Real>,
+    /// Name of each body.
     pub names: Vec<String>,
+    /// The walls (planes).
     pub walls: Vec<Wall>,
+    /// Materials and the contact law of each pair.
     pub materials: MaterialTable,
     /// Gravitational acceleration (m/s²).
     pub gravity: Vector,
+    /// Persistent contacts with their history (tangential springs, solver caches).
     pub contacts: ContactStore,
+    /// Broad phase: grid, neighbour list and Verlet skin.
     pub broad_phase: BroadPhase,
+    /// Resultant loads of the last force evaluation.
     pub loads: Loads,
+    /// Energy dissipated and work done so far.
     pub ledger: EnergyLedger,
     /// Which bodies are asleep (see [`super::sleeping`]); empty until the first step.
     pub sleep: SleepState,
-    /// Simulated time (s) and completed steps.
+    /// Simulated time (s).
     pub time: Real,
+    /// Completed steps.
     pub step_index: u64,
 }
 

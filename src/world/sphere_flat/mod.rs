@@ -107,14 +107,36 @@ use pair::{Kinematic, PairConstants, PairOut, Props, WallConstants, WallPlane};
 /// Why a world cannot take the flat sphere path (see the module docs).
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum NotSphereOnly {
+    /// A body is not a sphere.
     #[error("body {body} ('{name}') is not a sphere")]
-    NotASphere { body: usize, name: String },
+    NotASphere {
+        /// Index of the body.
+        body: usize,
+        /// Name of the body.
+        name: String,
+    },
+    /// A body is not dynamic (fixed or prescribed).
     #[error("body {body} ('{name}') is not a free (dynamic) body")]
-    NotDynamic { body: usize, name: String },
+    NotDynamic {
+        /// Index of the body.
+        body: usize,
+        /// Name of the body.
+        name: String,
+    },
+    /// A body's principal moments of inertia are not equal.
     #[error("body {body} ('{name}') has unequal principal moments")]
-    Anisotropic { body: usize, name: String },
+    Anisotropic {
+        /// Index of the body.
+        body: usize,
+        /// Name of the body.
+        name: String,
+    },
+    /// The step parameters use something the path does not implement.
     #[error("the flat sphere path needs {what}")]
-    Params { what: &'static str },
+    Params {
+        /// What the path needs.
+        what: &'static str,
+    },
 }
 
 /// The angular part of a sphere's state, read by the integration only.
@@ -467,6 +489,7 @@ impl SphereSim {
         self.kin.len()
     }
 
+    /// Whether there are no spheres.
     pub fn is_empty(&self) -> bool {
         self.kin.is_empty()
     }
@@ -481,20 +504,22 @@ impl SphereSim {
         self.kin[i].velocity
     }
 
-    /// Angular momentum (kg·m²/s) and orientation of sphere `i`.
+    /// Angular momentum of sphere `i` (kg·m²/s, world frame).
     pub fn angular_momentum(&self, i: usize) -> Vector {
         self.spin[i].angular_momentum
     }
 
+    /// Orientation of sphere `i` (body to world).
     pub fn orientation(&self, i: usize) -> Rotation {
         self.spin[i].orientation
     }
 
-    /// Contact force (N) and torque (N·m) on each sphere from the last evaluation.
+    /// Contact force on each sphere from the last evaluation (N).
     pub fn forces(&self) -> &[Vector] {
         &self.force
     }
 
+    /// Contact torque on each sphere from the last evaluation (N·m).
     pub fn torques(&self) -> &[Vector] {
         &self.torque
     }
@@ -542,11 +567,12 @@ impl SphereSim {
         sum
     }
 
-    /// Simulated time (s) and completed steps.
+    /// Simulated time (s).
     pub fn time(&self) -> Real {
         self.time
     }
 
+    /// Completed steps.
     pub fn step_index(&self) -> u64 {
         self.step_index
     }
@@ -711,8 +737,10 @@ impl SphereSim {
 /// failed.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum StepFlatError {
+    /// The world does not fit the flat sphere path.
     #[error(transparent)]
     NotSphereOnly(#[from] NotSphereOnly),
+    /// The initial force evaluation failed.
     #[error(transparent)]
     Step(#[from] StepError),
 }
