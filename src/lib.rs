@@ -15,6 +15,7 @@
 //! - [`special_functions`]: elliptic integrals and Jacobi elliptic functions for the analytic references.
 //! - [`world`]: the many-body engine: broad phase, contact store, step pipeline.
 
+#![warn(missing_docs)]
 #![cfg_attr(doctest, doc = include_str!("../README.md"))] // the README's example is a doctest
 
 pub mod contact;

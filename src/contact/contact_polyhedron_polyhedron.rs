@@ -32,7 +32,7 @@ use crate::math::{Point, Pose, Real, Vector};
 use crate::shape::{ConvexPolyhedron, SupportMap};
 
 /// Up to this many vertices (both shapes) the polyhedron query uses a contiguous linear scan as support
-/// map ([`VertexScan`]) rather than the shapes' hill-climbing; measured faster for 16–64-vertex hulls in
+/// map (`VertexScan`) rather than the shapes' hill-climbing; measured faster for 16–64-vertex hulls in
 /// `tests/contact_timing.rs`.
 pub const SCAN_MAX_VERTICES: usize = 64;
 

@@ -39,7 +39,7 @@
 //! observer reads a separated pair's geometry), `has_face = false` (already false: a stored proof is dropped
 //! by every query that could set it), and the support hints of both shapes. The hints are the only input
 //! a later query takes from them, and the bound is kept only for pairs whose shapes both use the full
-//! vertex scan ([`VertexScan`], at most `SCAN_MAX_VERTICES` vertices), which ignores the incoming hint: so
+//! vertex scan (`VertexScan`, at most `SCAN_MAX_VERTICES` vertices), which ignores the incoming hint: so
 //! a later query, the pair smoothing (which reads the hints that query left) and the forces are the same
 //! bits. `tests/world_skip_motion_bound.rs` checks the bound against the exact test over random motions
 //! and the trajectories of a polyhedral bed with the switch on and off.
