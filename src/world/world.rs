@@ -156,6 +156,64 @@ pub struct Loads {
 }
 
 /// Every body, wall, shape and material of a simulation, and the state kept between steps.
+///
+/// # Example
+/// A sphere of radius 0.1 m dropped from 0.5 m onto a floor, built by hand and stepped with
+/// [`step`](crate::world::step()) until it has bounced:
+///
+/// ```
+/// use polydem::dynamics::{PrincipalInertia, RigidBody};
+/// use polydem::law::{ContactModel, DampingLaw, NormalLaw, TangentialLaw};
+/// use polydem::math::{Point, Pose, Vector};
+/// use polydem::shape::{Plane, Shape, Sphere};
+/// use polydem::world::{step, MaterialTable, StepParams, StepScratch, Wall, World};
+///
+/// // One material; an elastic linear law between it and itself.
+/// let mut materials = MaterialTable::default();
+/// let steel = materials.add_material("steel");
+/// let model = ContactModel {
+///     normal: NormalLaw::linear(1.0e7)?, // k_n (N/m)
+///     damping: DampingLaw::None,
+///     tangential: TangentialLaw::None,
+/// };
+/// materials.set_model(steel, steel, model);
+/// let mut world = World::new(Vector::new(0.0, 0.0, -9.81), materials, 0.01);
+///
+/// // The floor: the half-space z ≤ 0 (outward normal +z).
+/// let floor = Wall {
+///     name: "floor".into(),
+///     plane: Plane::new(Vector::z(), 0.0)?,
+///     pose: Pose::identity(),
+///     velocity: Vector::zeros(),
+///     material: steel,
+/// };
+/// world.add_wall(floor)?;
+///
+/// // The ball: mass and inertia from the shape's volume properties and the density (kg/m³).
+/// let sphere = Sphere::new(0.1)?;
+/// let props = sphere.mass_properties();
+/// let density = 7800.0;
+/// let inertia = PrincipalInertia::new(props.principal_moments * density)?;
+/// let ball = RigidBody::new_dynamic(Point::new(0.0, 0.0, 0.5), props.volume * density, inertia)?;
+/// let shape = world.add_shape(Shape::Sphere(sphere));
+/// world.add_body("ball", shape, steel, ball)?;
+///
+/// // Δt well below the contact time π √(m/k_n) ≈ 5.7 ms.
+/// let params = StepParams::new(1.0e-4);
+/// let mut scratch = StepScratch::default();
+/// let mut lowest: f64 = 0.5;
+/// for _ in 0..4000 {
+///     step(&params, &mut world, &mut scratch)?;
+///     lowest = lowest.min(world.bodies[0].position.z);
+/// }
+/// let ball = &world.bodies[0];
+/// assert!(lowest < 0.1, "the ball reached the floor (lowest centre {lowest} m)");
+/// assert!(ball.velocity.z > 0.0 || ball.position.z > lowest, "and bounced");
+/// // No damping, no friction: the mechanical energy is kept (the balance closes to the step's error).
+/// let energy = world.energy();
+/// assert!(energy.balance.abs() < 1e-3 * energy.mechanical().abs());
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
 #[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub struct World {
     /// The shapes the bodies refer to (by index).
