@@ -32,7 +32,7 @@ use crate::math::{Point, Pose, Real, Vector};
 use crate::shape::{ConvexPolyhedron, SupportMap};
 
 /// Up to this many vertices (both shapes) the polyhedron query uses a contiguous linear scan as support
-/// map ([`VertexScan`]) rather than the shapes' hill-climbing; measured faster for 16–64-vertex hulls in
+/// map (`VertexScan`) rather than the shapes' hill-climbing; measured faster for 16–64-vertex hulls in
 /// `tests/contact_timing.rs`.
 pub const SCAN_MAX_VERTICES: usize = 64;
 
@@ -41,13 +41,16 @@ pub const SCAN_MAX_VERTICES: usize = 64;
 pub struct PairCache {
     /// Last GJK search vector (≈ the point of A ⊖ B closest to the origin), in A's frame; zero if none.
     pub dir: Vector,
-    /// Support-map hints (vertex indices for polyhedra) of A and B.
+    /// Support-map hint (vertex index for polyhedra) of A.
     pub hint_a: u32,
+    /// Support-map hint (vertex index) of B.
     pub hint_b: u32,
     /// The last overlap's EPA normal (A's frame) and the vertex-index pairs (A, B) of its terminal face:
     /// the next query starts EPA from this face (see the module docs). Valid when `has_face`.
     pub normal: Vector,
+    /// Vertex-index pairs (A, B) of the three vertices of the last terminal EPA face.
     pub face: [[u32; 2]; 3],
+    /// Whether `normal` and `face` hold a face from an earlier overlap.
     pub has_face: bool,
 }
 
@@ -430,6 +433,33 @@ pub fn intersect_polytopes_cached<A: Polytope + ?Sized, B: Polytope + ?Sized>(
 
 /// Contact query between two convex polyhedra with a fresh cache, fresh scratch, default tolerances and no
 /// counters: the convenience form (CLI, tests). The answer is the same as the hot path's.
+///
+/// `pos1` and `pos2` place A and B in the world (from each shape's principal frame); the answer is in the
+/// world frame, with the conventions of [`ContactGeometry`].
+///
+/// # Example
+/// Two unit cubes, B shifted by 0.9 m along x: they overlap by 0.1 m, normal +x.
+///
+/// ```
+/// use polydem::contact::{query_polyhedra, ContactKind};
+/// use polydem::math::{Point, Pose, Vector};
+/// use polydem::shape::ConvexPolyhedron;
+///
+/// let corners: Vec<Point> = (0..8)
+///     .map(|i| Point::new((i & 1) as f64 - 0.5, ((i >> 1) & 1) as f64 - 0.5, (i >> 2) as f64 - 0.5))
+///     .collect();
+/// // `frame` places the cube's principal frame in the frame of the corners.
+/// let (cube, frame) = ConvexPolyhedron::from_points(&corners)?;
+/// let pos1 = frame;
+/// let pos2 = Pose::translation(0.9, 0.0, 0.0) * frame;
+/// let g = query_polyhedra(&pos1, &cube, &pos2, &cube);
+/// assert_eq!(g.kind, ContactKind::Overlap);
+/// assert!((g.depth - 0.1).abs() < 1e-9, "depth {}", g.depth);
+/// assert!((g.normal - Vector::x()).norm() < 1e-9, "normal {}", g.normal);
+/// // c_M is the midpoint of the contact points on A and B.
+/// assert!((g.point - Point::from((g.point_a.coords + g.point_b.coords) / 2.0)).norm() < 1e-12);
+/// # Ok::<(), polydem::shape::ShapeError>(())
+/// ```
 pub fn query_polyhedra(
     pos1: &Pose,
     a: &ConvexPolyhedron,

@@ -3,7 +3,7 @@
 //!
 //! The signed overlap of A and B (depth when they overlap, minus the distance when they are apart) is
 //! s = min over unit n of h(n), h(n) = h_A(n) + h_B(−n) the support function of A ⊖ B in frame 1
-//! ([`super::minkowski`]); every direction gives an upper bound h(n) ≥ s. GJK (apart) and EPA (overlapping)
+//! (`minkowski`); every direction gives an upper bound h(n) ≥ s. GJK (apart) and EPA (overlapping)
 //! also keep a lower bound: −|v| for GJK's closest simplex point v, the closest face offset of EPA's
 //! polytope P ⊂ A ⊖ B. On a polytope both terminate exactly; on a curved surface they stop only by
 //! tolerance: when the bounds agree within `curved_gap · ℓ` ([`ContactTolerances::curved_gap`]), ℓ the
@@ -29,6 +29,7 @@ use crate::shape::{ConvexShape, SupportMap};
 /// The answer of the generic arm: the geometry the laws use and what the solver knows about it.
 #[derive(Copy, Clone, Debug, PartialEq)]
 pub struct SupportMapContact {
+    /// The contact features the laws use (world frame).
     pub geometry: ContactGeometry,
     /// Bounds `[lower, upper]` on the signed overlap s (m): s = depth when overlapping, −distance when apart.
     pub bounds: [Real; 2],

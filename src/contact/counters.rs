@@ -9,17 +9,22 @@ use std::fmt;
 /// Per-caller statistics of contact queries.
 #[derive(Copy, Clone, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub struct QueryCounters {
-    /// Queries answered, by the pair kind.
+    /// Polyhedron–polyhedron queries answered.
     pub polyhedron_polyhedron: u64,
+    /// Sphere–sphere queries answered.
     pub sphere_sphere: u64,
+    /// Sphere–plane queries answered.
     pub sphere_plane: u64,
+    /// Polyhedron–plane queries answered.
     pub polyhedron_plane: u64,
+    /// Sphere–polyhedron queries answered.
     pub sphere_polyhedron: u64,
-    /// Queries through the generic support-map arm (a pair with a curved shape other than two spheres) and
-    /// curved shapes against a plane. These three are not serialised, so that checkpoints and reports
-    /// keep their format.
+    /// Queries through the generic support-map arm (a pair with a curved shape other than two spheres).
+    /// This and the next two counters are not serialised, so that checkpoints and reports keep their
+    /// format.
     #[serde(skip)]
     pub support_map: u64,
+    /// Queries of a curved shape (other than a sphere) against a plane.
     #[serde(skip)]
     pub convex_plane: u64,
     /// Generic-arm queries whose depth bounds did not meet `curved_gap` (cap or degeneracy): answered with
@@ -33,24 +38,29 @@ pub struct QueryCounters {
     /// Pairs whose cached-axis test was skipped because their motion since it last proved them separated
     /// cannot have closed the gap (`crate::world::skips::still_separated`; no support call).
     pub motion_bound_skips: u64,
-    /// GJK runs and their total iterations.
+    /// GJK runs.
     pub gjk_runs: u64,
+    /// Total GJK iterations over `gjk_runs`.
     pub gjk_iterations: u64,
-    /// EPA runs and their total iterations.
+    /// EPA runs.
     pub epa_runs: u64,
+    /// Total EPA iterations over `epa_runs`.
     pub epa_iterations: u64,
     /// EPA runs started from the pair's previous terminal face, and how many of them proved the overlap
     /// (the others continued on the cold path).
     pub epa_warm_starts: u64,
+    /// Warm-started EPA runs that proved the overlap from the previous face.
     pub epa_warm_hits: u64,
     /// Exact SAT fallbacks after GJK or EPA hit its iteration cap.
     pub fallback_max_iterations: u64,
     /// Exact SAT fallbacks after GJK or EPA met a degenerate configuration (flat start, broken horizon,
     /// buffer full).
     pub fallback_degenerate: u64,
-    /// Results by kind.
+    /// Queries that ended [`Overlap`](super::ContactKind::Overlap).
     pub overlapping: u64,
+    /// Queries that ended [`Touching`](super::ContactKind::Touching).
     pub touching: u64,
+    /// Queries that ended [`Separated`](super::ContactKind::Separated).
     pub separated: u64,
 }
 

@@ -36,6 +36,7 @@ use crate::shape::{ConvexPolyhedron, ConvexShape, Shape};
 /// A query that has no meaning.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
 pub enum ContactError {
+    /// Both shapes are planes: walls never touch each other.
     #[error("contact between two planes (walls) is not defined")]
     PlanePlane,
 }

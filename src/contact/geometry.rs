@@ -45,13 +45,21 @@ pub enum SolverStatus {
 ///   where the contact force acts.
 #[derive(Copy, Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct ContactGeometry {
+    /// Overlap, touching or separated.
     pub kind: ContactKind,
+    /// Minkowski overlap δ_M ≥ 0 (m); zero unless overlapping.
     pub depth: Real,
+    /// Gap d ≥ 0 (m); zero unless separated.
     pub distance: Real,
+    /// Unit normal n_M, from A towards B (world frame).
     pub normal: Vector,
+    /// Contact point c1 on the surface of A (world frame, m).
     pub point_a: Point,
+    /// Contact point c2 on the surface of B (world frame, m).
     pub point_b: Point,
+    /// Midpoint c_M = (c1 + c2)/2 where the force acts (world frame, m).
     pub point: Point,
+    /// Which solver produced the answer and whether it fell back.
     pub status: SolverStatus,
 }
 

@@ -4,8 +4,8 @@
 //! returns a [`ContactGeometry`]. It never computes forces: contact laws live elsewhere and consume the
 //! geometry.
 //!
-//! Files, one job each: [`minkowski`] (support of A ⊖ B in A's frame), [`gjk`] (distance / intersection),
-//! [`epa`] (Minkowski overlap), [`sat`] (exact oracle and fallback), [`features`] (closest points of small
+//! Files, one job each: `minkowski` (support of A ⊖ B in A's frame), `gjk` (distance / intersection),
+//! `epa` (Minkowski overlap), [`sat`] (exact oracle and fallback), [`features`] (closest points of small
 //! features), one file per shape pair ([`contact_polyhedron_polyhedron`], [`contact_sphere_polyhedron`],
 //! [`contact_polyhedron_plane`], [`contact_sphere_plane`], [`contact_sphere_sphere`](mod@contact_sphere_sphere)),
 //! the generic arms for any [`ConvexShape`](crate::shape::ConvexShape) ([`contact_support_map`]: GJK + EPA
@@ -26,11 +26,11 @@ pub mod contact_sphere_sphere;
 pub mod contact_support_map;
 pub mod counters;
 pub mod dispatch;
-pub mod epa;
+pub(crate) mod epa;
 pub mod features;
 mod geometry;
-pub mod gjk;
-pub mod minkowski;
+pub(crate) mod gjk;
+pub(crate) mod minkowski;
 pub mod pair_smoothing;
 pub mod sat;
 pub mod tolerances;

@@ -82,7 +82,10 @@ pub enum PairSmoothing {
     /// The exact Minkowski overlap δ_M, n_M, c1, c2 of EPA (the paper's law; force jumps at ties).
     Exact,
     /// The smoothed overlap of the module docs with h = `band` × min(L_A, L_B).
-    Smoothed { band: Real },
+    Smoothed {
+        /// Smoothing width as a fraction of the smaller shape's length scale (dimensionless).
+        band: Real,
+    },
 }
 
 impl Default for PairSmoothing {

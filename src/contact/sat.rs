@@ -34,7 +34,9 @@ use crate::shape::SupportMap;
 
 /// The view of a convex polytope that the exact oracle needs (all in the shape's local frame).
 pub trait Polytope: SupportMap {
+    /// The vertices (local frame, m).
     fn vertices(&self) -> &[Point];
+    /// Number of faces.
     fn num_faces(&self) -> usize;
     /// Outward unit normal of face `i`.
     fn face_normal(&self, i: usize) -> Vector;

@@ -91,7 +91,10 @@ pub enum WallDepth {
     /// or an edge rocks flat on the wall). Kept for comparison.
     DeepestVertex,
     /// The smoothed depth D = 2 S_h − S_2h of the module docs, with h = `band` × L.
-    Smoothed { band: Real },
+    Smoothed {
+        /// Smoothing width as a fraction of the body's length scale L (dimensionless).
+        band: Real,
+    },
 }
 
 impl Default for WallDepth {

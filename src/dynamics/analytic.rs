@@ -32,13 +32,21 @@ use crate::special_functions::{
 /// Why an analytic solution cannot be built for these inputs.
 #[derive(Debug, Clone, Copy, PartialEq, thiserror::Error)]
 pub enum AnalyticError {
+    /// The principal moments (kg·m²) are not finite and positive, or not in the order the solution needs.
     #[error("principal moments {moments:?} must be finite, positive and {requirement}")]
     InertiaOrder {
+        /// The principal moments J̄₁, J̄₂, J̄₃ given (kg·m²).
         moments: Vector,
+        /// The order the solution needs (e.g. J̄₁ < J̄₂ < J̄₃).
         requirement: &'static str,
     },
+    /// The initial state gives a motion without a regular periodic solution.
     #[error("degenerate motion (steady rotation about a principal axis or the separatrix M² = 2EJ₂): {reason}")]
-    Degenerate { reason: &'static str },
+    Degenerate {
+        /// Which degenerate case was met.
+        reason: &'static str,
+    },
+    /// An elliptic function could not be evaluated.
     #[error(transparent)]
     Elliptic(#[from] EllipticError),
 }
@@ -108,6 +116,7 @@ pub enum Regime {
 #[derive(Debug, Clone, Copy)]
 pub struct AsymmetricTop {
     inertia: Vector,
+    /// Which body axis the angular momentum circulates about.
     pub regime: Regime,
     amplitudes: Vector,
     sign: Real,
@@ -125,6 +134,11 @@ pub struct AsymmetricTop {
 }
 
 impl AsymmetricTop {
+    /// The motion from the principal moments `inertia` (kg·m², ordered J̄₁ < J̄₂ < J̄₃), the initial body-frame
+    /// angular velocity `omega_body0` (rad/s) and the initial orientation `orientation0` (body to world).
+    ///
+    /// Errors: [`AnalyticError::InertiaOrder`] if the moments are not strictly increasing, finite and
+    /// positive; [`AnalyticError::Degenerate`] on a steady rotation about a principal axis or on the separatrix.
     pub fn new(
         inertia: Vector,
         omega_body0: Vector,

@@ -24,7 +24,9 @@ pub enum Motion {
     /// Moves with a prescribed constant linear velocity (m/s) and angular velocity (rad/s, world frame),
     /// whatever acts on it (e.g. a wall compacting a sample). Forces on it are still reported by the caller.
     Prescribed {
+        /// Linear velocity of the centre of mass (m/s, world frame).
         velocity: Vector,
+        /// Angular velocity (rad/s, world frame).
         angular_velocity_world: Vector,
     },
 }
@@ -57,10 +59,18 @@ impl PrincipalInertia {
 /// Invalid mass properties.
 #[derive(Debug, Clone, Copy, PartialEq, thiserror::Error)]
 pub enum BodyError {
+    /// The mass is not finite and positive.
     #[error("mass must be finite and positive, got {mass}")]
-    InvalidMass { mass: Real },
+    InvalidMass {
+        /// The mass given (kg).
+        mass: Real,
+    },
+    /// A principal moment of inertia is not finite and positive.
     #[error("principal moments of inertia must be finite and positive, got {moments:?}")]
-    InvalidInertia { moments: Vector },
+    InvalidInertia {
+        /// The principal moments given (kg·m²).
+        moments: Vector,
+    },
 }
 
 /// One rigid body. Plain data; every vector is in the world frame unless its name says `body`.

@@ -22,7 +22,9 @@ use crate::math::{Real, Rotation, Vector};
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Integrator {
+    /// How positions and velocities are advanced (leapfrog and its options).
     pub translation: TranslationParams,
+    /// How orientations and angular velocities are advanced.
     pub rotation: RotationScheme,
 }
 

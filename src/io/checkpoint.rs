@@ -65,6 +65,7 @@ pub struct CheckpointPayload {
     /// The identity of the run that wrote it ([`crate::io::run_identity`]); `None` for a file written
     /// outside a run or by a version-9 build.
     pub run: Option<u64>,
+    /// The simulation: world, parameters and run state.
     pub simulation: Simulation,
 }
 
@@ -78,30 +79,68 @@ struct PayloadV9 {
 /// Why a checkpoint could not be written or read.
 #[derive(Debug, thiserror::Error)]
 pub enum CheckpointError {
+    /// The file could not be read or written.
     #[error("{}: {source}", path.display())]
     Io {
+        /// The file.
         path: PathBuf,
+        /// The I/O error.
         #[source]
         source: std::io::Error,
     },
+    /// The file does not start with the checkpoint magic bytes.
     #[error(
         "not a polydem checkpoint (the file does not start with the magic bytes \"PDEMCKPT\")"
     )]
     NotACheckpoint,
+    /// The file's format version is not one this build reads.
     #[error("checkpoint format version {found} is not supported by this build (it reads versions 9 to {supported})")]
-    UnsupportedVersion { found: u32, supported: u32 },
+    UnsupportedVersion {
+        /// Version found in the file.
+        found: u32,
+        /// Newest version this build reads.
+        supported: u32,
+    },
+    /// The file is shorter than its header says.
     #[error("truncated checkpoint: {expected} bytes expected ({HEADER_LEN}-byte header + payload), the file has {actual}")]
-    Truncated { expected: u64, actual: u64 },
+    Truncated {
+        /// Bytes the header announces (header and payload).
+        expected: u64,
+        /// Bytes the file has.
+        actual: u64,
+    },
+    /// The file has bytes after the payload.
     #[error("corrupt checkpoint: {extra} bytes after the end of the payload")]
-    TrailingData { extra: u64 },
+    TrailingData {
+        /// Number of extra bytes.
+        extra: u64,
+    },
+    /// The payload's CRC-32 does not match the one stored in the header.
     #[error("corrupt checkpoint: payload checksum {computed:#010x} does not match the stored {stored:#010x}")]
-    Checksum { stored: u32, computed: u32 },
+    Checksum {
+        /// Checksum stored in the header.
+        stored: u32,
+        /// Checksum of the payload read.
+        computed: u32,
+    },
+    /// The payload cannot be decoded.
     #[error("checkpoint payload cannot be decoded ({message}); it was written by a build with another layout or is damaged")]
-    Decode { message: String },
+    Decode {
+        /// The decoder's message.
+        message: String,
+    },
+    /// The decoded state is inconsistent (e.g. per-body arrays of different lengths).
     #[error("checkpoint state is inconsistent: {what}")]
-    Invalid { what: String },
+    Invalid {
+        /// Which invariant.
+        what: String,
+    },
+    /// The state could not be encoded.
     #[error("cannot encode the checkpoint: {message}")]
-    Encode { message: String },
+    Encode {
+        /// The encoder's message.
+        message: String,
+    },
 }
 
 /// Encodes `sim` into the checkpoint format (header + payload), with no run identity.

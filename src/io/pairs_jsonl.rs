@@ -28,30 +28,47 @@ use crate::shape::{ConvexPolyhedron, ShapeError};
 /// One parsed input line.
 #[derive(Clone, Debug, PartialEq)]
 pub struct PairInput {
+    /// The line's `id`, any JSON value, echoed in the answer.
     pub id: Value,
+    /// Vertices of shape A (world frame, m); the shape is their convex hull.
     pub a: Vec<Point>,
+    /// Vertices of shape B (world frame, m); the shape is their convex hull.
     pub b: Vec<Point>,
 }
 
 /// Why one input line could not be answered.
 #[derive(Debug, thiserror::Error)]
 pub enum LineError {
+    /// The line is not valid UTF-8.
     #[error("line is not valid UTF-8")]
     NotUtf8,
+    /// The line is not valid JSON (the parser's message).
     #[error("invalid JSON: {0}")]
     Json(String),
+    /// The JSON value is not an object.
     #[error("line is not a JSON object")]
     NotObject,
+    /// A required field is absent.
     #[error("missing field `{0}`")]
     MissingField(&'static str),
+    /// A point list is malformed.
     #[error("field `{field}`: {reason}")]
-    BadPoints { field: &'static str, reason: String },
+    BadPoints {
+        /// The field.
+        field: &'static str,
+        /// What is wrong with it.
+        reason: String,
+    },
+    /// A point list does not make a convex polyhedron.
     #[error("shape `{field}`: {source}")]
     Shape {
+        /// The field.
         field: &'static str,
+        /// Why the shape could not be built.
         #[source]
         source: ShapeError,
     },
+    /// The query produced a NaN or infinite value.
     #[error("the contact query returned a non-finite value")]
     NonFiniteResult,
 }
@@ -59,31 +76,46 @@ pub enum LineError {
 /// The answer to one pair.
 #[derive(Clone, Debug, Serialize)]
 pub struct ContactRecord<'a> {
+    /// The line's `id`.
     pub id: &'a Value,
+    /// Overlap, touching or separated.
     pub status: ContactKind,
+    /// Minkowski overlap δ_M (m); zero unless overlapping.
     pub depth: Real,
+    /// Gap (m); zero unless separated.
     pub distance: Real,
+    /// Unit normal n_M from A towards B (world frame).
     pub normal: [Real; 3],
+    /// Contact point c1 on A (world frame, m).
     pub point_a: [Real; 3],
+    /// Contact point c2 on B (world frame, m).
     pub point_b: [Real; 3],
+    /// Midpoint c_M = (c1 + c2)/2 (world frame, m).
     pub point: [Real; 3],
+    /// Which solver produced the answer.
     pub solver: SolverStatus,
 }
 
 /// The record written for a line that could not be answered.
 #[derive(Clone, Debug, Serialize)]
 pub struct ErrorRecord {
+    /// The line's `id`, when it could be read.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub id: Option<Value>,
+    /// Line number in the input (1-based).
     pub line: usize,
+    /// What went wrong.
     pub error: String,
 }
 
 /// Counts of one run over a stream.
 #[derive(Copy, Clone, Debug, Default, PartialEq, Eq)]
 pub struct StreamSummary {
+    /// Lines answered with a contact record.
     pub answered: usize,
+    /// Lines answered with an error record.
     pub errors: usize,
+    /// Blank lines skipped.
     pub blank: usize,
 }
 

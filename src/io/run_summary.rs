@@ -14,8 +14,11 @@ use crate::scene::{RunSummary, Simulation};
 pub struct CheckpointRecord {
     /// File name relative to the output directory.
     pub file: String,
+    /// Step at which it was written.
     pub step: u64,
+    /// Simulated time at which it was written (s).
     pub time: Real,
+    /// Size of the file (bytes).
     pub bytes: u64,
     /// Wall time of encoding and writing (s).
     pub seconds: Real,
@@ -24,20 +27,29 @@ pub struct CheckpointRecord {
 /// What the output side of a run did (timed outside the step).
 #[derive(Clone, Debug, Default)]
 pub struct OutputRecord {
-    /// Steps between CSV rows, VTK frames and checkpoints (`None`: not written).
+    /// Steps between CSV rows.
     pub csv_every: u64,
+    /// Steps between VTK frames (`None`: not written).
     pub vtk_every: Option<u64>,
+    /// Steps between checkpoints (`None`: not written).
     pub checkpoint_every: Option<u64>,
+    /// VTK frames written.
     pub vtk_frames: u64,
+    /// Bytes of VTK frames written.
     pub vtk_bytes: u64,
-    /// Steps between contact-network frames (`None`: not written), frames and bytes of `.vtp` written.
+    /// Steps between contact-network (`.vtp`) frames (`None`: not written).
     pub contacts_every: Option<u64>,
+    /// Contact-network frames written.
     pub contact_frames: u64,
+    /// Bytes of contact-network frames written.
     pub contact_bytes: u64,
+    /// The checkpoints written, in order.
     pub checkpoints: Vec<CheckpointRecord>,
     /// Wall time of all output: CSV rows, VTK frames and checkpoints.
     pub time: Duration,
+    /// Wall time of the VTK frames.
     pub vtk_time: Duration,
+    /// Wall time of the checkpoints.
     pub checkpoint_time: Duration,
 }
 
@@ -46,9 +58,11 @@ pub struct OutputRecord {
 pub struct RunOrigin {
     /// The scene file, or the checkpoint the run restarted from.
     pub source: String,
+    /// Whether the run restarted from a checkpoint.
     pub restarted: bool,
-    /// Step count and simulated time at the start of this run.
+    /// Step count at the start of this run.
     pub start_step: u64,
+    /// Simulated time at the start of this run (s).
     pub start_time: Real,
 }
 

@@ -53,8 +53,9 @@ use crate::math::{Point, Real, Vector};
 use crate::shape::{ConvexPolyhedron, Shape, SurfaceMesh};
 use crate::world::World;
 
-/// VTK cell type codes used here.
+/// VTK cell type of a single vertex.
 pub const VTK_VERTEX: u8 = 1;
+/// VTK cell type of a polygon.
 pub const VTK_POLYGON: u8 = 7;
 
 /// How the numbers of a `.vtu` are written.
@@ -83,6 +84,7 @@ pub enum VtkPrecision {
 /// Compression of the binary arrays.
 #[derive(Copy, Clone, Debug, PartialEq, Eq)]
 pub enum VtkCompression {
+    /// Uncompressed.
     None,
     /// zlib (deflate) in 32 KiB blocks, VTK's `vtkZLibDataCompressor`; binary format only.
     Zlib,
@@ -94,8 +96,11 @@ pub enum VtkCompression {
 /// values deflate well).
 #[derive(Copy, Clone, Debug, PartialEq, Eq)]
 pub struct VtkEncoding {
+    /// Binary or ASCII.
     pub format: VtkFormat,
+    /// Width of the floating-point arrays.
     pub precision: VtkPrecision,
+    /// Compression of the binary arrays.
     pub compression: VtkCompression,
 }
 
@@ -141,20 +146,27 @@ impl VtkEncoding {
 /// What one `.vtu` file holds.
 #[derive(Copy, Clone, Debug, Default, PartialEq, Eq)]
 pub struct PieceCounts {
+    /// Number of points.
     pub points: usize,
+    /// Number of cells.
     pub cells: usize,
 }
 
 /// The kinds of series.
 #[derive(Copy, Clone, Debug, PartialEq, Eq)]
 pub enum SeriesKind {
+    /// Polyhedral bodies as their faces.
     Polyhedra,
+    /// Spherical bodies as their centres.
     Spheres,
+    /// Walls as polygons.
     Walls,
+    /// Curved bodies (ellipsoids) as tessellated surfaces.
     Surfaces,
 }
 
 impl SeriesKind {
+    /// The series' file name stem (`polyhedra`, `spheres`, `walls`, `surfaces`).
     pub fn name(self) -> &'static str {
         match self {
             SeriesKind::Polyhedra => "polyhedra",
@@ -173,6 +185,7 @@ pub struct VtkWriter {
     series: Vec<(SeriesKind, Vec<(Real, String)>)>,
     /// Bytes written to frame files so far.
     pub bytes_written: u64,
+    /// Frames written so far.
     pub frames_written: u64,
 }
 

@@ -39,11 +39,17 @@ pub enum DampingLaw {
     /// Elastic contact (e = 1).
     None,
     /// f_d = coefficient · √(m* k_n) · δ^((n−1)/2) · δ̇, with the dimensionless coefficient ζ̂ ≥ 0.
-    Viscous { coefficient: Real },
+    Viscous {
+        /// The dimensionless damping coefficient ζ̂ ≥ 0.
+        coefficient: Real,
+    },
     /// A dashpot of constant coefficient c (N s/m): f_d = c δ̇ whatever the masses and overlap — LIGGGHTS'
     /// `absolute_damping on` (`gamman_abs`) and YADE's `ViscElMat` `cn`. The restitution then depends on
     /// the masses of the pair: e = exp(−π ζ/√(1 − ζ²)), ζ = c/(2√(m* k_n)), for the linear law.
-    Dashpot { coefficient: Real },
+    Dashpot {
+        /// The dashpot coefficient c_n ≥ 0 (N s/m).
+        coefficient: Real,
+    },
 }
 
 impl DampingLaw {
@@ -120,13 +126,16 @@ impl DampingLaw {
 /// needs besides the overlap and its rate.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum PreparedDamping {
+    /// No damping.
     None,
     /// f_d = factor · δ^((n−1)/2) · δ̇, factor = ζ̂ √(m* k_n) (N s/m^((n+1)/2)).
     Viscous {
+        /// ζ̂ √(m* k_n) of this contact (N s/m^((n+1)/2)).
         factor: Real,
     },
     /// f_d = c_n δ̇.
     Dashpot {
+        /// The dashpot coefficient c_n (N s/m).
         coefficient: Real,
     },
 }

@@ -34,6 +34,9 @@ pub struct ElasticMaterial {
 }
 
 impl ElasticMaterial {
+    /// The material with Young's modulus `young_modulus` (Pa) and Poisson's ratio `poisson_ratio`.
+    ///
+    /// Errors: [`LawError::OutOfRange`] unless E > 0 and −1 < ν ≤ 0.5 (both finite).
     pub fn new(young_modulus: Real, poisson_ratio: Real) -> Result<Self, LawError> {
         check_range(
             "Young's modulus E",
@@ -87,7 +90,9 @@ pub fn effective(a: Real, b: Option<Real>) -> Real {
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct SpherePair {
+    /// Elastic constants of A.
     pub material_a: ElasticMaterial,
+    /// Elastic constants of B (of the wall when `radius_b` is `None`).
     pub material_b: ElasticMaterial,
     /// Radius of A (m).
     pub radius_a: Real,

@@ -34,10 +34,14 @@ pub use tangential::{SpringRotation, TangentialHistory, TangentialLaw};
 /// Invalid law parameters.
 #[derive(Debug, Clone, Copy, PartialEq, thiserror::Error)]
 pub enum LawError {
+    /// A parameter is not finite or lies outside its valid range.
     #[error("{name} = {value} is outside its valid range {range}")]
     OutOfRange {
+        /// Name of the parameter.
         name: &'static str,
+        /// The value given (in the parameter's SI unit).
         value: crate::math::Real,
+        /// The valid range, as text.
         range: &'static str,
     },
 }

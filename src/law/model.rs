@@ -15,8 +15,11 @@ use crate::math::{Point, Real, Vector};
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ContactModel {
+    /// The normal force as a function of the overlap.
     pub normal: NormalLaw,
+    /// The normal damping force.
     pub damping: DampingLaw,
+    /// The tangential (friction) force and its history.
     pub tangential: TangentialLaw,
 }
 

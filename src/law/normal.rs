@@ -124,10 +124,12 @@ impl NormalLaw {
         Self::new(stiffness, 1.5)
     }
 
+    /// The elastic normal force f_n(δ) = k_n δⁿ (N) at overlap δ (m); zero for δ ≤ 0.
     pub fn force(&self, overlap: Real) -> Real {
         power_law_force(self.stiffness, self.exponent, overlap)
     }
 
+    /// The elastic energy k_n δⁿ⁺¹/(n + 1) (J) stored at overlap δ (m); zero for δ ≤ 0.
     pub fn potential(&self, overlap: Real) -> Real {
         power_law_potential(self.stiffness, self.exponent, overlap)
     }

@@ -18,7 +18,9 @@ use crate::math::{Point, Real, Vector};
 pub struct PreparedModel {
     /// The normal slot (k_n as the caller scaled it for the contact's radii).
     pub normal: NormalLaw,
+    /// The damping slot with this contact's constants formed.
     pub damping: PreparedDamping,
+    /// The tangential slot.
     pub tangential: TangentialLaw,
     /// The tangential dashpot's c_t over δ^¼: damping · √(m* k̂_t) for [`TangentialLaw::DampedMindlin`]
     /// with k_t = k̂_t √δ (N s/m^(5/4)), zero for the other laws. Formed once per contact, so that an

@@ -98,8 +98,10 @@ impl TangentialHistory {
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum SpringRotation {
+    /// Rotate u rigidly with the normal, keeping |u| (see the type docs).
     #[default]
     Exact,
+    /// Project u into the new tangent plane, as LIGGGHTS and LAMMPS do (see the type docs).
     Projection,
 }
 
@@ -112,15 +114,21 @@ pub enum TangentialLaw {
     None,
     /// Constant stiffness k_t (N/m) and friction coefficient μ.
     Spring {
+        /// Tangential stiffness k_t (N/m).
         stiffness: Real,
+        /// Coulomb friction coefficient μ ≥ 0.
         friction: Real,
+        /// How the spring follows the turning normal.
         #[serde(default)]
         rotation: SpringRotation,
     },
     /// Mindlin no-slip stiffness k_t = coefficient · δ^(1/2) (coefficient = 8 G* √R*, N/m^1.5), friction μ.
     Mindlin {
+        /// 8 G* √R* (N/m^1.5), so that k_t = coefficient · δ^(1/2).
         coefficient: Real,
+        /// Coulomb friction coefficient μ ≥ 0.
         friction: Real,
+        /// How the spring follows the turning normal.
         #[serde(default)]
         rotation: SpringRotation,
     },
@@ -129,9 +137,13 @@ pub enum TangentialLaw {
     /// dimensionless `damping` is 2√(5/6) β for LIGGGHTS, β = −ln e/√(π² + ln² e)); when |k_t u| exceeds
     /// μ F_n the force is capped at μ F_n along −u and the dashpot is off for that step.
     DampedMindlin {
+        /// 8 G* √R* (N/m^1.5), so that k_t = coefficient · δ^(1/2).
         coefficient: Real,
+        /// Coulomb friction coefficient μ ≥ 0.
         friction: Real,
+        /// Dimensionless tangential damping (c_t = damping · √(m* k_t)).
         damping: Real,
+        /// How the spring follows the turning normal.
         #[serde(default)]
         rotation: SpringRotation,
     },

@@ -56,8 +56,10 @@ pub enum StepPath {
 /// Why a run stopped early.
 #[derive(Debug, thiserror::Error)]
 pub enum RunError {
+    /// A step failed.
     #[error(transparent)]
     Step(#[from] StepError),
+    /// Writing an output file failed.
     #[error("writing output: {0}")]
     Output(#[from] std::io::Error),
 }
@@ -65,13 +67,17 @@ pub enum RunError {
 /// What a run did.
 #[derive(Clone, Debug, Default)]
 pub struct RunSummary {
+    /// Steps taken.
     pub steps: u64,
+    /// Wall time of the run loop.
     pub wall_time: Duration,
+    /// Counters and stage times of the steps.
     pub counters: StepCounters,
     /// Largest overlap / particle size seen at the end of any step.
     pub max_overlap_ratio: Real,
-    /// Steps that reported a contact deeper than the warning fraction, and the first such step.
+    /// Steps that reported a contact deeper than the warning fraction.
     pub steps_with_deep_overlap: u64,
+    /// The first step that reported a contact deeper than the warning fraction.
     pub first_deep_overlap_step: Option<u64>,
     /// Steps in which the check of the time step found the motion too fast for it (with
     /// `time_step_check = "warn"`), and the first finding with its step.
@@ -242,12 +248,20 @@ impl Simulation {
 /// Why an end time was refused.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum EndTimeError {
+    /// The end time is not finite and positive.
     #[error("end time {end_time} s must be finite and positive")]
-    NotPositive { end_time: Real },
+    NotPositive {
+        /// The end time asked for (s).
+        end_time: Real,
+    },
+    /// The end time lies before the simulation's current time.
     #[error("end time {end_time} s lies before the current time {time} s (step {step})")]
     BeforeNow {
+        /// The end time asked for (s).
         end_time: Real,
+        /// The current simulated time (s).
         time: Real,
+        /// The current step.
         step: u64,
     },
     #[error(transparent)]

@@ -15,19 +15,27 @@ pub type Vec3 = [f64; 3];
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct SceneFile {
+    /// `[simulation]`.
     pub simulation: SimulationSection,
+    /// `[[material]]` tables.
     #[serde(default, rename = "material")]
     pub materials: Vec<MaterialSection>,
+    /// `[[interaction]]` tables.
     #[serde(default, rename = "interaction")]
     pub interactions: Vec<InteractionSection>,
+    /// `[[shape]]` tables.
     #[serde(default, rename = "shape")]
     pub shapes: Vec<ShapeSection>,
+    /// `[[body]]` tables.
     #[serde(default, rename = "body")]
     pub bodies: Vec<BodySection>,
+    /// `[[wall]]` tables.
     #[serde(default, rename = "wall")]
     pub walls: Vec<WallSection>,
+    /// `[[box]]` tables.
     #[serde(default, rename = "box")]
     pub boxes: Vec<BoxSection>,
+    /// `[[body_file]]` tables.
     #[serde(default, rename = "body_file")]
     pub body_files: Vec<BodyFileSection>,
 }
@@ -78,6 +86,7 @@ pub struct SimulationSection {
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct MaterialSection {
+    /// Name the interactions refer to.
     pub name: Spanned<String>,
     /// Density (kg/m³).
     pub density: Spanned<f64>,
@@ -91,6 +100,7 @@ pub struct MaterialSection {
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct InteractionSection {
+    /// The two material names of the pair (either order).
     pub materials: Spanned<[String; 2]>,
     /// `"linear"` (f_n = k_n δ), `"power"` (f_n = k_n δ^n) or `"hertz_mindlin"` (from the materials' E, ν).
     pub law: Spanned<String>,
@@ -120,6 +130,7 @@ pub struct InteractionSection {
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ShapeSection {
+    /// Name the bodies and body files refer to.
     pub name: Spanned<String>,
     /// `"box"`, `"sphere"`, `"polyhedron"` or `"ellipsoid"`.
     pub kind: Spanned<String>,
@@ -137,8 +148,11 @@ pub struct ShapeSection {
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct BodySection {
+    /// Name of the body.
     pub name: Spanned<String>,
+    /// Name of its `[[shape]]`.
     pub shape: Spanned<String>,
+    /// Name of its `[[material]]`.
     pub material: Spanned<String>,
     /// Where the origin of the shape's own coordinates goes (m).
     pub position: Spanned<Vec3>,
@@ -161,7 +175,9 @@ pub struct BodySection {
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct WallSection {
+    /// Name of the wall.
     pub name: Spanned<String>,
+    /// Name of its `[[material]]`.
     pub material: Spanned<String>,
     /// A point of the plane (m).
     pub point: Spanned<Vec3>,
@@ -175,7 +191,9 @@ pub struct WallSection {
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct BoxSection {
+    /// Name of the box (its walls are named after it and the face).
     pub name: Spanned<String>,
+    /// Material of its walls.
     pub material: Spanned<String>,
     /// The lower corner (m).
     pub min: Spanned<Vec3>,
@@ -196,6 +214,7 @@ pub struct BoxSection {
 pub struct BodyFileSection {
     /// The CSV file, relative to the scene file's directory.
     pub path: Spanned<String>,
+    /// Material of the bodies.
     pub material: Spanned<String>,
     /// Body names are this prefix followed by the `id` column (or the row number).
     pub name_prefix: Spanned<String>,

@@ -62,7 +62,9 @@ pub struct TimeStepInfo {
 /// One pair that can meet: its law and effective mass.
 #[derive(Clone, Copy, Debug)]
 pub struct PairEstimate {
+    /// The contact law of the pair.
     pub model: ContactModel,
+    /// Effective mass m* = m_a m_b/(m_a + m_b) of the pair (kg).
     pub effective_mass: Real,
 }
 

@@ -5,7 +5,9 @@ use crate::math::Point;
 /// An axis-aligned box `[mins, maxs]` in the world frame (m).
 #[derive(Copy, Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Aabb {
+    /// Lower corner (m).
     pub mins: Point,
+    /// Upper corner (m).
     pub maxs: Point,
 }
 

@@ -42,9 +42,13 @@ use crate::math::Real;
 /// Any shape a body or wall can have. Polyhedra are shared (`Arc`) because many bodies use one shape.
 #[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub enum Shape {
+    /// A convex polyhedron, shared between the bodies that use it.
     Polyhedron(std::sync::Arc<ConvexPolyhedron>),
+    /// A sphere.
     Sphere(Sphere),
+    /// A half-space (a wall).
     Plane(Plane),
+    /// An ellipsoid.
     Ellipsoid(Ellipsoid),
 }
 

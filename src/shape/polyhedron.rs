@@ -61,6 +61,34 @@ impl ConvexPolyhedron {
     /// triangles merged into polygonal faces and interior, duplicate and edge/face-interior points dropped.
     ///
     /// Returns the polyhedron in its principal frame and the pose mapping that frame to the input frame.
+    ///
+    /// Errors: a [`ShapeError`] for fewer than 4 points, a non-finite coordinate, or points that are
+    /// coincident, collinear or coplanar (tolerances relative to the cloud's extent).
+    ///
+    /// # Example
+    /// A 2 × 1 × 1 m box from its corners plus an interior point (dropped):
+    ///
+    /// ```
+    /// use polydem::math::Point;
+    /// use polydem::shape::{ConvexPolyhedron, ShapeError};
+    ///
+    /// let mut points: Vec<Point> = (0..8)
+    ///     .map(|i| Point::new(2.0 * (i & 1) as f64, ((i >> 1) & 1) as f64, (i >> 2) as f64))
+    ///     .collect();
+    /// points.push(Point::new(1.0, 0.5, 0.5));
+    /// let (boxed, frame) = ConvexPolyhedron::from_points(&points)?;
+    /// assert_eq!(boxed.vertices().len(), 8);
+    /// assert_eq!(boxed.num_faces(), 6); // coplanar hull triangles merged into the rectangles
+    /// let volume = boxed.mass_properties().volume;
+    /// assert!((volume - 2.0).abs() < 1e-12, "volume {volume} m³");
+    /// // The principal frame sits at the centroid.
+    /// assert!((frame.translation.vector - Point::new(1.0, 0.5, 0.5).coords).norm() < 1e-12);
+    ///
+    /// // Three points cannot make a solid.
+    /// let err = ConvexPolyhedron::from_points(&points[..3]).unwrap_err();
+    /// assert!(matches!(err, ShapeError::TooFewPoints { count: 3 }));
+    /// # Ok::<(), ShapeError>(())
+    /// ```
     pub fn from_points(points: &[Point]) -> Result<(ConvexPolyhedron, Pose), ShapeError> {
         let extent = hull::validate_points(points)?;
         let mesh = hull::convex_hull(points)?;

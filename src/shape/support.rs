@@ -9,5 +9,6 @@ use crate::math::{Point, Vector};
 /// that hill-climb over vertex adjacency start from vertex `*hint` and leave the arg-max vertex index in it;
 /// others ignore it. Any value of `hint` (even out of range) must be accepted.
 pub trait SupportMap {
+    /// A point of the shape (local frame, m) extreme along `dir_local`; `hint` is read and updated as in the trait docs.
     fn local_support(&self, dir_local: &Vector, hint: &mut u32) -> Point;
 }

@@ -7,7 +7,9 @@ use crate::math::{Point, Real};
 /// (vertex indices, counter-clockwise seen from outside).
 #[derive(Clone, Debug, PartialEq)]
 pub struct SurfaceMesh {
+    /// Vertices (body frame, m).
     pub vertices: Vec<Point>,
+    /// Faces as vertex indices, counter-clockwise seen from outside.
     pub faces: Vec<Vec<u32>>,
 }
 

@@ -8,19 +8,33 @@ use std::f64::consts::PI;
 pub enum EllipticError {
     /// The parameter m must satisfy 0 ≤ m ≤ 1 (and m < 1 for K and F, which diverge at m = 1).
     #[error("elliptic parameter m = {m} is outside the supported range {range}")]
-    ParameterOutOfRange { m: Real, range: &'static str },
+    ParameterOutOfRange {
+        /// The parameter given.
+        m: Real,
+        /// The range allowed, as text.
+        range: &'static str,
+    },
     /// An argument was not finite.
     #[error("non-finite argument {name} = {value}")]
-    NonFinite { name: &'static str, value: Real },
+    NonFinite {
+        /// Name of the argument.
+        name: &'static str,
+        /// Its value.
+        value: Real,
+    },
 }
 
 /// The values of the three Jacobi elliptic functions at one argument, with the amplitude φ = am(u | m)
 /// (sn = sin φ, cn = cos φ).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct JacobiElliptic {
+    /// sn(u | m) = sin φ.
     pub sn: Real,
+    /// cn(u | m) = cos φ.
     pub cn: Real,
+    /// dn(u | m) = √(1 − m sin²φ).
     pub dn: Real,
+    /// The amplitude φ = am(u | m) (rad).
     pub am: Real,
 }
 

@@ -121,6 +121,7 @@ impl BroadPhase {
         }
     }
 
+    /// The Verlet skin (m): how far bounding spheres may be apart and still be listed as candidates.
     pub fn skin(&self) -> Real {
         self.skin
     }

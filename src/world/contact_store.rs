@@ -45,9 +45,19 @@ pub use super::separation_bound::SeparationBound;
 )]
 pub enum ContactKey {
     /// Two bodies, `a < b`; A = body a, B = body b.
-    Body { a: u32, b: u32 },
+    Body {
+        /// Index of the body with the smaller index.
+        a: u32,
+        /// Index of the other body.
+        b: u32,
+    },
     /// A body and a wall; A = the wall, B = the body.
-    Wall { body: u32, wall: u32 },
+    Wall {
+        /// Index of the body.
+        body: u32,
+        /// Index of the wall.
+        wall: u32,
+    },
 }
 
 /// What the store keeps for one pair.
@@ -146,7 +156,9 @@ pub struct BodyAdjacency {
     /// Whether the rows match the store's keys (false after a sync that changed them).
     valid: bool,
     bodies: usize,
+    /// Start of each body's row in `entries` (`bodies + 1` offsets).
     pub start: Vec<u32>,
+    /// Entry indices, row after row, each possibly tagged with `SIDE_A`.
     pub entries: Vec<u32>,
 }
 
@@ -212,8 +224,11 @@ impl PartialEq for ContactStore {
 /// What [`ContactStore::sync`] did.
 #[derive(Copy, Clone, Debug, Default, PartialEq, Eq)]
 pub struct SyncCounts {
+    /// Entries whose key was already stored.
     pub kept: usize,
+    /// Entries created for new candidates.
     pub created: usize,
+    /// Entries dropped (no longer candidates).
     pub dropped: usize,
 }
 
@@ -275,14 +290,17 @@ impl ContactStore {
         counts
     }
 
+    /// The stored keys, sorted.
     pub fn keys(&self) -> &[ContactKey] {
         &self.keys
     }
 
+    /// The state of each stored key, in key order.
     pub fn states(&self) -> &[ContactState] {
         &self.states
     }
 
+    /// The states, mutable, in key order.
     pub fn states_mut(&mut self) -> &mut [ContactState] {
         &mut self.states
     }
@@ -306,10 +324,12 @@ impl ContactStore {
         self.keys.binary_search(key).ok().map(|i| &self.states[i])
     }
 
+    /// Number of stored contacts.
     pub fn len(&self) -> usize {
         self.keys.len()
     }
 
+    /// Whether no contact is stored.
     pub fn is_empty(&self) -> bool {
         self.keys.is_empty()
     }

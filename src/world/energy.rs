@@ -81,9 +81,13 @@ use crate::math::Vector;
 pub struct EnergyLedger {
     /// Mechanical energy at the first evaluation of the loads (J); `None` before it.
     pub initial_total: Option<Real>,
+    /// Work of the normal damping dissipated so far (J).
     pub dissipated_damping: Real,
+    /// Work of friction dissipated so far (J).
     pub dissipated_friction: Real,
+    /// Work of the global viscous damping dissipated so far (J).
     pub dissipated_viscous: Real,
+    /// Work done on the system by non-dynamic bodies and walls so far (J).
     pub external_work: Real,
     /// Kinetic energy removed when bodies fell asleep (J).
     #[serde(default)]
@@ -97,15 +101,25 @@ pub struct EnergyLedger {
 /// Every term of the ledger at one instant (J).
 #[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct EnergyReport {
+    /// Simulated time (s).
     pub time: Real,
+    /// Translational kinetic energy of the dynamic bodies (J).
     pub translational_kinetic: Real,
+    /// Rotational kinetic energy of the dynamic bodies (J).
     pub rotational_kinetic: Real,
+    /// Elastic energy stored in the contacts (normal and tangential) (J).
     pub elastic_potential: Real,
+    /// Gravitational potential energy of the dynamic bodies (J).
     pub gravitational_potential: Real,
+    /// Work of the normal damping dissipated so far (J).
     pub dissipated_damping: Real,
+    /// Work of friction dissipated so far (J).
     pub dissipated_friction: Real,
+    /// Work of the global viscous damping dissipated so far (J).
     pub dissipated_viscous: Real,
+    /// Work done on the system by non-dynamic bodies and walls so far (J).
     pub external_work: Real,
+    /// Work of the tangential stiffness change so far (J).
     pub tangential_stiffness_work: Real,
     /// E(t) + dissipated (+ removed by sleeping) − external − tangential stiffness work − E(0): zero for
     /// exact dynamics.

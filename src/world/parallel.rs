@@ -125,7 +125,9 @@ impl Default for Parallelism {
 /// Per-chunk scratch of the narrow phase: nothing in it matters after the step's accumulation.
 #[derive(Clone, Debug, Default)]
 pub struct Worker {
+    /// Scratch of EPA (polytope buffers), reused across queries.
     pub epa: EpaScratch,
+    /// Counters of the queries of this chunk.
     pub query: QueryCounters,
     /// Items of this chunk that the caller marked for a serial pass after the region, in item order
     /// (cleared by [`for_each_chunked`]). Chunks are contiguous ranges of items in chunk order, so the

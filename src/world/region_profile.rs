@@ -50,6 +50,7 @@ const SECTIONS: usize = 9;
 const MAX_THREADS: usize = 64;
 
 impl Section {
+    /// Every section, in report order.
     pub const ALL: [Section; SECTIONS] = [
         Section::KickDrift,
         Section::BroadSearch,
@@ -62,6 +63,7 @@ impl Section {
         Section::SerialSums,
     ];
 
+    /// The section's name in reports.
     pub fn name(self) -> &'static str {
         match self {
             Section::KickDrift => "kick+drift",

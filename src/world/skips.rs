@@ -39,7 +39,7 @@
 //! observer reads a separated pair's geometry), `has_face = false` (already false: a stored proof is dropped
 //! by every query that could set it), and the support hints of both shapes. The hints are the only input
 //! a later query takes from them, and the bound is kept only for pairs whose shapes both use the full
-//! vertex scan ([`VertexScan`], at most `SCAN_MAX_VERTICES` vertices), which ignores the incoming hint: so
+//! vertex scan (`VertexScan`, at most `SCAN_MAX_VERTICES` vertices), which ignores the incoming hint: so
 //! a later query, the pair smoothing (which reads the hints that query left) and the forces are the same
 //! bits. `tests/world_skip_motion_bound.rs` checks the bound against the exact test over random motions
 //! and the trajectories of a polyhedral bed with the switch on and off.
@@ -77,16 +77,27 @@ pub use super::separation_bound::SeparationBound;
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Skips {
+    /// Skip a pair query whose bounding spheres are apart.
     pub bounding_spheres: bool,
+    /// Skip GJK for a polyhedron pair still separated along its cached axis.
     pub cached_axis: bool,
+    /// Skip the cached-axis test while the pair's motion cannot have closed the gap.
     pub motion_bound: bool,
+    /// Skip the cached-axis test of a pair whose warm-started EPA proves it still overlaps.
     pub warm_overlap: bool,
+    /// Rebuild the broad phase only when the bodies' moves reach the skin.
     pub verlet_skin: bool,
+    /// Keep no tangential history for frictionless pairs.
     pub frictionless_history: bool,
+    /// Skip the damping term of a law whose coefficient is zero.
     pub undamped_contacts: bool,
+    /// Skip the rotation drift of a body with zero angular momentum.
     pub still_rotation: bool,
+    /// Turn a body with equal principal moments in one exact rotation.
     pub isotropic_rotation: bool,
+    /// Skip queries between two non-dynamic bodies and the integration of fixed bodies.
     pub non_dynamic_pairs: bool,
+    /// Evaluate sphere–sphere and sphere–wall pairs with the closed forms and the law directly.
     pub sphere_kernel: bool,
 }
 

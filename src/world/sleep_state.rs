@@ -7,6 +7,7 @@ use crate::math::{Real, Vector};
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct SleepParams {
+    /// Whether bodies may fall asleep.
     pub enabled: bool,
     /// Rest speed as a fraction of √(|g| d).
     pub rest_speed: Real,
@@ -59,8 +60,9 @@ pub struct SleepState {
     pub calm_steps: Vec<u32>,
     /// Number of sleeping bodies.
     pub sleeping: usize,
-    /// Rest load of each sleeping body: net force F + m g (N) and contact torque (N·m) when it fell asleep.
+    /// Rest load of each sleeping body: net force F + m g (N) when it fell asleep.
     pub rest_force: Vec<Vector>,
+    /// Contact torque of each sleeping body when it fell asleep (N·m).
     pub rest_torque: Vec<Vector>,
     /// Departure of the net force (N) from the rest load that wakes each sleeping body (of the torque:
     /// this times its bounding radius).
@@ -79,6 +81,7 @@ impl SleepState {
         self.wake_limit.resize(n, 0.0);
     }
 
+    /// Whether body `i` is asleep (false for an index the state does not cover yet).
     pub fn is_asleep(&self, i: usize) -> bool {
         self.asleep.get(i).copied().unwrap_or(false)
     }
@@ -107,6 +110,8 @@ impl SleepState {
 /// What one sleeping update did.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct SleepCounts {
+    /// Bodies that fell asleep.
     pub fell_asleep: u64,
+    /// Bodies woken.
     pub woken: u64,
 }

@@ -28,7 +28,9 @@ pub enum Stage {
 /// The time of one stage: its wall time and the part of it that ran on one thread whatever the pool.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct StageTime {
+    /// Wall time of the stage.
     pub wall: Duration,
+    /// Part of `wall` spent on one thread whatever the pool.
     pub serial: Duration,
 }
 

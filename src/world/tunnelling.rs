@@ -50,7 +50,9 @@ use super::world::World;
 /// What the centre of a body went through.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Obstacle {
+    /// Another body (its index).
     Body(usize),
+    /// A wall (its index).
     Wall(usize),
 }
 
@@ -70,7 +72,9 @@ pub struct Crossing {
     pub step: u64,
     /// The dynamic body whose centre crossed.
     pub body: usize,
+    /// What the centre went through.
     pub obstacle: Obstacle,
+    /// Whether the pair's contact was registered during the step.
     pub kind: CrossingKind,
     /// Length of the centre's path during the step relative to the obstacle (m).
     pub path_length: Real,
@@ -79,9 +83,13 @@ pub struct Crossing {
 /// Counts of crossings over a run.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct CrossingCounts {
+    /// Bodies that tunnelled through another body.
     pub missed_body: u64,
+    /// Bodies that tunnelled through a wall.
     pub missed_wall: u64,
+    /// Bodies whose centre passed through another body despite a registered contact.
     pub pass_through_body: u64,
+    /// Bodies whose centre passed through a wall despite a registered contact.
     pub pass_through_wall: u64,
 }
 

@@ -8,12 +8,15 @@ use crate::shape::Plane;
 /// constant velocity (zero for a fixed wall).
 #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Wall {
+    /// Name of the wall.
     pub name: String,
+    /// The half-space in the wall's own frame.
     pub plane: Plane,
     /// Places the plane in the world (m).
     pub pose: Pose,
     /// Prescribed velocity (m/s), world frame; zero for a fixed wall.
     pub velocity: Vector,
+    /// Material id.
     pub material: u32,
 }
 

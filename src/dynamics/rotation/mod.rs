@@ -82,7 +82,10 @@ pub enum SubRotation {
 #[serde(rename_all = "snake_case")]
 pub enum RotationScheme {
     /// The DLM splitting of paper eqs. 19–25 (default: [`SubRotation::Cayley`] as in the paper).
-    Splitting { sub_rotation: SubRotation },
+    Splitting {
+        /// How each sub-rotation of the splitting is computed.
+        sub_rotation: SubRotation,
+    },
     /// Explicit first-order quaternion and Euler-equation update (comparison only).
     ExplicitEuler,
     /// Classical RK4 on the quaternion and Euler equations (comparison only).

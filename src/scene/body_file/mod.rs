@@ -30,7 +30,9 @@ pub use super::orientation::QUATERNION_NORM_TOLERANCE;
 pub struct SphereRow {
     /// The `id` column, or the row number (from 1).
     pub id: String,
+    /// Position of the centre (world frame, m).
     pub position: Vector,
+    /// Radius (m).
     pub radius: Real,
     /// `None` when the file has no velocity columns.
     pub velocity: Option<Vector>,
@@ -58,24 +60,34 @@ pub struct PoseRow {
 /// The rows of a body file, of either table.
 #[derive(Clone, Debug, PartialEq)]
 pub enum BodyTable {
+    /// A sphere table (a `radius` column).
     Spheres(Vec<SphereRow>),
+    /// A shape table (a `shape` column and a pose).
     Poses(Vec<PoseRow>),
 }
 
 /// Why a body file could not be read.
 #[derive(Debug, thiserror::Error)]
 pub enum BodyFileError {
+    /// The file could not be read.
     #[error("{}: cannot read the body file: {source}", path.display())]
     Io {
+        /// The file.
         path: PathBuf,
+        /// The I/O error.
         #[source]
         source: std::io::Error,
     },
+    /// A cell is missing or not valid.
     #[error("{}:{line}: {column}: {message}", path.display())]
     Invalid {
+        /// The file.
         path: PathBuf,
+        /// Line of the file (1-based).
         line: u64,
+        /// The column.
         column: String,
+        /// What is wrong.
         message: String,
     },
 }

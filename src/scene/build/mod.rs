@@ -28,26 +28,37 @@ use ctx::Ctx;
 /// Why a scene could not be read.
 #[derive(Debug, thiserror::Error)]
 pub enum SceneError {
+    /// The file could not be read.
     #[error("{}: cannot read the scene file: {source}", path.display())]
     Io {
+        /// The file.
         path: PathBuf,
+        /// The I/O error.
         #[source]
         source: std::io::Error,
     },
     /// Malformed TOML, an unknown field, a missing field or a value of the wrong type.
     #[error("{}:{line}:{column}: {message}", path.display())]
     Parse {
+        /// The file.
         path: PathBuf,
+        /// Line (1-based).
         line: usize,
+        /// Column (1-based).
         column: usize,
+        /// The parser's message.
         message: String,
     },
     /// A value that parses but is not valid.
     #[error("{}:{line}: {field}: {message}", path.display())]
     Invalid {
+        /// The file.
         path: PathBuf,
+        /// Line (1-based).
         line: usize,
+        /// The field at fault.
         field: String,
+        /// What is wrong.
         message: String,
     },
 }

@@ -303,7 +303,7 @@ fn relative(rates: &[f64]) -> Vec<f64> {
     clamped.iter().map(|r| r / mean).collect()
 }
 
-/// How the threads of a team share the work of a flat step ([`Blocks`]); a tuning knob for measurements
+/// How the threads of a team share the work of a flat step (`Blocks`); a tuning knob for measurements
 /// (`examples/sphere_flat_threads --splits`): the bits are the same for any split.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct TeamSplit {
@@ -312,7 +312,7 @@ pub struct TeamSplit {
     pub middle_share: f64,
     /// The same for the middles of the drift and of the kick.
     pub pass_middle_share: f64,
-    /// Whether each thread's shares follow its measured speed ([`ThreadSpeeds`]), or are equal.
+    /// Whether each thread's shares follow its measured speed (`ThreadSpeeds`), or are equal.
     pub follow_speeds: bool,
 }
 

@@ -9,17 +9,17 @@
 //!   last evaluation's force and torque;
 //! - the walls (planes; fixed or moving with their prescribed velocity) and their last forces;
 //! - a half neighbour list with a Verlet skin (the world's broad-phase skin) and a body–wall list, each
-//!   pair's tangential spring stored beside it and carried across rebuilds ([`neighbours`]); nothing is
+//!   pair's tangential spring stored beside it and carried across rebuilds (`neighbours`); nothing is
 //!   stored for a separated pair but its cleared spring and a flag;
 //! - the time, step index and energy ledger of the world, and with the ledger on, per listed pair the
-//!   last damping force and contact point it books from ([`ledger`]).
+//!   last damping force and contact point it books from (`ledger`).
 //!
 //! [`SphereSim::step`] advances it by one step with the stages of the general step for free spheres
 //! (`super::sphere_step`): first half kick, drift (leapfrog translation, one turn about L for the
 //! orientation), walls moved, lists rebuilt when the two largest displacements since the build sum to the
-//! skin, the pair loop (closed-form geometry and the laws of [`crate::law`], [`pair`]), per-body sums, the
+//! skin, the pair loop (closed-form geometry and the laws of [`crate::law`], `pair`), per-body sums, the
 //! second half kick and the finiteness checks; [`SphereSim::run_steps`] runs many, holding the pool's
-//! threads for the run ([`crew`]). [`SphereSim::write_back`] puts the state back into the
+//! threads for the run (`crew`). [`SphereSim::write_back`] puts the state back into the
 //! world (bodies, walls, loads, ledger, time, and a contact store with every listed pair's spring and
 //! last forces), so that checkpoints, outputs and the general step continue from it.
 //!
@@ -35,7 +35,7 @@
 //! forces, elastic potential, the ledger's contact terms) are taken serially in pair order.
 //! The per-contact terms of the energy ledger (damping, friction and tangential stiffness work) are
 //! booked by the pair loop with the general step's functions and summed in its candidate order
-//! ([`ledger`]; `tests/sphere_flat_ledger.rs`).
+//! (`ledger`; `tests/sphere_flat_ledger.rs`).
 //!
 //! # When it applies (else [`NotSphereOnly`])
 //! Every body a dynamic sphere with equal principal moments; the splitting rotation with the
@@ -60,8 +60,8 @@
 //! ~16 % of its instructions at 71 builds; the fast bed spheres the projectile throws, not only the
 //! projectile (listed with four skins), use up the skin), integration. The target (≤ ~900) is not reached.
 //! Since then (time, not instructions: `examples/sphere_bed_speed`, 5000 steps, one thread, quiet, same final
-//! checksums): a separated pair no longer stores its cleared spring and flag again ([`pair`]), and the kicks
-//! leave out the viscous-damping terms this path never has ([`step`]): bed a 1.31–1.51 s (five of six runs
+//! checksums): a separated pair no longer stores its cleared spring and flag again (`pair`), and the kicks
+//! leave out the viscous-damping terms this path never has (`step`): bed a 1.31–1.51 s (five of six runs
 //! ≤ 1.37 s) against 1.49–1.54 s, b 2.19–2.35 against 2.34–2.49, c 1.08–1.17 against 1.31–1.42 (release
 //! build, six and three runs; `perf record` of bed a then
 //! puts ~73 % of the samples in the pair loop and ~17 % in the kicks and drift).
@@ -108,14 +108,36 @@ use pair::{Kinematic, PairConstants, PairOut, Props, WallConstants, WallPlane};
 /// Why a world cannot take the flat sphere path (see the module docs).
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum NotSphereOnly {
+    /// A body is not a sphere.
     #[error("body {body} ('{name}') is not a sphere")]
-    NotASphere { body: usize, name: String },
+    NotASphere {
+        /// Index of the body.
+        body: usize,
+        /// Name of the body.
+        name: String,
+    },
+    /// A body is not dynamic (fixed or prescribed).
     #[error("body {body} ('{name}') is not a free (dynamic) body")]
-    NotDynamic { body: usize, name: String },
+    NotDynamic {
+        /// Index of the body.
+        body: usize,
+        /// Name of the body.
+        name: String,
+    },
+    /// A body's principal moments of inertia are not equal.
     #[error("body {body} ('{name}') has unequal principal moments")]
-    Anisotropic { body: usize, name: String },
+    Anisotropic {
+        /// Index of the body.
+        body: usize,
+        /// Name of the body.
+        name: String,
+    },
+    /// The step parameters use something the path does not implement.
     #[error("the flat sphere path needs {what}")]
-    Params { what: &'static str },
+    Params {
+        /// What the path needs.
+        what: &'static str,
+    },
 }
 
 /// The angular part of a sphere's state, read by the integration only.
@@ -471,6 +493,7 @@ impl SphereSim {
         self.kin.len()
     }
 
+    /// Whether there are no spheres.
     pub fn is_empty(&self) -> bool {
         self.kin.is_empty()
     }
@@ -485,20 +508,22 @@ impl SphereSim {
         self.kin[i].velocity
     }
 
-    /// Angular momentum (kg·m²/s) and orientation of sphere `i`.
+    /// Angular momentum of sphere `i` (kg·m²/s, world frame).
     pub fn angular_momentum(&self, i: usize) -> Vector {
         self.spin[i].angular_momentum
     }
 
+    /// Orientation of sphere `i` (body to world).
     pub fn orientation(&self, i: usize) -> Rotation {
         self.spin[i].orientation
     }
 
-    /// Contact force (N) and torque (N·m) on each sphere from the last evaluation.
+    /// Contact force on each sphere from the last evaluation (N).
     pub fn forces(&self) -> &[Vector] {
         &self.force
     }
 
+    /// Contact torque on each sphere from the last evaluation (N·m).
     pub fn torques(&self) -> &[Vector] {
         &self.torque
     }
@@ -546,11 +571,12 @@ impl SphereSim {
         sum
     }
 
-    /// Simulated time (s) and completed steps.
+    /// Simulated time (s).
     pub fn time(&self) -> Real {
         self.time
     }
 
+    /// Completed steps.
     pub fn step_index(&self) -> u64 {
         self.step_index
     }
@@ -715,8 +741,10 @@ impl SphereSim {
 /// failed.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum StepFlatError {
+    /// The world does not fit the flat sphere path.
     #[error(transparent)]
     NotSphereOnly(#[from] NotSphereOnly),
+    /// The initial force evaluation failed.
     #[error(transparent)]
     Step(#[from] StepError),
 }

@@ -377,7 +377,7 @@ impl Grid {
 }
 
 impl NeighbourList {
-    /// An empty list with the given skin (m); the first [`rebuild`](Self::rebuild) fills it.
+    /// An empty list with the given skin (m); the first `rebuild` fills it.
     pub fn new(skin: Real) -> Self {
         Self {
             skin,

@@ -16,7 +16,7 @@ impl SphereSim {
     /// simulation large enough for its parallel passes) the run holds the pool's threads from the
     /// first step to the last, each step's team job handed to threads already running: `after_step`
     /// runs on one of them (hence `Send`), and no other work of the pool's gets a thread until the run
-    /// ends but through their idle polling (see [`super::crew`]).
+    /// ends but through their idle polling (see `crew`).
     pub fn run_steps(
         &mut self,
         steps: u64,

@@ -12,13 +12,16 @@ use super::super::parallel::Parallelism;
 /// Stage timers and counters of one or more steps (merge them with [`StepCounters::merge`]).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct StepCounters {
+    /// Steps counted.
     pub steps: u64,
+    /// Wall time of the broad phase.
     pub broad: Duration,
     /// The fused narrow phase and laws (one pass over the candidates).
     pub narrow: Duration,
     /// Zero since the laws run fused with the narrow phase (their time is in `narrow`); kept so that the
     /// summaries keep their columns.
     pub laws: Duration,
+    /// Wall time of the per-body force and torque sums.
     pub accumulate: Duration,
     /// Stages 1–2 and 7–8 (the checks run fused with the second half kick).
     pub integrate: Duration,
@@ -36,19 +39,23 @@ pub struct StepCounters {
     pub broad_rebuilds: u64,
     /// Body pairs passed to the narrow phase (broad-phase candidates with at least one dynamic body).
     pub body_pairs_tested: u64,
-    /// Body–wall pairs passed to the narrow phase, and those rejected by the bounding-sphere distance.
+    /// Body–wall pairs passed to the narrow phase.
     pub wall_pairs_tested: u64,
+    /// Body–wall pairs rejected by the bounding-sphere distance.
     pub wall_pairs_rejected: u64,
     /// Overlapping contacts evaluated by the laws.
     pub contacts: u64,
-    /// Contact-store entries created and dropped.
+    /// Contact-store entries created.
     pub contacts_created: u64,
+    /// Contact-store entries dropped.
     pub contacts_dropped: u64,
     /// Candidates not re-evaluated because frozen (both sides asleep or fixed; see [`crate::world::sleeping`]).
     pub frozen_pairs: u64,
-    /// Bodies that fell asleep and that were woken; sleeping bodies summed over the steps.
+    /// Bodies that fell asleep.
     pub fell_asleep: u64,
+    /// Bodies woken.
     pub woken: u64,
+    /// Sleeping bodies summed over the steps (body-steps).
     pub sleeping_body_steps: u64,
     /// Bodies that moved more than half the skin in one step, summed over the steps ("dangerous builds";
     /// see [`super::guard`]).
@@ -58,6 +65,7 @@ pub struct StepCounters {
 }
 
 impl StepCounters {
+    /// Adds the counts and times of `other` (e.g. of a later stretch of steps) to `self`.
     pub fn merge(&mut self, other: &StepCounters) {
         self.steps += other.steps;
         self.broad += other.broad;
