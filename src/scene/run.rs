@@ -82,6 +82,7 @@ pub struct RunSummary {
     /// Steps in which the check of the time step found the motion too fast for it (with
     /// `time_step_check = "warn"`), and the first finding with its step.
     pub steps_with_time_step_findings: u64,
+    /// The first finding of the time-step check: its step and its message.
     pub first_time_step_finding: Option<(u64, String)>,
     /// The path the steps took.
     pub path: StepPath,
@@ -264,6 +265,7 @@ pub enum EndTimeError {
         /// The current step.
         step: u64,
     },
+    /// The end time gives a step count beyond the counter or the run's limit.
     #[error(transparent)]
     Steps(#[from] StepCountError),
 }

@@ -20,16 +20,23 @@ pub enum StepCountError {
     /// end_time / Δt does not fit the step counter (or is not a number).
     #[error("end time {end_time:?} s at Δt = {dt:?} s is {steps:e} steps, beyond the step counter's range ({} steps); shorten the end time or lengthen the step", u64::MAX)]
     Overflow {
+        /// The end time asked for (s).
         end_time: Real,
+        /// The time step (s).
         dt: Real,
+        /// end_time / Δt.
         steps: Real,
     },
     /// The run is longer than the limit.
     #[error("end time {end_time:?} s at Δt = {dt:?} s is {steps} steps, above the limit of {limit} steps; raise the limit explicitly (simulation.max_steps in a scene, --max-steps on the command line) to run it")]
     AboveLimit {
+        /// The end time asked for (s).
         end_time: Real,
+        /// The time step (s).
         dt: Real,
+        /// The steps the run would take.
         steps: u64,
+        /// The limit in force.
         limit: u64,
     },
 }

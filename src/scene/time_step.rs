@@ -107,7 +107,9 @@ pub fn contact_time_and_limit(
 /// What the estimate reads of one body.
 #[derive(Clone, Copy, Debug)]
 pub struct BodyFacts<'a> {
+    /// Material id.
     pub material: u32,
+    /// Whether the body moves under forces (walls and fixed bodies are the heavy side of a pair).
     pub dynamic: bool,
     /// Mass (kg).
     pub mass: Real,

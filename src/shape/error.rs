@@ -34,14 +34,25 @@ pub enum ShapeError {
 
     /// The cloud's extent is outside the sizes whose mass properties f64 represents.
     #[error("extent {extent:e} is outside the sizes this hull builder handles, {min:e} to {max:e} (the mass properties scale as the fifth power of the size and must stay within f64's normal range); express the coordinates in another unit")]
-    ExtentOutOfRange { extent: Real, min: Real, max: Real },
+    ExtentOutOfRange {
+        /// Largest extent of the cloud (m).
+        extent: Real,
+        /// Smallest extent handled (m).
+        min: Real,
+        /// Largest extent handled (m).
+        max: Real,
+    },
 
     /// The cloud is too small for its distance from the origin: its coordinates' round-off blurs its shape.
     #[error("extent {extent:e} is too small for coordinates as large as {largest:e}: their round-off allowance there is {rounding:e} (64 ε × the largest coordinate), and a shape must be at least {min_extent:e} across (1000 times that); give the points relative to a nearby origin")]
     BelowRoundOff {
+        /// Largest extent of the cloud (m).
         extent: Real,
+        /// Largest coordinate magnitude (m).
         largest: Real,
+        /// Round-off allowance at that magnitude (m).
         rounding: Real,
+        /// Smallest extent accepted there (m).
         min_extent: Real,
     },
 

@@ -58,7 +58,7 @@ pub struct StepCounters {
     /// Sleeping bodies summed over the steps (body-steps).
     pub sleeping_body_steps: u64,
     /// Bodies that moved more than half the skin in one step, summed over the steps ("dangerous builds";
-    /// see [`super::guard`]).
+    /// see `world::step::guard`).
     pub dangerous_moves: u64,
     /// Narrow-phase counters (queries by kind, GJK/EPA iterations, fallbacks).
     pub query: QueryCounters,

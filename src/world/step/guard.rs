@@ -72,10 +72,11 @@ pub enum TimeStepCheck {
 pub enum TimeStepFinding {
     /// A listed pair meets faster than the largest approach speed the step is stable for.
     FastApproach {
+        /// The pair's contact key.
         key: ContactKey,
         /// "body 3 ('a') and body 7 ('b')", or "body 3 ('a') and wall 0 ('floor')".
         pair: String,
-        /// Normal speed along the line of centres or the wall normal (m/s; see [`fastest_approach`]).
+        /// Normal speed along the line of centres or the wall normal (m/s; see `fastest_approach`).
         speed: Real,
         /// The largest approach speed for which the step is within the stability limit (m/s).
         critical_speed: Real,
@@ -88,9 +89,11 @@ pub enum TimeStepFinding {
     Tunnelling {
         /// The fastest body.
         body: usize,
+        /// Its name.
         name: String,
-        /// Its speed |v| (m/s) and move |v| Δt (m).
+        /// Its speed |v| (m/s).
         speed: Real,
+        /// Its move |v| Δt in the step (m).
         displacement: Real,
         /// The bound on how far two bodies, or a body and a wall, close in one step (m).
         closing: Real,

@@ -69,7 +69,7 @@ use super::world::World;
 use ledger::StepPowers;
 
 /// Advances the world by one step `params.dt` (see the module docs for the stages), then checks the step
-/// against the motion it produced ([`guard`]: reads the state only).
+/// against the motion it produced (`guard`: reads the state only).
 pub fn step(
     params: &StepParams,
     world: &mut World,

@@ -46,7 +46,7 @@ pub struct StepParams {
     /// [`World::energy`]'s balance no longer closes.
     pub energy_ledger: bool,
     /// What the step does when its check finds the motion too fast for the time step (stop by default;
-    /// see [`super::guard`]). Not stored in checkpoints: a run restarted from one checks with the default.
+    /// see `world::step::guard`). Not stored in checkpoints: a run restarted from one checks with the default.
     #[serde(skip)]
     pub time_step_check: TimeStepCheck,
 }

@@ -31,7 +31,7 @@ pub struct StepReport {
     /// Contacts deeper than the warning fraction.
     pub overlap_warnings: Vec<OverlapWarning>,
     /// What the check of the time step found in this step, when it warns instead of stopping (see
-    /// [`super::guard`]).
+    /// `world::step::guard`).
     pub time_step_findings: Vec<TimeStepFinding>,
 }
 
