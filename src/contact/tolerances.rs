@@ -81,5 +81,13 @@ pub const PAIR_SCALE_FLOOR: Real = 1e-4;
 /// the larger one. Symmetric in its arguments; equal to either for a pair of equal sizes.
 #[inline]
 pub fn pair_length_scale(la: Real, lb: Real) -> Real {
-    la.min(lb).max(PAIR_SCALE_FLOOR * la.max(lb))
+    // Plain comparisons rather than f64::min/max (whose NaN rules cost instructions on the hot path);
+    // length scales are finite and positive.
+    let (small, large) = if la < lb { (la, lb) } else { (lb, la) };
+    let floor = PAIR_SCALE_FLOOR * large;
+    if small > floor {
+        small
+    } else {
+        floor
+    }
 }
