@@ -12,6 +12,8 @@ fn main() {
     println!("cargo::rustc-check-cfg=cfg(peer_bullet)");
     println!("cargo::rerun-if-changed=peers");
     println!("cargo::rerun-if-changed=build.rs");
+    println!("cargo::rerun-if-env-changed=PKG_CONFIG_PATH");
+    println!("cargo::rerun-if-env-changed=PKG_CONFIG_LIBDIR");
     #[cfg(feature = "peers")]
     peers::build();
 }
