@@ -193,3 +193,132 @@ proptest! {
         }
     }
 }
+
+/// A hull of `n` seeded points on an ellipsoid of semi-axes (1, 0.8, 0.6) × `radius` about the origin.
+fn seeded_hull(rng: &mut rand_chacha::ChaCha8Rng, n: usize, radius: Real) -> ConvexPolyhedron {
+    use rand::Rng;
+    let points: Vec<Point> = (0..n)
+        .map(|_| {
+            let d = unit(
+                rng.random_range(-1.0..1.0),
+                rng.random_range(-1.0..1.0),
+                rng.random_range(-1.0..1.0),
+            );
+            Point::new(d.x, 0.8 * d.y, 0.6 * d.z) * radius
+        })
+        .collect();
+    ConvexPolyhedron::from_points(&points)
+        .expect("a seeded ellipsoid cloud has a hull")
+        .0
+}
+
+fn seeded_rotation(rng: &mut rand_chacha::ChaCha8Rng) -> UnitQuaternion<Real> {
+    use rand::Rng;
+    let axis = unit(
+        rng.random_range(-1.0..1.0),
+        rng.random_range(-1.0..1.0),
+        rng.random_range(-1.0..1.0),
+    );
+    UnitQuaternion::from_scaled_axis(axis * rng.random_range(0.0..std::f64::consts::PI))
+}
+
+/// Pebble–boulder pairs (size ratios 1e2 … 1e5): a pebble hull resting on the top face of a rotated box
+/// boulder, placed so that its lowest vertex along the face normal is `s` inside (s > 0) or |s| outside
+/// (s < 0) the face, |s| from 1e-9 to 1e-3 of the pebble's size. The face is wider than the pebble by far, so
+/// the exact answer is the constructed one: overlap s, or gap |s|, to the round-off of coordinates of the
+/// boulder's size. Both the query and the SAT oracle must return that status, in both pair orders: the
+/// touching band follows the smaller body, so no such pair may come back as touching.
+#[test]
+fn pebble_on_boulder_pairs_have_the_constructed_status() {
+    use rand::{Rng, SeedableRng};
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(20261128);
+    let mut wrong = Vec::new();
+    let mut checked = 0;
+    for ratio in [1e2, 1e3, 1e4, 1e5] {
+        for trial in 0..4 {
+            let boulder_half = Vector::new(1.0, 0.7, 0.4);
+            let corners: Vec<Point> = (0..8)
+                .map(|i| {
+                    let s = |bit: usize, h: Real| if i & bit == 0 { -h } else { h };
+                    Point::new(
+                        s(1, boulder_half.x),
+                        s(2, boulder_half.y),
+                        s(4, boulder_half.z),
+                    )
+                })
+                .collect();
+            let boulder = ConvexPolyhedron::from_points(&corners)
+                .expect("a box has a hull")
+                .0;
+            let pebble = seeded_hull(&mut rng, 16, 2.0 / ratio);
+            let rot_b = seeded_rotation(&mut rng);
+            let centre_b = unit(
+                rng.random_range(-1.0..1.0),
+                rng.random_range(-1.0..1.0),
+                rng.random_range(-1.0..1.0),
+            ) * 3.0;
+            let pos_b = Pose::from_parts(Translation3::from(centre_b), rot_b);
+            let n = rot_b * Vector::z();
+            let on_face = pos_b
+                * Point::new(
+                    rng.random_range(-0.5..0.5),
+                    rng.random_range(-0.3..0.3),
+                    boulder_half.z,
+                );
+            let rot_p = seeded_rotation(&mut rng);
+            let lowest = pebble
+                .vertices()
+                .iter()
+                .map(|v| n.dot(&(rot_p * v.coords)))
+                .fold(Real::INFINITY, Real::min);
+            let size = pebble.length_scale();
+            for decade in 3..=9 {
+                for sign in [1.0, -1.0] {
+                    let s = sign * size * 10f64.powi(-decade);
+                    let centre_p = on_face.coords + n * (-s - lowest);
+                    let pos_p = Pose::from_parts(Translation3::from(centre_p), rot_p);
+                    let want = if s > 0.0 {
+                        ContactKind::Overlap
+                    } else {
+                        ContactKind::Separated
+                    };
+                    for (order, (pos1, a, pos2, b)) in [
+                        (&pos_p, &pebble, &pos_b, &boulder),
+                        (&pos_b, &boulder, &pos_p, &pebble),
+                    ]
+                    .into_iter()
+                    .enumerate()
+                    {
+                        let ours = query_polyhedra(pos1, a, pos2, b);
+                        let exact = sat_polyhedra(pos1, a, pos2, b);
+                        checked += 1;
+                        for (who, g) in [("query", &ours), ("SAT oracle", &exact)] {
+                            if g.kind != want {
+                                wrong.push(format!(
+                                    "ratio {ratio:e}, trial {trial}, s = {s:e} (= {:e} × pebble size), order {order}: {who} says {:?} (depth {:e}, distance {:e}), want {want:?}",
+                                    s / size, g.kind, g.depth, g.distance
+                                ));
+                            }
+                        }
+                        // Coordinates of the boulder's size carry round-off of ~ε·(|centre| + size); the value
+                        // must match the constructed one within a few of those and 1e-9 of itself.
+                        let round_off = 64.0 * Real::EPSILON * 6.0;
+                        let value = ours.depth - ours.distance;
+                        if ours.kind == want && (value - s).abs() > round_off + 1e-9 * s.abs() {
+                            wrong.push(format!(
+                                "ratio {ratio:e}, trial {trial}, order {order}: signed overlap {value:e}, constructed {s:e}, |error| {:e} > {:e}",
+                                (value - s).abs(), round_off + 1e-9 * s.abs()
+                            ));
+                        }
+                    }
+                }
+            }
+        }
+    }
+    assert!(
+        wrong.is_empty(),
+        "{} wrong answers of {checked} pebble–boulder queries:\n{}",
+        wrong.len(),
+        wrong.join("\n")
+    );
+}

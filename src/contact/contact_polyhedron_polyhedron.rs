@@ -7,7 +7,8 @@
 //! 3. on an iteration cap or a degeneracy of either solver, the exact SAT answer
 //!    ([`sat`](super::sat)) with the status saying why, counted in [`QueryCounters`].
 //!
-//! Classification uses the touching band `touching · L` (L = the larger `length_scale()` of the two): Overlap when
+//! Classification uses the touching band `touching · L` (L = [`pair_length_scale`] of the two, the smaller
+//! body's `length_scale()`): Overlap when
 //! δ_M > band, Separated when the gap > band, Touching otherwise (depth and distance then reported as 0).
 //!
 //! Warm start for persistent contacts: when the pair overlapped at the previous query, EPA first starts
@@ -26,7 +27,7 @@ use super::epa::{epa, EpaOutcome, EpaScratch};
 use super::gjk::{gjk, GjkMode, GjkOutcome, Simplex};
 use super::minkowski::{MinkowskiPair, SupportPoint, VertexScan};
 use super::sat::{sat_polytopes, Polytope};
-use super::tolerances::ContactTolerances;
+use super::tolerances::{pair_length_scale, ContactTolerances};
 use super::{ContactGeometry, ContactKind, SolverStatus};
 use crate::math::{Point, Pose, Real, Vector};
 use crate::shape::{ConvexPolyhedron, SupportMap};
@@ -130,7 +131,7 @@ where
     SA: SupportMap + ?Sized,
     SB: SupportMap + ?Sized,
 {
-    let scale = a.length_scale().max(b.length_scale());
+    let scale = pair_length_scale(a.length_scale(), b.length_scale());
     let touch = tol.touching * scale;
     if let Some(g) = warm_hit(pos1, a, b, pos12, pair, tol, cache, scratch, counters) {
         return g;
@@ -242,7 +243,7 @@ where
     if !cache.has_face {
         return None;
     }
-    let scale = a.length_scale().max(b.length_scale());
+    let scale = pair_length_scale(a.length_scale(), b.length_scale());
     let touch = tol.touching * scale;
     let start = warm_tetrahedron(a, b, pos12, cache, pair)?;
     let er = epa(pair, &start, scale, tol, scratch);
@@ -381,7 +382,7 @@ pub fn intersect_polytopes_cached<A: Polytope + ?Sized, B: Polytope + ?Sized>(
 ) -> bool {
     let pos12 = pos1.inv_mul(pos2);
     let (ra, rb) = (a.bounding_radius(), b.bounding_radius());
-    let scale = a.length_scale().max(b.length_scale());
+    let scale = pair_length_scale(a.length_scale(), b.length_scale());
     let touch = tol.touching * scale;
     let t12 = pos12.translation.vector;
     if t12.norm_squared() > (ra + rb + touch) * (ra + rb + touch) {

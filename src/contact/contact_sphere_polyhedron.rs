@@ -18,7 +18,7 @@ use super::features::closest_on_triangle;
 use super::gjk::{gjk, GjkMode, GjkOutcome, Simplex};
 use super::minkowski::MinkowskiPair;
 use super::sat::Polytope;
-use super::tolerances::ContactTolerances;
+use super::tolerances::{pair_length_scale, ContactTolerances};
 use super::{ContactGeometry, SolverStatus};
 use crate::math::{Point, Pose, Real, Vector};
 use crate::shape::SupportMap;
@@ -43,7 +43,7 @@ pub fn contact_polytope_sphere<A: Polytope + ?Sized>(
     counters: &mut QueryCounters,
 ) -> ContactGeometry {
     counters.sphere_polyhedron += 1;
-    let scale = a.length_scale().max(2.0 * r2);
+    let scale = pair_length_scale(a.length_scale(), 2.0 * r2);
     let touch = tol.touching * scale;
     let c = pos1.inverse_transform_point(c2);
     let origin = PointShape(Point::origin());

@@ -21,7 +21,7 @@ use super::counters::QueryCounters;
 use super::epa::{closest_face_bounds, epa, EpaOutcome, EpaScratch};
 use super::gjk::{gjk, GjkMode, GjkOutcome, Simplex};
 use super::minkowski::MinkowskiPair;
-use super::tolerances::ContactTolerances;
+use super::tolerances::{pair_length_scale, ContactTolerances};
 use super::{ContactGeometry, SolverStatus};
 use crate::math::{Pose, Real, Vector};
 use crate::shape::{ConvexShape, SupportMap};
@@ -63,7 +63,7 @@ pub fn contact_support_maps<A: ConvexShape + ?Sized, B: ConvexShape + ?Sized>(
     counters: &mut QueryCounters,
 ) -> SupportMapContact {
     counters.support_map += 1;
-    let scale = a.length_scale().min(b.length_scale());
+    let scale = pair_length_scale(a.length_scale(), b.length_scale());
     let gap = tol.curved_gap * scale;
     let touch = tol.touching * scale;
     let curved = ContactTolerances {

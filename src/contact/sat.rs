@@ -27,7 +27,7 @@
 //! and as a rare fallback, not a hot path. It allocates.
 
 use super::features::{closest_on_triangle, closest_point_sets, closest_segments};
-use super::tolerances::ContactTolerances;
+use super::tolerances::{pair_length_scale, ContactTolerances};
 use super::{ContactGeometry, ContactKind, SolverStatus};
 use crate::math::{Point, Pose, Real, Vector};
 use crate::shape::SupportMap;
@@ -246,7 +246,7 @@ pub fn sat_polytopes<A: Polytope + ?Sized, B: Polytope + ?Sized>(
     let pos12 = pos1.inv_mul(pos2);
     let va: Vec<Vector> = a.vertices().iter().map(|p| p.coords).collect();
     let vb: Vec<Vector> = b.vertices().iter().map(|p| (pos12 * p).coords).collect();
-    let scale = a.length_scale().max(b.length_scale());
+    let scale = pair_length_scale(a.length_scale(), b.length_scale());
     let touch = tol.touching * scale;
     let (s, n) = best_axis(a, b, &va, &vb, &pos12.rotation);
     let to_world = |n1: Vector, c1: Vector, c2: Vector, kind, depth, distance| {

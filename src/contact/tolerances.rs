@@ -1,8 +1,8 @@
 //! Tolerances of the contact queries, all relative to the pair's length scale.
 //!
-//! Every tolerance here is a dimensionless factor multiplied by the length scale `L` of the pair (the larger
-//! bounding radius of the two shapes), so that a pair of 1 mm grains and a pair of 1 km blocks are decided
-//! alike. Iteration caps are counts. A harness may sweep [`ContactTolerances::epa_gap`] to draw a
+//! Every tolerance here is a dimensionless factor multiplied by the length scale `L` of the pair
+//! ([`pair_length_scale`]: the length scale of the *smaller* body), so that a pair of 1 mm grains and a pair
+//! of 1 km blocks are decided alike, and a pebble on a boulder is measured to the pebble's size. Iteration caps are counts. A harness may sweep [`ContactTolerances::epa_gap`] to draw a
 //! work-precision curve; the defaults are what the engine uses.
 
 use crate::math::Real;
@@ -67,4 +67,27 @@ impl Default for ContactTolerances {
 
 fn default_curved_gap() -> Real {
     1e-10
+}
+
+/// The floor of [`pair_length_scale`] as a fraction of the larger body's length scale. Coordinates of the
+/// larger body's size carry round-off of a few ε·L_max ≈ 1e-15 L_max; the touching band, `touching` times
+/// the pair's scale, is kept at 1e-11 · 1e-4 = 1e-15 L_max or more, so that it never falls below the
+/// round-off of the coordinates it is compared with. Only pairs of size ratio above 1e4 reach the floor.
+pub const PAIR_SCALE_FLOOR: Real = 1e-4;
+
+/// The length scale of a pair of bodies of length scales `la` and `lb` (m): the smaller one, since a pair's
+/// force and energy error live at the scale of its smaller body (a tolerance taken from the larger body of a
+/// pebble–boulder pair of size ratio 1e5 would be 1e-6 of the pebble), floored at [`PAIR_SCALE_FLOOR`] times
+/// the larger one. Symmetric in its arguments; equal to either for a pair of equal sizes.
+#[inline]
+pub fn pair_length_scale(la: Real, lb: Real) -> Real {
+    // Plain comparisons rather than f64::min/max (whose NaN rules cost instructions on the hot path);
+    // length scales are finite and positive.
+    let (small, large) = if la < lb { (la, lb) } else { (lb, la) };
+    let floor = PAIR_SCALE_FLOOR * large;
+    if small > floor {
+        small
+    } else {
+        floor
+    }
 }

@@ -2,8 +2,8 @@
 //!
 //! Every error is measured against the SAT oracle on the same polyhedra and expressed in metres; the
 //! tolerance of a pair is `tol = depth_abs · size + depth_rel · |reference overlap or gap|`, with `size`
-//! the particle size (the larger of the two polyhedra's `length_scale()`, the diameter of the
-//! centroid-centred bounding sphere).
+//! the particle size (the pair's length scale: the smaller of the two polyhedra's `length_scale()`, the
+//! diameter of the centroid-centred bounding sphere, as the core's tolerances take it).
 //! - gap error: |signed gap − reference signed gap| (signed gap = distance − overlap), which covers the
 //!   depth of overlapping pairs and the distance of separated ones;
 //! - normal error: |signed gap along the reported normal (support functions evaluated by brute force over
@@ -13,6 +13,7 @@
 //! - wrong status: the kind (overlap/touching/separated) differs from the reference, unless the reference
 //!   signed gap lies within `tol` of the edge of the touching band (where either answer is right).
 
+use polydem::contact::tolerances::pair_length_scale;
 use polydem::contact::{ContactGeometry, ContactKind, ContactTolerances};
 use polydem::math::{Point, Pose, Vector};
 use polydem::shape::ConvexPolyhedron;
@@ -194,8 +195,8 @@ pub fn evaluate(
     let Built {
         a, pos1, b, pos2, ..
     } = &built;
-    let size = a.length_scale().max(b.length_scale());
-    let band = ContactTolerances::default().touching * a.bounding_radius().max(b.bounding_radius());
+    let size = pair_length_scale(a.length_scale(), b.length_scale());
+    let band = ContactTolerances::default().touching * size;
     let reference = Answer::from_geometry(&sat(pos1, a, pos2, b));
     let tol = depth_abs * size + depth_rel * reference.signed_gap.abs();
     let g = ours.query(pos1, a, pos2, b);

@@ -8,7 +8,9 @@
 //! an EPA tolerance sweep for the work-precision plot) is measured on the size-1 pairs of the same sets.
 
 pub mod eval;
+pub mod native_peers;
 pub mod ours;
+pub mod pebble;
 pub mod timing;
 
 use std::path::Path;
@@ -223,6 +225,9 @@ struct Evaluated {
     random: Vec<Pair>,
     evals: Vec<Eval>,
     deg_evals: Vec<Eval>,
+    degenerate: Vec<Pair>,
+    pebble: Vec<Pair>,
+    pebble_evals: Vec<Eval>,
     /// Our solver counters over the random set.
     random_counters: QueryCounters,
 }
@@ -239,9 +244,12 @@ fn evaluate_sets(
         .stage("generating random pairs", n_random as u64);
     let random = random_set(&spec, || ctx.progress().inc(1))?;
     let degenerate = degenerate_set(&p.sizes);
+    let pebble = pebble::pebble_set(p.seed);
 
-    ctx.progress()
-        .stage("evaluating pairs", (random.len() + degenerate.len()) as u64);
+    ctx.progress().stage(
+        "evaluating pairs",
+        (random.len() + degenerate.len() + pebble.len()) as u64,
+    );
     let size_index = |pair: &Pair| p.sizes.iter().position(|s| *s == pair.size).unwrap_or(0);
     let mut evaluate_all = |pairs: &[Pair], ours: &mut Ours| -> Result<Vec<Eval>, SuiteError> {
         let mut evals = Vec::with_capacity(pairs.len());
@@ -255,10 +263,15 @@ fn evaluate_sets(
     let evals = evaluate_all(&random, &mut ours)?;
     let mut ours_deg = Ours::new(ContactTolerances::default());
     let deg_evals = evaluate_all(&degenerate, &mut ours_deg)?;
+    let mut ours_pebble = Ours::new(ContactTolerances::default());
+    let pebble_evals = evaluate_all(&pebble, &mut ours_pebble)?;
     Ok(Evaluated {
         random,
         evals,
         deg_evals,
+        degenerate,
+        pebble,
+        pebble_evals,
         random_counters: ours.counters,
     })
 }
@@ -294,6 +307,44 @@ fn check_random_coverage(evals: &[Eval], ctx: &mut CaseContext) {
         count(ContactKind::Separated),
         Target::at_least(1.0),
         "pairs",
+    );
+}
+
+/// The pebble–boulder set is what it claims: the SAT oracle returns the constructed status of every pair
+/// (overlap or gap of 1e-9 to 1e-3 of the pebble, [`pebble`]), and the constructed value within the pair
+/// tolerance. Our query must return the constructed status too, with no allowance at the band's edge (the
+/// smallest constructed values are within a pair tolerance of it at the largest size ratio).
+fn check_pebble_oracle(ev: &Evaluated, ctx: &mut CaseContext) {
+    let mut wrong = 0;
+    let mut ours_wrong = 0;
+    let mut worst: f64 = 0.0;
+    for (pair, e) in ev.pebble.iter().zip(&ev.pebble_evals) {
+        let (kind, signed) = match pair.intent {
+            pairsets::Intent::Overlap(d) => (ContactKind::Overlap, -d),
+            pairsets::Intent::Separated(d) => (ContactKind::Separated, d),
+            pairsets::Intent::Touching => (ContactKind::Touching, 0.0),
+        };
+        wrong += (e.reference.kind != kind) as usize;
+        ours_wrong += (e.ours_kind != kind) as usize;
+        worst = worst.max((e.reference.signed_gap - signed).abs() / e.tol);
+    }
+    ctx.check(
+        "pebble_ours_wrong_status_vs_constructed",
+        ours_wrong as f64,
+        Target::equal(0.0),
+        "pairs",
+    );
+    ctx.check(
+        "pebble_oracle_wrong_status",
+        wrong as f64,
+        Target::equal(0.0),
+        "pairs",
+    );
+    ctx.check(
+        "pebble_oracle_value_error_over_tol_max",
+        worst,
+        Target::at_most(1.0),
+        "1",
     );
 }
 
@@ -334,16 +385,20 @@ fn overview(
     ctx: &mut CaseContext,
 ) -> Result<(), SuiteError> {
     ctx.text(&format!(
-        "Pairs: {} random ({} classes × {} particle sizes × {} pairs; seed {}) and {} degenerate. Reference: \
-         the exact SAT oracle. Pair tolerance tol = {:e} × size + {:e} × |reference overlap or gap| \
-         (issue 2); size = diameter of the centroid-centred bounding sphere (larger of the two). The rows \
-         above check ours; parry's figures are reported for comparison, not checked.",
+        "Pairs: {} random ({} classes × {} particle sizes × {} pairs; seed {}), {} degenerate and {} \
+         pebble–boulder (size ratios 1e2 to 1e5, overlaps and gaps of 1e-9 to 1e-3 of the pebble, both pair \
+         orders; checked above against their constructed status and value). Reference: the exact SAT oracle. \
+         Pair tolerance tol = {:e} × size + {:e} × |reference overlap or gap| (issue 2); size = diameter of \
+         the centroid-centred bounding sphere of the smaller body (the pair's length scale, as the core's \
+         tolerances take it). The rows above check ours; parry's figures are reported for comparison, not \
+         checked.",
         ev.random.len(),
         p.classes.len(),
         p.sizes.len(),
         p.pairs_per_class_and_size,
         p.seed,
         ev.deg_evals.len(),
+        ev.pebble.len(),
         tol.abs,
         tol.rel
     ));
@@ -653,7 +708,10 @@ fn error_cdf_plot(evals: &[Eval], ctx: &mut CaseContext) -> Result<(), SuiteErro
 
 /// Ours against parry in ns per query on each class's size-1 pairs. Returns the overlapping timing pairs of
 /// all classes, pooled for the work-precision sweep.
-fn speed(p: &Params, ev: &Evaluated, ctx: &mut CaseContext) -> Result<Vec<Built>, SuiteError> {
+/// The overlapping and separated size-1 pairs timed per class, pooled over the classes.
+type TimingPools = (Vec<Built>, Vec<Built>);
+
+fn speed(p: &Params, ev: &Evaluated, ctx: &mut CaseContext) -> Result<TimingPools, SuiteError> {
     let timing_size = p.sizes.iter().position(|s| *s == 1.0).unwrap_or(0);
     let pick = |class: &str, kind: ContactKind| -> Result<Vec<Built>, SuiteError> {
         ev.random
@@ -670,6 +728,7 @@ fn speed(p: &Params, ev: &Evaluated, ctx: &mut CaseContext) -> Result<Vec<Built>
         .stage("timing", (p.classes.len() + p.epa_gaps.len()) as u64);
     let mut timing_rows = Vec::new();
     let mut pooled_overlap: Vec<Built> = Vec::new();
+    let mut pooled_separated: Vec<Built> = Vec::new();
     for class in &p.classes {
         let ov = pick(class, ContactKind::Overlap)?;
         let sep = pick(class, ContactKind::Separated)?;
@@ -689,10 +748,11 @@ fn speed(p: &Params, ev: &Evaluated, ctx: &mut CaseContext) -> Result<Vec<Built>
             format!("{:.2}", ours_sep / parry_sep),
         ]);
         pooled_overlap.extend(ov);
+        pooled_separated.extend(sep);
         ctx.progress().inc(1);
     }
     speed_report(&timing_rows, ctx)?;
-    Ok(pooled_overlap)
+    Ok((pooled_overlap, pooled_separated))
 }
 
 fn speed_report(timing_rows: &[Vec<String>], ctx: &mut CaseContext) -> Result<(), SuiteError> {
@@ -867,6 +927,9 @@ impl Case for Contact {
         check_random_coverage(&ev.evals, ctx);
         check_ours("random", &ours_all, ctx);
         check_ours("degenerate", &ours_deg, ctx);
+        let pebble: Vec<&Eval> = ev.pebble_evals.iter().collect();
+        check_pebble_oracle(&ev, ctx);
+        check_ours("pebble", &group(&pebble, |e| e.ours), ctx);
 
         let groups = [&ours_all, &parry_all, &ours_deg, &parry_deg];
         overview(&p, &ev, tol, groups, ctx)?;
@@ -881,7 +944,19 @@ impl Case for Contact {
         if !ctx.writes_files() {
             return Ok(());
         }
-        let pooled_overlap = speed(&p, &ev, ctx)?;
-        work_precision(&p, &pooled_overlap, ctx)
+        let (pooled_overlap, pooled_separated) = speed(&p, &ev, ctx)?;
+        work_precision(&p, &pooled_overlap, ctx)?;
+        let sets = [
+            (&ev.random[..], &ev.evals[..]),
+            (&ev.degenerate[..], &ev.deg_evals[..]),
+            (&ev.pebble[..], &ev.pebble_evals[..]),
+        ];
+        native_peers::report(
+            &sets,
+            &pooled_overlap,
+            &pooled_separated,
+            p.timing_repeats,
+            ctx,
+        )
     }
 }
