@@ -1,4 +1,4 @@
-//! Property-based fuzzing of shape construction and the contact core (issue 5, "stability stress tests").
+//! Property-based fuzzing of shape construction and the contact core (stability stress tests).
 //!
 //! Random and adversarial inputs — clouds at scales from 1e-6 to 1e6, far from the origin, nearly coplanar —
 //! must never panic or produce non-finite output. Every polyhedron that is built must

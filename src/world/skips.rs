@@ -48,7 +48,7 @@
 //! Trajectories unchanged: the beds (`bed_rocks.csv`), packing traces and penetration monitors of
 //! `polydem rockfill` are byte-identical with and without the two skips, and so are the GJK/EPA counts.
 //!
-//! | scene (command) | before | after | per rock- or body-step |
+//! | scene (command) | without the skips | with them | per rock- or body-step |
 //! |---|---|---|---|
 //! | quick packing, deposition capped (copy of `scenes/rockfill/quick.toml` with `max_deposition_time = 1.2`, `compaction_speed = 2.0`, `hold_time = 0.02`: 9 800 + 2 288 + 163 steps, 351 rocks; `polydem rockfill --config FILE`, inclusive cost of `rockfill::packing::pack`) | 103.3e9 | 75.5e9 | 24.0e3 → 17.6e3 |
 //! | quick penetration from the saved quick bed (`polydem rockfill --bed DIR`, 882 steps, 351 rocks; `penetrate_with`) | 12.54e9 | 9.87e9 | 40.5e3 → 31.9e3 |

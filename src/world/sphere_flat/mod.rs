@@ -48,23 +48,15 @@
 //!
 //! # Cost (callgrind instructions, one thread)
 //! The first 1000 steps of sphere beds a / b / c (`examples/sphere_bed_speed.rs`, run under
-//! `valgrind --tool=callgrind --toggle-collect='*run_flat*'`), per particle-step: 1481 / 1774 / 1206,
-//! from 1750 / 2216 / 1438 (−15 / −20 / −16 %) with the scenes' LIGGGHTS projection of the spring
-//! ([`crate::law::SpringRotation::Projection`]: a 1750 → 1478, b 2152 → 1866 alone; other bits, the
-//! exact rotation stays the default), their 0.5 mm skin (LIGGGHTS' `neighbor`; same bits: bed b's
-//! rebuilds 109 → 71, a and c 18 → 11 per 1000 steps) and a list search that takes each grid row's
-//! cells as one run (same bits; b 2216 → 2152). Earlier: 2256 / 2745 / 1865 before the pair constants,
-//! the inlined geometry, the loads summed by the pair loop, the untracked orientations and the first
-//! cheaper search. What remains: the pair loop (~80 % of bed a: ~3.7 listed pairs and ~2.3 overlapping
-//! ones per sphere), list rebuilds (bed b: ~3800 instructions per sphere and build with the constants,
-//! ~16 % of its instructions at 71 builds; the fast bed spheres the projectile throws, not only the
-//! projectile (listed with four skins), use up the skin), integration. The target (≤ ~900) is not reached.
-//! Since then (time, not instructions: `examples/sphere_bed_speed`, 5000 steps, one thread, quiet, same final
-//! checksums): a separated pair no longer stores its cleared spring and flag again (`pair`), and the kicks
-//! leave out the viscous-damping terms this path never has (`step`): bed a 1.31–1.51 s (five of six runs
-//! ≤ 1.37 s) against 1.49–1.54 s, b 2.19–2.35 against 2.34–2.49, c 1.08–1.17 against 1.31–1.42 (release
-//! build, six and three runs; `perf record` of bed a then
-//! puts ~73 % of the samples in the pair loop and ~17 % in the kicks and drift).
+//! `valgrind --tool=callgrind --toggle-collect='*run_flat*'`) take 1481 / 1774 / 1206 instructions per
+//! particle-step, with the scenes' LIGGGHTS projection of the spring
+//! ([`crate::law::SpringRotation::Projection`]) and their 0.5 mm skin (LIGGGHTS' `neighbor`: bed b
+//! rebuilds its lists 71 times per 1000 steps, a and c 11). Where they go: the pair loop (~80 % of bed a:
+//! ~3.7 listed pairs and ~2.3 overlapping ones per sphere), list rebuilds (bed b: ~3800 instructions per
+//! sphere and build, ~16 % of its instructions: the fast bed spheres the projectile throws use up the
+//! skin), integration. In time (`examples/sphere_bed_speed`, 5000 steps, one thread, release build) bed a
+//! takes 1.31–1.51 s, b 2.19–2.35 s, c 1.08–1.17 s; `perf record` of bed a puts ~73 % of the samples in
+//! the pair loop and ~17 % in the kicks and drift.
 //!
 //! # Validity of the owned state
 //! From [`SphereSim::from_world`] on, the simulation owns the state: the world it came from is stale

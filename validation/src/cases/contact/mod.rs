@@ -1,5 +1,5 @@
 //! Case `contact`: the polyhedron–polyhedron contact core (GJK + EPA) against the exact SAT oracle, with
-//! parry3d-f64 on the same pairs side by side (issue 2, "What must be shown").
+//! parry3d-f64 on the same pairs side by side.
 //!
 //! Pairs: seeded random pairs of seven shape classes at three particle sizes with overlaps and gaps
 //! log-spread over [1e-9, 0.3] × size plus touching pairs ([`crate::pairsets`]), and the degenerate set.
@@ -388,7 +388,7 @@ fn overview(
         "Pairs: {} random ({} classes × {} particle sizes × {} pairs; seed {}), {} degenerate and {} \
          pebble–boulder (size ratios 1e2 to 1e5, overlaps and gaps of 1e-9 to 1e-3 of the pebble, both pair \
          orders; checked above against their constructed status and value). Reference: the exact SAT oracle. \
-         Pair tolerance tol = {:e} × size + {:e} × |reference overlap or gap| (issue 2); size = diameter of \
+         Pair tolerance tol = {:e} × size + {:e} × |reference overlap or gap| (the project target); size = diameter of \
          the centroid-centred bounding sphere of the smaller body (the pair's length scale, as the core's \
          tolerances take it). The rows above check ours; parry's figures are reported for comparison, not \
          checked.",
@@ -760,7 +760,7 @@ fn speed_report(timing_rows: &[Vec<String>], ctx: &mut CaseContext) -> Result<()
     ctx.text(
         "ns per query, minimum over repeated passes, size-1 pairs of the random set. Overlapping: our full \
          query (cold cache) vs parry's `query::contact`. Separated: our boolean intersection test vs parry's \
-         `intersection_test`. Ratio = ours / parry (issue 2 target: ≤ 1/3 on voronoi and hull16–32 and for \
+         `intersection_test`. Ratio = ours / parry (target: ≤ 1/3 on voronoi and hull16–32 and for \
          separated rejection). Wall-clock figures vary between runs; the criterion bench `benches/contact.rs` \
          gives the careful measurement.",
     );
