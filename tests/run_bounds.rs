@@ -1,6 +1,6 @@
 //! A run's number of steps is computed with checked arithmetic and held to a stated limit. `end_time = 1e300`,
-//! `time_step = 1e-300` or `normal_stiffness = 1e300` (a derived step of 1e-152 s) used to saturate the
-//! step count at 2^64 − 1 ("steps 0 → 18446744073709551615") and run forever; they are refused at set-up
+//! `time_step = 1e-300` or `normal_stiffness = 1e300` (a derived step of 1e-152 s) give step counts beyond
+//! the counter (2^64 − 1, where a saturating count would run forever); they are refused at set-up
 //! with the field, the count, where Δt came from, and the limit. A run above the default limit of 10^9
 //! steps is refused unless `simulation.max_steps` (or `--max-steps` with `--end-time`) raises it.
 

@@ -2,8 +2,8 @@
 //! step the positions, velocities, angular momenta and loads the accessors return are the general step's
 //! bits (not only the final state after a write-back, which `tests/sphere_flat_paths.rs` compares), and a
 //! non-finite state is reported by the same step, for the same body and quantity, as the general step
-//! reports it. Written for a variant that left each step's second half kick to the next step's first
-//! pass (tried and dropped: no measured gain); it guards any such change of the step's passes.
+//! reports it. It guards any change of the step's passes (such as leaving each step's second half kick to
+//! the next step's first pass).
 
 use std::path::Path;
 

@@ -1,7 +1,6 @@
 //! The command line refuses runs that would never end or outgrow the machine, at once and with the number
-//! that explains why: `end_time = 1e300` used to print "steps 0 → 18446744073709551615" and run forever,
-//! `--end-time` far out had no limit, and `polydem rockfill --size 12` grew to 3.4 GB in 40 s without a
-//! line of output. A contact-pairs file that starts with a byte-order mark is answered.
+//! that explains why: `end_time = 1e300` (a step count beyond the counter), an `--end-time` far out
+//! (beyond the step limit) and `polydem rockfill --size 12` (millions of rocks). A contact-pairs file that starts with a byte-order mark is answered.
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};

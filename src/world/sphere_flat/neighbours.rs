@@ -16,7 +16,7 @@
 //! when they do ([`NeighbourList::is_stale`], the rule of the general broad phase). A large body (see
 //! below: a projectile) is listed with [`LARGE_SKIN_FACTOR`] times the skin against every body and wall,
 //! and its pairs stay valid while its displacement and the largest other one sum to that wider skin: a
-//! fast projectile alone no longer forces a rebuild every few steps (at 200 m/s it crossed the skin of
+//! fast projectile alone does not force a rebuild every few steps (at 200 m/s it crosses the common skin of
 //! sphere bed b in 8 steps).
 //!
 //! # Build
