@@ -108,6 +108,19 @@ impl PyContactResult {
     }
 }
 
+/// The engine poses of the two shapes: each user pose (identity when `None`) times the shape's own frame.
+fn engine_poses(
+    a: &PyShape,
+    b: &PyShape,
+    pose_a: Option<&Bound<'_, PyAny>>,
+    pose_b: Option<&Bound<'_, PyAny>>,
+) -> PyResult<(Pose, Pose)> {
+    Ok((
+        arrays::pose(pose_a, "pose_a")? * a.frame,
+        arrays::pose(pose_b, "pose_b")? * b.frame,
+    ))
+}
+
 /// The contact between shape `a` at `pose_a` and shape `b` at `pose_b`. A pose is
 /// `(position[3], quaternion[4] as w, x, y, z)` placing the shape's input frame in the world; `None` is the
 /// identity (a polyhedron then sits where its points were given).
@@ -120,8 +133,7 @@ pub fn contact(
     pose_a: Option<&Bound<'_, PyAny>>,
     pose_b: Option<&Bound<'_, PyAny>>,
 ) -> PyResult<PyContactResult> {
-    let pos1 = arrays::pose(pose_a, "pose_a")? * a.frame;
-    let pos2 = arrays::pose(pose_b, "pose_b")? * b.frame;
+    let (pos1, pos2) = engine_poses(&a, &b, pose_a, pose_b)?;
     let (shape1, shape2) = (&a.shape, &b.shape);
     let geometry = py
         .detach(|| exact_query(&pos1, shape1, &pos2, shape2, &mut EpaScratch::default()))
@@ -167,8 +179,7 @@ pub fn contact_oracle(
     pose_a: Option<&Bound<'_, PyAny>>,
     pose_b: Option<&Bound<'_, PyAny>>,
 ) -> PyResult<PyContactResult> {
-    let pos1 = arrays::pose(pose_a, "pose_a")? * a.frame;
-    let pos2 = arrays::pose(pose_b, "pose_b")? * b.frame;
+    let (pos1, pos2) = engine_poses(&a, &b, pose_a, pose_b)?;
     let (Shape::Polyhedron(p1), Shape::Polyhedron(p2)) = (&a.shape, &b.shape) else {
         return Err(PyValueError::new_err(
             "contact_oracle: the separating-axis oracle takes two ConvexPolyhedron shapes",

@@ -316,8 +316,11 @@ impl PairContext<'_> {
         let velocity_back = |p: &Point| kb.velocity_back_at(p, dt) - ka.velocity_back_at(p, dt);
         let d_vec = kb.position - ka.position;
         let d_squared = d_vec.norm_squared();
-        if d_squared >= reach * reach {
-            // d ≥ r_A + r_B: no overlap beyond the touching band.
+        // d ≥ r_A + r_B, or an overlap within the touching band: separated.
+        let overlap = (d_squared < reach * reach)
+            .then(|| sphere_sphere_normal(&d_vec, d_squared, reach))
+            .filter(|&(_, depth)| depth > c.touch && depth > 0.0);
+        let Some((normal, depth)) = overlap else {
             separated(
                 history,
                 in_contact,
@@ -327,19 +330,7 @@ impl PairContext<'_> {
                 dt,
             );
             return Ok(None);
-        }
-        let (normal, depth) = sphere_sphere_normal(&d_vec, d_squared, reach);
-        if !(depth > c.touch && depth > 0.0) {
-            separated(
-                history,
-                in_contact,
-                ledger,
-                c.law.as_ref(),
-                velocity_back,
-                dt,
-            );
-            return Ok(None);
-        }
+        };
         let Some(law) = &c.law else {
             return Err(self.missing_law(self.props[a].material, self.props[b].material));
         };
