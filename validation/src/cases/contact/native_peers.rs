@@ -41,8 +41,10 @@ struct Column {
 fn describe(a: &NativeAnswer, size: f64) -> String {
     match a {
         NativeAnswer::Overlap { depth, .. } => format!("overlap {:.3e}", depth / size),
-        NativeAnswer::Separated { distance: Some(d) } => format!("gap {:.3e}", d / size),
-        NativeAnswer::Separated { distance: None } => "no intersection".into(),
+        NativeAnswer::Separated {
+            distance: Some(d), ..
+        } => format!("gap {:.3e}", d / size),
+        NativeAnswer::Separated { distance: None, .. } => "no intersection".into(),
         NativeAnswer::Failed => "failed".into(),
     }
 }
@@ -60,8 +62,10 @@ fn score(a: &NativeAnswer, e: &Eval, band: f64) -> (bool, bool, Option<f64>) {
     let reference = e.reference.signed_gap;
     let (kind, signed) = match *a {
         NativeAnswer::Overlap { depth, .. } => (classify(-depth, band), Some(-depth)),
-        NativeAnswer::Separated { distance: Some(d) } => (classify(d, band), Some(d)),
-        NativeAnswer::Separated { distance: None } => (ContactKind::Separated, None),
+        NativeAnswer::Separated {
+            distance: Some(d), ..
+        } => (classify(d, band), Some(d)),
+        NativeAnswer::Separated { distance: None, .. } => (ContactKind::Separated, None),
         NativeAnswer::Failed => return (true, true, None),
     };
     let ambiguous = (reference.abs() - band).abs() <= e.tol;
