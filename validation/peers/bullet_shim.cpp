@@ -35,7 +35,9 @@ void pd_bt_hull_free(void *shape) { delete static_cast<btConvexHullShape *>(shap
 
 // mode 0: Penetration (true when penetrating: distance < 0 is minus the depth); mode 1: Distance (true when
 // separated). Returns 1 when the call returned true, 0 when false, and writes Bullet's status, signed
-// distance, normal (world) and witness points (world) in every case.
+// distance, normal and witness points (world) in every case. Bullet runs GJK and EPA in the first shape's
+// frame and returns the witnesses in world coordinates but the normal in that frame: it is rotated to the
+// world here.
 int pd_bt_query(const void *a, const double ta[3], const double qa[4], const void *b, const double tb[3],
                 const double qb[4], int mode, int *status, double *distance, double normal[3],
                 double wa[3], double wb[3]) {
@@ -48,7 +50,7 @@ int pd_bt_query(const void *a, const double ta[3], const double qa[4], const voi
                         : btGjkEpaSolver2::Distance(sa, pa, sb, pb, guess, r);
     *status = (int)r.status;
     *distance = r.distance;
-    write(r.normal, normal);
+    write(pa.getBasis() * r.normal, normal);
     write(r.witnesses[0], wa);
     write(r.witnesses[1], wb);
     return ok ? 1 : 0;

@@ -1,6 +1,7 @@
 //! Bullet 3.24 (float64) through `peers/bullet_shim.cpp`: `btGjkEpaSolver2::Penetration` and `Distance`.
-//! Bullet's normal points from the second body to the first (`witnesses[0] − witnesses[1]` for a
-//! distance, minus EPA's normal for a penetration); it is turned around here.
+//! Bullet's normal (rotated to the world by the shim) points from the second body to the first
+//! (`witnesses[0] − witnesses[1]` for a distance, minus EPA's normal for a penetration); it is turned
+//! around here.
 
 use super::{flat, parts, unit, NativeAnswer, NativePair};
 use polydem::math::{Real, Vector};

@@ -1,36 +1,45 @@
-//! Every compiled-in peer on two unit cubes side by side along x: the answer's kind, value and normal
-//! direction (from the first body to the second) against the construction.
+//! Every compiled-in peer on two boxes side by side: the answer's kind, value and normal direction (world,
+//! from the first body to the second) against the construction.
 
 use super::{NativeAnswer, NativePair, NativePeer};
 use polydem::contact::tolerances::pair_length_scale;
-use polydem::math::{Point, Vector};
+use polydem::math::{Point, Rotation, Vector};
 use polydem::shape::ConvexPolyhedron;
 
-/// Cube A of side 1 at the origin, cube B of side 1 at x = 1 − `overlap` (rotated 0.3 rad about x, so
-/// the contact face stays normal to x).
-fn cubes(overlap: f64) -> NativePair {
-    let corners = |cx: f64, turn: f64| -> Vec<Point> {
-        let rot = polydem::math::Rotation::from_axis_angle(&Vector::x_axis(), turn);
+/// The rotation of both boxes: a generic one, so that no body frame is the world's.
+fn turn() -> Rotation {
+    Rotation::from_euler_angles(0.4, -0.7, 1.1)
+}
+
+/// Two 1 × 0.8 × 0.6 boxes with the same rotation, B's centre (1 − `overlap`, 0.15, −0.1) from A's in the
+/// turned axes: they overlap by `overlap` (or are −`overlap` apart) across their x faces, and that axis is
+/// the minimal one (the overlaps along y and z are 0.65 and 0.5). The shift along y and z keeps the side
+/// faces apart, a degenerate configuration that is not this test's subject.
+fn boxes(overlap: f64) -> NativePair {
+    let corners = |centre: Vector| -> Vec<Point> {
         (0..8)
             .map(|i| {
-                let c = |bit: usize| if i & bit == 0 { -0.5 } else { 0.5 };
-                Point::from(rot * Vector::new(c(1), c(2), c(4)) + Vector::new(cx, 0.0, 0.0))
+                let c = |bit: usize, h: f64| if i & bit == 0 { -h } else { h };
+                Point::from(turn() * Vector::new(c(1, 0.5), c(2, 0.4), c(4, 0.3)) + centre)
             })
             .collect()
     };
-    let (a, pos1) = ConvexPolyhedron::from_points(&corners(0.0, 0.0)).expect("cube A");
-    let (b, pos2) = ConvexPolyhedron::from_points(&corners(1.0 - overlap, 0.3)).expect("cube B");
+    let offset = turn() * Vector::new(1.0 - overlap, 0.15, -0.1);
+    let (a, pos1) =
+        ConvexPolyhedron::from_points(&corners(Vector::new(0.2, -0.1, 0.3))).expect("box A");
+    let (b, pos2) = ConvexPolyhedron::from_points(&corners(Vector::new(0.2, -0.1, 0.3) + offset))
+        .expect("box B");
     let size = pair_length_scale(a.length_scale(), b.length_scale());
     NativePair::new(&a, &pos1, &b, &pos2, size)
 }
 
 fn along_x(n: &Vector) -> bool {
-    (n - Vector::x()).norm() <= 1e-6
+    (n - turn() * Vector::x()).norm() <= 1e-6
 }
 
 #[test]
-fn peers_answer_cubes_with_normals_from_first_to_second() {
-    let (overlapping, separated) = (cubes(0.1), cubes(-0.1));
+fn peers_answer_boxes_with_world_normals_from_first_to_second() {
+    let (overlapping, separated) = (boxes(0.1), boxes(-0.1));
     for peer in NativePeer::ALL.into_iter().filter(|p| p.available()) {
         match overlapping.answer(peer) {
             NativeAnswer::Overlap {
@@ -38,11 +47,12 @@ fn peers_answer_cubes_with_normals_from_first_to_second() {
                 normal: Some(normal),
             } => assert!(
                 (depth - 0.1).abs() <= 1e-6 && along_x(&normal),
-                "{}: overlapping cubes (overlap 0.1 along +x): depth {depth}, normal {normal:?}; \
-                 expected 0.1 within 1e-6 and +x within 1e-6",
-                peer.label()
+                "{}: overlapping boxes (overlap 0.1 along the turned x axis {:?}): depth {depth}, \
+                 normal {normal:?}; expected 0.1 within 1e-6 and that axis within 1e-6",
+                peer.label(),
+                turn() * Vector::x()
             ),
-            other => panic!("{}: overlapping cubes answered {other:?}", peer.label()),
+            other => panic!("{}: overlapping boxes answered {other:?}", peer.label()),
         }
         match separated.answer(peer) {
             NativeAnswer::Separated {
@@ -50,12 +60,13 @@ fn peers_answer_cubes_with_normals_from_first_to_second() {
                 normal: Some(n),
             } => assert!(
                 (d - 0.1).abs() <= 1e-6 && along_x(&n),
-                "{}: cubes 0.1 apart along +x: distance {d}, normal {n:?}; expected 0.1 within 1e-6 \
-                 and +x within 1e-6",
-                peer.label()
+                "{}: boxes 0.1 apart along the turned x axis {:?}: distance {d}, normal {n:?}; \
+                 expected 0.1 within 1e-6 and that axis within 1e-6",
+                peer.label(),
+                turn() * Vector::x()
             ),
             NativeAnswer::Separated { distance: None, .. } if !peer.gives_distance() => {}
-            other => panic!("{}: separated cubes answered {other:?}", peer.label()),
+            other => panic!("{}: separated boxes answered {other:?}", peer.label()),
         }
     }
 }
