@@ -22,6 +22,9 @@ pub enum SeriesStyle {
     LinePoints,
     /// A line without markers (CDFs, histories).
     Line,
+    /// Large markers without a line, their shape (circle, triangle, square, cross) changing with the
+    /// series' index as well as their colour: one marker per method in a comparison of many.
+    Marker,
 }
 
 /// One named data series.
@@ -155,6 +158,52 @@ fn legend_corner(data: &[Vec<(f64, f64)>], xr: (f64, f64), yr: (f64, f64)) -> Se
     best.1
 }
 
+type Chart<'a, 'b> = ChartContext<
+    'a,
+    SVGBackend<'b>,
+    Cartesian2d<plotters::coord::types::RangedCoordf64, plotters::coord::types::RangedCoordf64>,
+>;
+
+/// Draws one [`SeriesStyle::Marker`] series and its legend entry: series `i` gets the shape
+/// `(i + i / 8) % 4`, so that no two of the first 32 series share both shape and colour.
+fn draw_markers(
+    chart: &mut Chart,
+    i: usize,
+    color: RGBColor,
+    pts: &[(f64, f64)],
+    label: &str,
+) -> Result<(), String> {
+    const SIZE: i32 = 7;
+    let style = color.filled();
+    let stroke = color.stroke_width(3);
+    let err = |e: DrawingAreaErrorKind<_>| e.to_string();
+    match (i + i / 8) % 4 {
+        0 => chart
+            .draw_series(pts.iter().map(|p| Circle::new(*p, SIZE, style)))
+            .map_err(err)?
+            .label(label)
+            .legend(move |(x, y)| Circle::new((x + 8, y), SIZE, style)),
+        1 => chart
+            .draw_series(pts.iter().map(|p| TriangleMarker::new(*p, SIZE + 2, style)))
+            .map_err(err)?
+            .label(label)
+            .legend(move |(x, y)| TriangleMarker::new((x + 8, y), SIZE + 2, style)),
+        2 => chart
+            .draw_series(pts.iter().map(|p| {
+                EmptyElement::at(*p) + Rectangle::new([(-SIZE, -SIZE), (SIZE, SIZE)], style)
+            }))
+            .map_err(err)?
+            .label(label)
+            .legend(move |(x, y)| Rectangle::new([(x + 2, y - 6), (x + 14, y + 6)], style)),
+        _ => chart
+            .draw_series(pts.iter().map(|p| Cross::new(*p, SIZE + 1, stroke)))
+            .map_err(err)?
+            .label(label)
+            .legend(move |(x, y)| Cross::new((x + 8, y), SIZE + 1, stroke)),
+    };
+    Ok(())
+}
+
 impl Plot {
     /// Number of points per series that a log axis cannot show (value ≤ 0 or non-finite).
     pub fn hidden_points(&self) -> Vec<(String, usize)> {
@@ -260,6 +309,10 @@ impl Plot {
                 .map_err(|e| e.to_string())?;
             for (i, (s, pts)) in self.series.iter().zip(&data).enumerate() {
                 let color = COLORS[i % COLORS.len()];
+                if s.style == SeriesStyle::Marker {
+                    draw_markers(&mut chart, i, color, pts, &s.label)?;
+                    continue;
+                }
                 let marker_style = color.mix(0.6).filled();
                 let line_style = color.stroke_width(2);
                 let anno = match s.style {
@@ -269,6 +322,7 @@ impl Plot {
                     SeriesStyle::Line => chart
                         .draw_series(LineSeries::new(pts.iter().copied(), line_style))
                         .map_err(|e| e.to_string())?,
+                    SeriesStyle::Marker => unreachable!("drawn by draw_markers"),
                     SeriesStyle::LinePoints => {
                         chart
                             .draw_series(LineSeries::new(pts.iter().copied(), line_style))
@@ -341,6 +395,42 @@ mod tests {
         );
         // Left in the temp directory for a look: `rsvg-convert` it to PNG.
         let path = std::env::temp_dir().join("polydem_plot_test.svg");
+        plot.write_svg(&path).unwrap();
+    }
+
+    #[test]
+    fn marker_series_are_drawn_with_their_legend_entries() {
+        let series = (0..10i32)
+            .map(|i| Series {
+                label: format!("method {i}"),
+                style: SeriesStyle::Marker,
+                points: vec![(1e3 * (1.0 + f64::from(i)), 10f64.powi(-i))],
+            })
+            .collect();
+        let plot = Plot {
+            name: "m".into(),
+            title: "Time against error".into(),
+            x_label: "ns".into(),
+            y_label: "error".into(),
+            x_log: true,
+            y_log: true,
+            series,
+            caption: String::new(),
+        };
+        let mut svg = String::new();
+        plot.render(&mut svg).unwrap();
+        for i in 0..10 {
+            assert!(
+                svg.contains(&format!("method {i}")),
+                "SVG lacks legend `method {i}`"
+            );
+        }
+        // Circles, triangles (polygons) and squares among the first four markers.
+        for needle in ["<circle", "<polygon", "<rect"] {
+            assert!(svg.contains(needle), "SVG lacks a `{needle}` marker");
+        }
+        // Left in the temp directory for a look: `rsvg-convert` it to PNG.
+        let path = std::env::temp_dir().join("polydem_plot_markers.svg");
         plot.write_svg(&path).unwrap();
     }
 }

@@ -6,8 +6,11 @@
 //! diameter of the centroid-centred bounding sphere, as the core's tolerances take it).
 //! - gap error: |signed gap − reference signed gap| (signed gap = distance − overlap), which covers the
 //!   depth of overlapping pairs and the distance of separated ones;
-//! - normal error: |signed gap along the reported normal (support functions evaluated by brute force over
-//!   the input points) − reference signed gap|: zero exactly when the normal is an optimal axis;
+//! - normal error: |normal excess|, where the normal excess ([`normal_excess`]) is the overlap of the two
+//!   bodies along the reported normal (support functions evaluated by brute force over the input points)
+//!   minus the exact overlap (for separated pairs: the exact distance minus the separation along the
+//!   normal). It is ≥ 0 for every direction up to round-off, and zero exactly when the normal is an
+//!   optimal axis;
 //! - point error: the largest of |plane distance of c1 to ∂A|, |plane distance of c2 to ∂B| and
 //!   |c1 − c2 + gap · n| (the witness points must realise the reported gap along the normal);
 //! - wrong status: the kind (overlap/touching/separated) differs from the reference, unless the reference
@@ -53,6 +56,8 @@ pub struct Errors {
     pub wrong_status: bool,
     pub gap: f64,
     pub normal: f64,
+    /// The normal excess (m, signed; `normal` is its magnitude), ∞ without a usable normal.
+    pub normal_excess: f64,
     pub point: f64,
 }
 
@@ -115,6 +120,13 @@ pub fn build(pair: &Pair) -> Result<Built, String> {
     })
 }
 
+/// The normal excess of unit `n` (from A to B) on the pair: overlap of the clouds along `n` plus the
+/// reference signed gap (m). The exact overlap is the least overlap over all directions, and the exact
+/// distance the largest separation, so the excess is ≥ 0 up to round-off; 0 when `n` is optimal.
+pub fn normal_excess(pair: &Pair, n: &Vector, reference_signed_gap: f64) -> f64 {
+    overlap_along(&pair.a, &pair.b, n) + reference_signed_gap
+}
+
 /// Overlap of the point clouds along unit `n`: max_a n·a − min_b n·b (brute force).
 fn overlap_along(a: &[Point], b: &[Point], n: &Vector) -> f64 {
     let ha = a
@@ -152,9 +164,8 @@ fn errors(
             .iter()
             .chain(ans.point_b.coords.iter())
             .all(|x| x.is_finite());
-    let normal = if (n_norm - 1.0).abs() <= 1e-9 && finite {
-        let n = ans.normal / n_norm;
-        (-overlap_along(&pair.a, &pair.b, &n) - reference.signed_gap).abs()
+    let normal_excess = if (n_norm - 1.0).abs() <= 1e-9 && finite {
+        normal_excess(pair, &(ans.normal / n_norm), reference.signed_gap)
     } else {
         f64::INFINITY
     };
@@ -167,7 +178,8 @@ fn errors(
         failed: !finite,
         wrong_status: ans.kind != reference.kind && !ambiguous,
         gap: (ans.signed_gap - reference.signed_gap).abs(),
-        normal,
+        normal: normal_excess.abs(),
+        normal_excess,
         point: if finite { point } else { f64::INFINITY },
     }
 }
@@ -232,6 +244,7 @@ pub fn evaluate(
                 wrong_status: true,
                 gap: f64::INFINITY,
                 normal: f64::INFINITY,
+                normal_excess: f64::INFINITY,
                 point: f64::INFINITY,
             },
             None,

@@ -8,7 +8,7 @@
 //! an EPA tolerance sweep for the work-precision plot) is measured on the size-1 pairs of the same sets.
 
 pub mod eval;
-pub mod native_peers;
+pub mod libraries;
 pub mod ours;
 pub mod pebble;
 pub mod timing;
@@ -951,7 +951,7 @@ impl Case for Contact {
             (&ev.degenerate[..], &ev.deg_evals[..]),
             (&ev.pebble[..], &ev.pebble_evals[..]),
         ];
-        native_peers::report(
+        libraries::report(
             &sets,
             &pooled_overlap,
             &pooled_separated,

@@ -74,3 +74,52 @@ pub fn parry_intersects_ns(pairs: &[Built], repeats: usize) -> f64 {
         black_box(peer.intersects(&p.pos1, &p.pos2));
     })
 }
+
+/// The vertex-count classes of the per-class timings: bounds on nA + nB, the hull vertices of both bodies.
+pub const VERTEX_CLASSES: [(&str, usize, usize); 4] = [
+    ("≤16", 0, 16),
+    ("17–32", 17, 32),
+    ("33–48", 33, 48),
+    ("≥49", 49, usize::MAX),
+];
+
+/// The index in [`VERTEX_CLASSES`] of a pair with `vertices` hull vertices in all.
+pub fn vertex_class(vertices: usize) -> usize {
+    VERTEX_CLASSES
+        .iter()
+        .position(|(_, lo, hi)| (*lo..=*hi).contains(&vertices))
+        .unwrap_or(VERTEX_CLASSES.len() - 1)
+}
+
+/// The pool's items grouped by vertex class: `classes[i]` is item i's class index.
+pub fn class_members(classes: &[usize]) -> [Vec<usize>; 4] {
+    let mut members: [Vec<usize>; 4] = Default::default();
+    for (i, c) in classes.iter().enumerate() {
+        members[*c].push(i);
+    }
+    members
+}
+
+/// ns per call of `f` over the whole pool and over each vertex class of it (NaN for an empty class),
+/// each the minimum over `repeats` passes ([`ns_per_item`]).
+pub fn ns_pool_and_classes(
+    members: &[Vec<usize>; 4],
+    repeats: usize,
+    mut f: impl FnMut(usize),
+) -> (f64, [f64; 4]) {
+    let n: usize = members.iter().map(Vec::len).sum();
+    let all = if n == 0 {
+        f64::NAN
+    } else {
+        ns_per_item(n, repeats, &mut f)
+    };
+    let by_class = std::array::from_fn(|c| {
+        let idx = &members[c];
+        if idx.is_empty() {
+            f64::NAN
+        } else {
+            ns_per_item(idx.len(), repeats, |k| f(idx[k]))
+        }
+    });
+    (all, by_class)
+}
