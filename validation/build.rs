@@ -136,6 +136,11 @@ mod peers {
 
     fn build_coal(prefix: &Path) {
         let lib = prefix.join("lib");
+        // Rebuilt when the wheel is installed, replaced or removed (a missing file reruns every build).
+        println!(
+            "cargo::rerun-if-changed={}",
+            lib.join("libcoal.so").display()
+        );
         let (include, eigen) = (prefix.join("include"), prefix.join("include/eigen3"));
         let found = lib.join("libcoal.so").is_file() && eigen.join("Eigen/Core").is_file();
         let Some(version) = coal_version(prefix).filter(|_| found) else {

@@ -6,6 +6,9 @@
 //! Every pair is answered by the SAT oracle (reference), by our query (cold cache, default tolerances) and by
 //! parry's `query::contact`; errors are defined in [`eval`]. Timing (ns per query, ours vs parry vs SAT, and
 //! an EPA tolerance sweep for the work-precision plot) is measured on the size-1 pairs of the same sets.
+//! [`libraries`] puts every library side by side on all three sets, the C/C++ ones (libccd, Bullet, coal)
+//! when the `peers` feature has them: statuses, errors, normal excess, ns per query by vertex count, a
+//! time-against-error plot and where each fails.
 
 pub mod eval;
 pub mod libraries;
