@@ -21,7 +21,7 @@ fi
 # (boost, assimp, qhull, octomap) that libcoal.so finds through its own rpath. build.rs reads the prefix.
 coal_dir="$PWD/target/coal-wheel"
 if [ ! -d "$coal_dir/libcoal-3.0.3.dist-info" ]; then
-    python3 -m pip install --quiet --disable-pip-version-check --target "$coal_dir" \
+    PIP_ROOT_USER_ACTION=ignore python3 -m pip install --quiet --disable-pip-version-check --target "$coal_dir" \
         libcoal==3.0.3 cmeel-eigen==3.4.1 ||
         echo "peers: pip could not install libcoal and cmeel-eigen: the coal peer is left out" >&2
 fi
