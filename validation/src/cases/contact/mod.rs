@@ -625,12 +625,16 @@ fn depth_error_plot(
         .iter()
         .filter(|e| e.reference.kind == ContactKind::Overlap)
         .collect();
+    let drawn = scatter_sample(over.len(), |i| {
+        over[i].ours.gap.max(over[i].parry.gap) / over[i].size
+    });
     let scatter = |label: &str, pick: &dyn Fn(&Eval) -> f64| Series {
         label: label.into(),
         style: SeriesStyle::Points,
-        points: over
+        points: drawn
             .iter()
-            .map(|e| {
+            .map(|&i| {
+                let e = over[i];
                 (
                     -e.reference.signed_gap / e.size,
                     (pick(e) / e.size).max(PLOT_FLOOR),
@@ -659,11 +663,36 @@ fn depth_error_plot(
             tol_line,
         ],
         caption: format!(
-            "All sizes pooled. Errors below {PLOT_FLOOR:e} × size (including exact zeros) are drawn at \
-             {PLOT_FLOOR:e}."
+            "All sizes pooled; {} of {} pairs drawn (an even sample plus the {SCATTER_WORST} largest \
+             errors). Errors below {PLOT_FLOOR:e} × size (including exact zeros) are drawn at \
+             {PLOT_FLOOR:e}.",
+            drawn.len(),
+            over.len()
         ),
     })?;
     Ok(())
+}
+
+/// Most pairs a scatter draws: the full profile's tens of thousands of points would make a page of
+/// megabytes that a browser renders slowly and that shows no more than a sample does.
+const SCATTER_POINTS: usize = 4000;
+/// The pairs of largest error a scatter always draws, so that a thinned plot keeps its outliers.
+const SCATTER_WORST: usize = 200;
+
+/// The indices (ascending) of the `n` pairs a scatter draws: all when `n <= SCATTER_POINTS`, else an even
+/// stride through them plus the [`SCATTER_WORST`] largest by `error(i)`.
+fn scatter_sample(n: usize, error: impl Fn(usize) -> f64) -> Vec<usize> {
+    if n <= SCATTER_POINTS {
+        return (0..n).collect();
+    }
+    let stride = n.div_ceil(SCATTER_POINTS - SCATTER_WORST);
+    let mut by_error: Vec<usize> = (0..n).collect();
+    by_error.sort_by(|&a, &b| error(b).total_cmp(&error(a)));
+    let mut picked: Vec<usize> = (0..n).step_by(stride).collect();
+    picked.extend_from_slice(&by_error[..SCATTER_WORST]);
+    picked.sort_unstable();
+    picked.dedup();
+    picked
 }
 
 /// Cumulative distribution of the gap/depth error of ours and parry over the random set.
