@@ -172,9 +172,10 @@ impl PySimulation {
     /// Advances the simulation by `n` steps in the engine, with the GIL released (other Python threads
     /// run meanwhile). The steps are the same bits as `polydem run`'s. Raises `polydem.StepError` if a
     /// step fails (the state is then that of the failed step). Ctrl-C (or any signal whose handler
-    /// raises) is seen within about 0.1 s and stops the stepping at a step boundary: the exception
-    /// (`KeyboardInterrupt`) is raised, `step_index` tells how far it got, and the simulation is
-    /// consistent and can go on (the steps after it are the bits of an uninterrupted run).
+    /// raises) is seen within about 0.1 s (the engine's run loop looks at most 64 steps later) and stops
+    /// the stepping at a step boundary: the exception (`KeyboardInterrupt`) is raised, `step_index`
+    /// tells how far it got, and the simulation is consistent and can go on (the steps after it are the
+    /// bits of an uninterrupted run).
     #[pyo3(signature = (n = 1))]
     fn step(&mut self, py: Python<'_>, n: u64) -> PyResult<()> {
         let sim = &mut self.sim;
@@ -193,10 +194,10 @@ impl PySimulation {
     /// series at the scene's output interval, and VTK frames, the contact network and checkpoints at the
     /// given intervals (s); the directory is locked for the run and its series start afresh. The steps
     /// run in Rust with the GIL released; it is taken again between stretches for the callbacks, and
-    /// about every 0.1 s for Ctrl-C: a signal whose handler raises (`KeyboardInterrupt`) stops the run at
-    /// a step boundary, with the outputs flushed up to there, and the exception is raised; the
-    /// simulation is consistent there and can go on. An exception raised by a callback stops the run
-    /// and propagates. A run to `until` longer than the engine's step limit (10⁹ steps) is refused unless
+    /// about every 0.1 s (64 steps at most past that) for Ctrl-C: a signal whose handler raises
+    /// (`KeyboardInterrupt`) stops the run at a step boundary, with the outputs flushed up to there, and
+    /// the exception is raised; the simulation is consistent there and can go on (as `step`). An
+    /// exception raised by a callback stops the run and propagates. A run to `until` longer than the engine's step limit (10⁹ steps) is refused unless
     /// `max_steps` raises it.
     #[pyo3(signature = (until = None, every = None, callback = None, *, progress = None, out = None,
                         vtk_interval = None, contacts_interval = None, checkpoint_interval = None,
