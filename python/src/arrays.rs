@@ -136,11 +136,8 @@ pub fn unit_quaternion([w, x, y, z]: [Real; 4], what: &str) -> PyResult<Rotation
     Ok(Rotation::new_normalize(q))
 }
 
-/// A pose given as `(position[3], quaternion[4] w,x,y,z)`; `None` is the identity.
-pub fn pose(obj: Option<&Bound<'_, PyAny>>, what: &str) -> PyResult<Pose> {
-    let Some(obj) = obj else {
-        return Ok(Pose::identity());
-    };
+/// A pose given as `(position[3], quaternion[4] w,x,y,z)`.
+pub fn pose(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<Pose> {
     let (position, orientation): (Bound<'_, PyAny>, Bound<'_, PyAny>) =
         obj.extract().map_err(|_| {
             value_error(

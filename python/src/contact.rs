@@ -108,16 +108,24 @@ impl PyContactResult {
     }
 }
 
-/// The engine poses of the two shapes: each user pose (identity when `None`) times the shape's own frame.
+/// The engine pose of a shape placed at the user's `pose`: `pose · frame`; without a pose, the shape's own
+/// frame (it sits where its points were given, the pose `polydem contact` gives it).
+pub fn engine_pose(pose: Option<&Pose>, frame: &Pose) -> Pose {
+    pose.map_or(*frame, |p| p * frame)
+}
+
+/// The engine poses of the two shapes.
 fn engine_poses(
     a: &PyShape,
     b: &PyShape,
     pose_a: Option<&Bound<'_, PyAny>>,
     pose_b: Option<&Bound<'_, PyAny>>,
 ) -> PyResult<(Pose, Pose)> {
+    let user =
+        |pose: Option<&Bound<'_, PyAny>>, what| pose.map(|p| arrays::pose(p, what)).transpose();
     Ok((
-        arrays::pose(pose_a, "pose_a")? * a.frame,
-        arrays::pose(pose_b, "pose_b")? * b.frame,
+        engine_pose(user(pose_a, "pose_a")?.as_ref(), &a.frame),
+        engine_pose(user(pose_b, "pose_b")?.as_ref(), &b.frame),
     ))
 }
 

@@ -7,6 +7,7 @@ mod arrays;
 mod contact;
 mod contact_batch;
 mod errors;
+mod interrupt;
 mod rockfill;
 mod run_loop;
 mod scene_dict;

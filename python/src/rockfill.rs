@@ -1,16 +1,19 @@
 //! `polydem.rockfill`: the paper's experiment (generation, packing, penetration) run by the same function
 //! as `polydem rockfill`, with the GIL released, its monitors returned as numpy arrays.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use numpy::{PyArray1, PyArray2, PyArrayMethods};
 use polydem::math::{Real, Vector};
 use polydem_rockfill::config::ExperimentConfig;
+use polydem_rockfill::experiment::ExperimentResult;
 use polydem_rockfill::penetration::{MonitorRow, Outcome, PenetrationReport};
-use polydem_rockfill::study::run_one;
+use polydem_rockfill::study::run_one_with_stop;
 use pyo3::exceptions::{PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
+
+use crate::interrupt;
 
 /// The experiment file: "quick", "paper" (full scale) or a path to a file of that format.
 fn config_of(config: &Bound<'_, PyAny>) -> PyResult<ExperimentConfig> {
@@ -110,8 +113,11 @@ fn report<'py>(py: Python<'py>, p: &PenetrationReport) -> PyResult<Bound<'py, Py
 /// `velocity`, `speed`, `force`, `axial_force`, `velocity_deflection`, `axis_deflection`, `contacts`).
 /// `progress(stage, text)` receives the experiment's progress messages. `max_rocks` and `max_steps` raise
 /// the experiment's limits (rocks generated; steps of the packing and of the penetration), beyond which
-/// a run is refused before it starts, with what it would need. The run holds no GIL; it cannot
-/// be interrupted from Python before it ends; an exception raised by `progress` is raised when it does.
+/// a run is refused before it starts, with what it would need. The run holds no GIL. Ctrl-C (a signal
+/// whose handler raises, `KeyboardInterrupt`) is seen within about 0.1 s during the packing and the
+/// penetration (the generation of the rocks before them runs to its end first), and an exception raised
+/// by `progress` as soon as it is raised: either stops the run between two steps and is raised, and the
+/// outputs of a finished run (monitors, summary, picture; the bed of a finished packing) are not written.
 #[pyfunction]
 #[pyo3(signature = (out, config = None, *, size_mm = None, seed = None, bed = None, progress = None,
                     max_rocks = None, max_steps = None))]
@@ -153,21 +159,35 @@ pub fn rockfill<'py>(
         config.rock.mean_size * 1e3,
         config.rock.seed
     );
-    let mut callback_error: Option<PyErr> = None;
+    let result = run_stoppable(py, &config, &out, bed.as_deref(), &title, progress)?;
+    report(py, &result.penetration)
+}
+
+/// The run of `polydem rockfill` with the GIL released, stopped between two steps by an exception: a
+/// signal handler's (Ctrl-C) or the progress callback's, which is then raised.
+fn run_stoppable(
+    py: Python<'_>,
+    config: &ExperimentConfig,
+    out: &Path,
+    bed: Option<&Path>,
+    title: &str,
+    progress: Option<Py<PyAny>>,
+) -> PyResult<ExperimentResult> {
+    let (stop, signals) = interrupt::stop_check();
     let result = py.detach(|| {
         let mut report_progress = |stage: &str, text: String| {
-            let (Some(callback), None) = (&progress, &callback_error) else {
+            let Some(callback) = &progress else { return };
+            if interrupt::raised_already(&signals) {
                 return;
-            };
+            }
             if let Err(e) = Python::attach(|py| callback.call1(py, (stage, text)).map(|_| ())) {
-                callback_error = Some(e);
+                interrupt::record(&signals, e);
             }
         };
-        run_one(&config, &out, bed.as_deref(), &title, &mut report_progress)
+        run_one_with_stop(config, out, bed, title, Some(stop), &mut report_progress)
     });
-    if let Some(e) = callback_error {
+    if let Some(e) = interrupt::raised(&signals) {
         return Err(e);
     }
-    let result = result.map_err(|e| PyRuntimeError::new_err(e.to_string()))?;
-    report(py, &result.penetration)
+    result.map_err(|e| PyRuntimeError::new_err(e.to_string()))
 }

@@ -1,5 +1,6 @@
 //! `Simulation.run`: the engine's run loop driven in stretches, with the GIL released inside each stretch
-//! and taken again between them for the user's callback, the progress callback and Ctrl-C. The outputs
+//! and taken again between them for the user's callback and the progress callback, and within them for
+//! Ctrl-C ([`crate::interrupt`]). The outputs
 //! (CSV series, VTK frames, contact network, checkpoints) are the engine's, opened by the same function
 //! as `polydem run`'s, so a directory written from Python is the one the command writes.
 
@@ -13,6 +14,7 @@ use pyo3::exceptions::{PyOSError, PyValueError};
 use pyo3::prelude::*;
 
 use crate::errors::run_error;
+use crate::interrupt::{Interruptible, SignalCheck};
 use crate::simulation::PySimulation;
 
 /// What a `run` call asked for.
@@ -76,6 +78,7 @@ pub fn run<'py>(owner: &Bound<'py, PySimulation>, request: RunRequest<'py>) -> P
         request.callback_every
     };
     let mut next_callback = start.saturating_add(request.callback_every);
+    let mut signals = SignalCheck::new();
     loop {
         let done = owner.borrow().sim.world.step_index;
         if done >= request.last {
@@ -89,8 +92,17 @@ pub fn run<'py>(owner: &Bound<'py, PySimulation>, request: RunRequest<'py>) -> P
             let mut this = owner.borrow_mut();
             let sim = &mut this.sim;
             let skip = (done != start).then_some(done);
-            py.detach(|| stretch(sim, end, outputs.as_mut(), skip))
-                .map_err(|e| run_error(&e))?;
+            let result = py.detach(|| stretch(sim, end, outputs.as_mut(), skip, &mut signals));
+            if let Some(interrupt) = signals.take_raised() {
+                // What was written up to the interrupt is flushed: the files end at the state where the
+                // simulation stopped.
+                outputs
+                    .map(OutputSet::finish)
+                    .transpose()
+                    .map_err(os_error)?;
+                return Err(interrupt);
+            }
+            result.map_err(|e| run_error(&e))?;
         }
         py.check_signals()?;
         if let Some(progress) = &request.progress {
@@ -103,12 +115,15 @@ pub fn run<'py>(owner: &Bound<'py, PySimulation>, request: RunRequest<'py>) -> P
             }
         }
     }
-    if let Some(outputs) = outputs {
-        outputs
-            .finish()
-            .map_err(|e| PyOSError::new_err(e.to_string()))?;
-    }
+    outputs
+        .map(OutputSet::finish)
+        .transpose()
+        .map_err(os_error)?;
     Ok(())
+}
+
+fn os_error(e: std::io::Error) -> PyErr {
+    PyOSError::new_err(e.to_string())
 }
 
 /// The outputs of a run from `sim`'s state to step `last`, in `dir`.
@@ -130,18 +145,26 @@ fn open_for<'a>(
     })
 }
 
-/// Steps `sim` to step `end` through the engine's run loop, handing the outputs (if any) their states.
+/// Steps `sim` to step `end` through the engine's run loop, handing the outputs (if any) their states,
+/// and stops early at a step boundary if a signal handler raises ([`Interruptible`]).
 fn stretch(
     sim: &mut Simulation,
     end: u64,
     outputs: Option<&mut OutputSet<'_>>,
     skip: Option<u64>,
+    signals: &mut SignalCheck,
 ) -> Result<(), scene::RunError> {
     let scene_end = sim.steps;
     sim.steps = end;
     let result = match outputs {
-        Some(outputs) => sim.run_observed(&mut Stretch { outputs, skip }),
-        None => sim.run_observed(&mut Unobserved),
+        Some(outputs) => sim.run_observed(&mut Interruptible {
+            inner: Stretch { outputs, skip },
+            signals,
+        }),
+        None => sim.run_observed(&mut Interruptible {
+            inner: Unobserved,
+            signals,
+        }),
     };
     sim.steps = scene_end;
     result.map(|_| ())

@@ -13,6 +13,7 @@ use pyo3::prelude::*;
 use pyo3::types::{PyBytes, PyDict, PyType};
 
 use crate::errors::{checkpoint_error, run_error, scene_error};
+use crate::interrupt::{Interruptible, SignalCheck};
 use crate::run_loop::{self, RunRequest, Unobserved};
 use crate::world_arrays;
 
@@ -77,11 +78,15 @@ impl PyScene {
     }
 }
 
-/// Advances `sim` by `n` steps through the engine's run loop, whatever the scene's end time.
-fn advance(sim: &mut Simulation, n: u64) -> Result<(), scene::RunError> {
+/// Advances `sim` by `n` steps through the engine's run loop, whatever the scene's end time; a signal
+/// handler that raises stops it early, at a step boundary ([`Interruptible`]).
+fn advance(sim: &mut Simulation, n: u64, signals: &mut SignalCheck) -> Result<(), scene::RunError> {
     let end = sim.steps;
     sim.steps = sim.world.step_index.saturating_add(n);
-    let result = sim.run_observed(&mut Unobserved);
+    let result = sim.run_observed(&mut Interruptible {
+        inner: Unobserved,
+        signals,
+    });
     sim.steps = end;
     result.map(|_| ())
 }
@@ -166,11 +171,20 @@ impl PySimulation {
 
     /// Advances the simulation by `n` steps in the engine, with the GIL released (other Python threads
     /// run meanwhile). The steps are the same bits as `polydem run`'s. Raises `polydem.StepError` if a
-    /// step fails (the state is then that of the failed step).
+    /// step fails (the state is then that of the failed step). Ctrl-C (or any signal whose handler
+    /// raises) is seen within about 0.1 s (the engine's run loop looks at most 64 steps later) and stops
+    /// the stepping at a step boundary: the exception (`KeyboardInterrupt`) is raised, `step_index`
+    /// tells how far it got, and the simulation is consistent and can go on (the steps after it are the
+    /// bits of an uninterrupted run).
     #[pyo3(signature = (n = 1))]
     fn step(&mut self, py: Python<'_>, n: u64) -> PyResult<()> {
         let sim = &mut self.sim;
-        py.detach(|| advance(sim, n)).map_err(|e| run_error(&e))
+        let mut signals = SignalCheck::new();
+        let result = py.detach(|| advance(sim, n, &mut signals));
+        if let Some(interrupt) = signals.take_raised() {
+            return Err(interrupt);
+        }
+        result.map_err(|e| run_error(&e))
     }
 
     /// Runs to the time `until` (s; default: the scene's end time), calling `callback(sim)` every
@@ -179,9 +193,11 @@ impl PySimulation {
     /// (for a progress bar). With `out`, the run writes the outputs of `polydem run --out` there: the CSV
     /// series at the scene's output interval, and VTK frames, the contact network and checkpoints at the
     /// given intervals (s); the directory is locked for the run and its series start afresh. The steps
-    /// run in Rust with the GIL released; it is taken again between stretches for the callbacks and for
-    /// Ctrl-C (`KeyboardInterrupt` stops the run there). An exception raised by a callback stops the run
-    /// and propagates. A run to `until` longer than the engine's step limit (10⁹ steps) is refused unless
+    /// run in Rust with the GIL released; it is taken again between stretches for the callbacks, and
+    /// about every 0.1 s (64 steps at most past that) for Ctrl-C: a signal whose handler raises
+    /// (`KeyboardInterrupt`) stops the run at a step boundary, with the outputs flushed up to there, and
+    /// the exception is raised; the simulation is consistent there and can go on (as `step`). An
+    /// exception raised by a callback stops the run and propagates. A run to `until` longer than the engine's step limit (10⁹ steps) is refused unless
     /// `max_steps` raises it.
     #[pyo3(signature = (until = None, every = None, callback = None, *, progress = None, out = None,
                         vtk_interval = None, contacts_interval = None, checkpoint_interval = None,

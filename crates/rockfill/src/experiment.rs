@@ -11,7 +11,7 @@ use super::config::ExperimentConfig;
 use super::generation::{generate, GenerationError, GenerationParams, Sample};
 use super::limits::{check_penetration_steps, check_rock_count, LimitError};
 use super::packing::{
-    empty_world, load_bed, loose_world, pack, save_bed, PackingError, PackingReport,
+    empty_world, load_bed, loose_world, pack_with_stop, save_bed, PackingError, PackingReport,
 };
 use super::penetration::{
     add_projectile, penetrate_with, MonitorRow, PenetrationError, PenetrationOptions,
@@ -306,7 +306,8 @@ pub fn run_experiment_with(
                 report
             });
             let mut world = loose_world(config, &rocks, top)?;
-            let mut packing = pack(config, &mut world, |stage, t, h| {
+            let stop = options.stop.as_ref();
+            let mut packing = pack_with_stop(config, &mut world, stop, |stage, t, h| {
                 progress(stage, format!("t = {t:.3} s, height {h:.3} m"))
             })?;
             packing.collapse = collapsed;

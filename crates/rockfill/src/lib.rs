@@ -17,6 +17,7 @@
 //! - [`bed`]: the packed bed as an engine checkpoint, so that penetration runs start from it;
 //! - [`penetration`]: the impact run and its monitors (velocity, resistance, deflection, disturbed zone);
 //! - [`experiment`]: generation → packing (or a saved bed) → penetration;
+//! - [`stop`]: the check a front end answers to stop a packing or penetration run between two steps;
 //! - [`cli`]: the `polydem rockfill` subcommand.
 
 pub mod bed;
@@ -36,6 +37,7 @@ pub mod seeds;
 pub mod sensitivity;
 pub mod spatial_order;
 pub mod statistics;
+pub mod stop;
 pub mod study;
 pub mod voronoi;
 

@@ -68,6 +68,7 @@ use super::collapse::CollapseReport;
 use super::config::{ConfigError, DepositionDamping, ExperimentConfig};
 use super::grading::Rock;
 use super::limits::{check_packing_steps, LimitError};
+use super::stop::{self, StopCheck};
 use polydem::dynamics::{BodyError, PrincipalInertia, RigidBody, ViscousDamping};
 use polydem::math::{Point, Pose, Real, Rotation, Vector};
 use polydem::scene::time_step::{contact_time_and_limit, PairEstimate};
@@ -106,6 +107,9 @@ pub enum PackingError {
     BedFile { path: String, message: String },
     #[error(transparent)]
     Limit(#[from] LimitError),
+    /// The run's [`StopCheck`] asked it to stop (before a step: the world is at a step boundary).
+    #[error("packing interrupted at t = {time} s")]
+    Interrupted { time: Real },
 }
 
 /// The world of the experiment: materials (rock, steel, wall) with Table 1's laws, gravity −9.81 e_z.
@@ -466,6 +470,16 @@ pub fn bed_overlap(world: &World, size: Real) -> [Real; 2] {
 pub fn pack(
     config: &ExperimentConfig,
     world: &mut World,
+    progress: impl FnMut(&str, Real, Real),
+) -> Result<PackingReport, PackingError> {
+    pack_with_stop(config, world, None, progress)
+}
+
+/// [`pack`] that asks `stop` before each step whether to end there ([`PackingError::Interrupted`]).
+pub fn pack_with_stop(
+    config: &ExperimentConfig,
+    world: &mut World,
+    stop: Option<&StopCheck>,
     mut progress: impl FnMut(&str, Real, Real),
 ) -> Result<PackingReport, PackingError> {
     let start = Instant::now();
@@ -524,6 +538,9 @@ pub fn pack(
                    stage: usize,
                    dt: Real|
      -> Result<(), PackingError> {
+        if stop::requested(stop) {
+            return Err(PackingError::Interrupted { time: world.time });
+        }
         params.dt = dt;
         let r = step(&params, world, &mut scratch)?;
         if let Some(alpha) = local_alpha {

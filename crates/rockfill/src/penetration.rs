@@ -25,6 +25,7 @@ use super::config::ExperimentConfig;
 use super::limits::{check_penetration_steps, LimitError};
 use super::packing::{rock_time_step, top_wall_height, PackingError, KEPT_WALLS, STEEL};
 use super::projectile::Projectile;
+use super::stop::{self, StopCheck};
 use polydem::dynamics::{Motion, RigidBody, ViscousDamping};
 use polydem::math::{Point, Pose, Real, Vector};
 use polydem::shape::Shape;
@@ -46,6 +47,9 @@ pub enum PenetrationError {
     NotABed { walls: usize, expected: usize },
     #[error(transparent)]
     Limit(#[from] LimitError),
+    /// [`PenetrationOptions::stop`] asked the run to stop (before a step: the world is at a step boundary).
+    #[error("penetration interrupted after {steps} steps")]
+    Interrupted { steps: u64 },
 }
 
 /// One row of the monitor time series.
@@ -128,6 +132,9 @@ pub struct PenetrationOptions {
     /// Shifts the projectile's start (m, world frame): a perturbed initial state, whose spread of results
     /// measures how chaotic the run is (zero for the experiment).
     pub start_offset: Vector,
+    /// Asked before each step (of the penetration, and of the packing when the run packs a bed) whether
+    /// to stop there; `None` runs to the end.
+    pub stop: Option<StopCheck>,
 }
 
 impl Default for PenetrationOptions {
@@ -137,6 +144,7 @@ impl Default for PenetrationOptions {
             snapshot_tip_x: Vec::new(),
             max_steps: None,
             start_offset: Vector::zeros(),
+            stop: None,
         }
     }
 }
@@ -373,6 +381,9 @@ pub fn penetrate_with(
     let mut pending: Vec<Real> = options.snapshot_tip_x.clone();
     pending.sort_by(|a, b| b.total_cmp(a));
     let outcome = loop {
+        if stop::requested(options.stop.as_ref()) {
+            return Err(PenetrationError::Interrupted { steps });
+        }
         let report = step(&params, world, &mut scratch)?;
         counters.merge(&report.counters);
         steps += 1;

@@ -30,6 +30,7 @@ use super::config::ExperimentConfig;
 use super::experiment::{run_experiment_with, BedSource, ExperimentError, ExperimentResult};
 use super::penetration::{MonitorRow, Outcome, PenetrationOptions};
 use super::section::{draw_sections, SectionError, SectionPicture};
+use super::stop::StopCheck;
 use polydem::math::Real;
 
 /// Why the study failed.
@@ -250,6 +251,19 @@ pub fn run_one(
     title: &str,
     progress: &mut dyn FnMut(&str, String),
 ) -> Result<ExperimentResult, StudyError> {
+    run_one_with_stop(config, dir, bed, title, None, progress)
+}
+
+/// [`run_one`] whose packing and penetration ask `stop` before each step whether to end there (an
+/// `Interrupted` error; nothing is written after the stop).
+pub fn run_one_with_stop(
+    config: &ExperimentConfig,
+    dir: &Path,
+    bed: Option<&Path>,
+    title: &str,
+    stop: Option<StopCheck>,
+    progress: &mut dyn FnMut(&str, String),
+) -> Result<ExperimentResult, StudyError> {
     std::fs::create_dir_all(dir).map_err(io_error(dir))?;
     let source = match bed {
         Some(b) => BedSource::Load(b),
@@ -257,6 +271,7 @@ pub fn run_one(
     };
     let options = PenetrationOptions {
         snapshot_tip_x: section_instants(config),
+        stop,
         ..PenetrationOptions::default()
     };
     let mut result = run_experiment_with(config, source, &options, progress).map_err(|source| {
