@@ -469,7 +469,8 @@ impl ConvexPolyhedron {
 impl SupportMap for ConvexPolyhedron {
     fn local_support(&self, dir_local: &Vector, hint: &mut u32) -> Point {
         let i = if self.vertices.len() <= LINEAR_SCAN_MAX_VERTICES {
-            self.support_vertex_linear(dir_local)
+            // The vectorised scan picks the vertex `support_vertex_linear` picks (the first maximiser).
+            self.columns.support_index(dir_local) as u32
         } else {
             self.support_vertex_hill_climb(dir_local, *hint)
         };
