@@ -133,7 +133,8 @@ impl VertexColumns {
         for &m in &lane_max[1..] {
             max = if m > max { m } else { max };
         }
-        if !(max > Real::NEG_INFINITY) {
+        // `max` is never NaN (only values greater than it replace it): −∞ means no product exceeded −∞.
+        if max == Real::NEG_INFINITY {
             return 0;
         }
         for (k, block) in self.blocks.iter().enumerate() {
