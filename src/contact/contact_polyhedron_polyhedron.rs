@@ -97,7 +97,10 @@ pub fn query_polytopes_cached<A: Polytope + ?Sized, B: Polytope + ?Sized>(
     // Support maps: a contiguous linear scan for particle-sized polyhedra, the shapes' own (hill-climbing)
     // supports beyond.
     let g = if a.vertices().len() <= SCAN_MAX_VERTICES && b.vertices().len() <= SCAN_MAX_VERTICES {
-        let (sa, sb) = (VertexScan(a.vertices()), VertexScan(b.vertices()));
+        let (sa, sb) = (
+            VertexScan(a.vertex_columns()),
+            VertexScan(b.vertex_columns()),
+        );
         let mut pair = MinkowskiPair::new(&sa, &sb, &pos12, cache.hint_a, cache.hint_b);
         query_inner(
             pos1, a, pos2, b, &pos12, &mut pair, tol, cache, scratch, counters,
@@ -301,7 +304,10 @@ pub fn warm_overlap_polytopes<A: Polytope + ?Sized, B: Polytope + ?Sized>(
     }
     let mut attempt = QueryCounters::default();
     let g = if a.vertices().len() <= SCAN_MAX_VERTICES && b.vertices().len() <= SCAN_MAX_VERTICES {
-        let (sa, sb) = (VertexScan(a.vertices()), VertexScan(b.vertices()));
+        let (sa, sb) = (
+            VertexScan(a.vertex_columns()),
+            VertexScan(b.vertex_columns()),
+        );
         let mut pair = MinkowskiPair::new(&sa, &sb, pos12, cache.hint_a, cache.hint_b);
         warm_hit(
             pos1,

@@ -320,22 +320,28 @@ fn closest_triangle(s: &mut Simplex) -> Vector {
     n * (n.dot(&a) / nn)
 }
 
-/// Sets `s` to the best (closest to the origin) of the given sub-simplices and returns its closest point.
+/// Sets `s` to the best (closest to the origin) of the given sub-simplices and returns its closest point;
+/// the first of equally close faces wins. Each face is reduced in one reused buffer and copied out only
+/// when it improves on the best so far.
 fn best_of_faces<const K: usize>(s: &mut Simplex, faces: &[[usize; K]]) -> Vector {
-    let orig = *s;
-    let mut best: Option<(Real, Simplex, Vector)> = None;
+    let pts = s.pts;
+    let mut sub = *s;
+    let mut best: Option<(Real, Vector)> = None;
     for f in faces {
-        let mut sub = orig;
-        keep(&mut sub, f);
+        for (k, &i) in f.iter().enumerate() {
+            sub.pts[k] = pts[i];
+        }
+        sub.len = K;
         let v = closest_to_origin(&mut sub);
         let d = v.norm_squared();
-        if best.as_ref().is_none_or(|(bd, _, _)| d < *bd) {
-            best = Some((d, sub, v));
+        if best.is_none_or(|(bd, _)| d < bd) {
+            best = Some((d, v));
+            s.pts[..sub.len].copy_from_slice(&sub.pts[..sub.len]);
+            s.bary[..sub.len].copy_from_slice(&sub.bary[..sub.len]);
+            s.len = sub.len;
         }
     }
-    let (_, sub, v) = best.expect("at least one face");
-    *s = sub;
-    v
+    best.expect("at least one face").1
 }
 
 fn det(a: &Vector, b: &Vector, c: &Vector) -> Real {

@@ -36,6 +36,8 @@ use crate::shape::SupportMap;
 pub trait Polytope: SupportMap {
     /// The vertices (local frame, m).
     fn vertices(&self) -> &[Point];
+    /// The same vertices as columns for the vectorised support scan.
+    fn vertex_columns(&self) -> &crate::shape::VertexColumns;
     /// Number of faces.
     fn num_faces(&self) -> usize;
     /// Outward unit normal of face `i`.
@@ -57,6 +59,9 @@ pub trait Polytope: SupportMap {
 impl Polytope for crate::shape::ConvexPolyhedron {
     fn vertices(&self) -> &[Point] {
         crate::shape::ConvexPolyhedron::vertices(self)
+    }
+    fn vertex_columns(&self) -> &crate::shape::VertexColumns {
+        crate::shape::ConvexPolyhedron::vertex_columns(self)
     }
     fn num_faces(&self) -> usize {
         crate::shape::ConvexPolyhedron::num_faces(self)

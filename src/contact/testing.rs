@@ -3,7 +3,7 @@
 
 use super::sat::Polytope;
 use crate::math::{Point, Pose, Real, Rotation, Vector};
-use crate::shape::SupportMap;
+use crate::shape::{SupportMap, VertexColumns};
 use rand::Rng;
 
 /// A polytope given by vertices and (ordered, outward) faces; support by linear scan.
@@ -16,6 +16,8 @@ pub struct TestPolytope {
     /// Neighbours of each vertex, from `edges`.
     pub adjacency: Vec<Vec<u32>>,
     pub radius: Real,
+    /// `verts` as columns (the query's vectorised scan reads these).
+    pub columns: VertexColumns,
 }
 
 impl TestPolytope {
@@ -54,6 +56,7 @@ impl TestPolytope {
         }
         let radius = verts.iter().map(|p| p.coords.norm()).fold(0.0, Real::max);
         Self {
+            columns: VertexColumns::new(&verts),
             verts,
             faces: faces_out,
             normals,
@@ -110,6 +113,9 @@ impl SupportMap for TestPolytope {
 impl Polytope for TestPolytope {
     fn vertices(&self) -> &[Point] {
         &self.verts
+    }
+    fn vertex_columns(&self) -> &VertexColumns {
+        &self.columns
     }
     fn num_faces(&self) -> usize {
         self.faces.len()

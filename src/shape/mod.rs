@@ -7,7 +7,7 @@
 //! One job per file: [`error`] (construction errors), `hull` (point cloud → polygonal convex hull),
 //! `polygon` (face plane helpers), [`mass`] (exact mass properties), [`polyhedron`] (the polyhedron, its
 //! topology and support map), [`sphere`], [`ellipsoid`], [`plane`] (walls), [`aabb`], `support` (the
-//! support-map trait), [`convex`] (the convex-shape trait every bounded shape implements).
+//! support-map trait), [`vertex_columns`] (vertices laid out for the vectorised support scan), [`convex`] (the convex-shape trait every bounded shape implements).
 //!
 //! Adding a bounded shape: a file with the shape and its [`ConvexShape`] implementation, a variant here and
 //! its arm in [`Shape::convex`]. Code elsewhere reaches a new shape through [`Shape::convex`] (catch-all
@@ -25,6 +25,7 @@ pub mod polyhedron;
 pub mod sphere;
 mod support;
 pub mod surface_mesh;
+pub mod vertex_columns;
 
 pub use aabb::Aabb;
 pub use convex::{ConvexShape, SurfaceMesh};
@@ -36,6 +37,7 @@ pub use plane::Plane;
 pub use polyhedron::ConvexPolyhedron;
 pub use sphere::Sphere;
 pub use support::SupportMap;
+pub use vertex_columns::VertexColumns;
 
 use crate::math::Real;
 

@@ -9,7 +9,8 @@
 //!
 //! Stored data: vertices; faces as vertex loops (counter-clockwise seen from outside) with outward unit
 //! normals and plane offsets; unique edges; vertex adjacency in compressed-sparse-row form; bounding radius
-//! about the origin; mass properties per unit density.
+//! about the origin; mass properties per unit density; the vertices again as columns for the vectorised
+//! support scan ([`VertexColumns`], derived, not serialised).
 //!
 //! # Tolerances
 //! [`ConvexPolyhedron::length_scale`] is the diameter of the bounding sphere centred at the centroid
@@ -24,6 +25,7 @@ use super::hull;
 use super::mass::{polyhedron_mass_properties, MassProperties};
 use super::polygon::{newell_normal, supporting_plane};
 use super::support::SupportMap;
+use super::vertex_columns::VertexColumns;
 
 /// Up to this many vertices the support map scans all vertices instead of hill-climbing: for small
 /// polyhedra a branch-predictable linear scan beats graph walking. Measured with `benches/support_map.rs`
@@ -41,8 +43,13 @@ pub const VOLUME_ROUNDOFF_FACTOR: Real = 1e3;
 
 /// A convex polyhedron in its principal frame (see the module docs).
 #[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
+#[serde(from = "PolyhedronData")]
 pub struct ConvexPolyhedron {
     vertices: Vec<Point>,
+    /// The vertices again, as columns for the vectorised support scan; derived from `vertices`, so not
+    /// serialised (the serialised form is [`PolyhedronData`]'s).
+    #[serde(skip_serializing)]
+    columns: VertexColumns,
     /// Face `f` is `face_indices[face_starts[f]..face_starts[f + 1]]`.
     face_starts: Vec<u32>,
     face_indices: Vec<u32>,
@@ -54,6 +61,40 @@ pub struct ConvexPolyhedron {
     adjacency: Vec<u32>,
     bounding_radius: Real,
     mass_properties: MassProperties,
+}
+
+/// The serialised fields of a [`ConvexPolyhedron`], in its order: everything but the derived vertex columns,
+/// which deserialisation rebuilds.
+#[derive(serde::Deserialize)]
+struct PolyhedronData {
+    vertices: Vec<Point>,
+    face_starts: Vec<u32>,
+    face_indices: Vec<u32>,
+    face_normals: Vec<Vector>,
+    face_offsets: Vec<Real>,
+    edges: Vec<[u32; 2]>,
+    adjacency_starts: Vec<u32>,
+    adjacency: Vec<u32>,
+    bounding_radius: Real,
+    mass_properties: MassProperties,
+}
+
+impl From<PolyhedronData> for ConvexPolyhedron {
+    fn from(d: PolyhedronData) -> Self {
+        ConvexPolyhedron {
+            columns: VertexColumns::new(&d.vertices),
+            vertices: d.vertices,
+            face_starts: d.face_starts,
+            face_indices: d.face_indices,
+            face_normals: d.face_normals,
+            face_offsets: d.face_offsets,
+            edges: d.edges,
+            adjacency_starts: d.adjacency_starts,
+            adjacency: d.adjacency,
+            bounding_radius: d.bounding_radius,
+            mass_properties: d.mass_properties,
+        }
+    }
 }
 
 impl ConvexPolyhedron {
@@ -244,6 +285,7 @@ impl ConvexPolyhedron {
             principal_axes: Rotation::identity(),
         };
         let shape = ConvexPolyhedron {
+            columns: VertexColumns::new(&local),
             vertices: local,
             face_starts,
             face_indices,
@@ -313,6 +355,11 @@ impl ConvexPolyhedron {
     /// Vertices in the principal frame (m).
     pub fn vertices(&self) -> &[Point] {
         &self.vertices
+    }
+
+    /// The vertices as columns for the vectorised support scan (the same points, in the same order).
+    pub fn vertex_columns(&self) -> &VertexColumns {
+        &self.columns
     }
 
     /// Number of faces.
@@ -422,7 +469,8 @@ impl ConvexPolyhedron {
 impl SupportMap for ConvexPolyhedron {
     fn local_support(&self, dir_local: &Vector, hint: &mut u32) -> Point {
         let i = if self.vertices.len() <= LINEAR_SCAN_MAX_VERTICES {
-            self.support_vertex_linear(dir_local)
+            // The vectorised scan picks the vertex `support_vertex_linear` picks (the first maximiser).
+            self.columns.support_index(dir_local) as u32
         } else {
             self.support_vertex_hill_climb(dir_local, *hint)
         };
@@ -1047,6 +1095,49 @@ mod tests {
             let (p, _) = ConvexPolyhedron::from_points(&cloud).unwrap();
             check_invariants(&p, &format!("{n} points on a sphere"));
         }
+    }
+
+    /// The vertex columns are derived data: not in the encoded form (the checkpoint's postcard bytes are
+    /// those of the fields without them) and rebuilt on decoding, equal to the built shape's.
+    #[test]
+    fn encoding_omits_and_decoding_rebuilds_the_vertex_columns() {
+        let mut rng = ChaCha8Rng::seed_from_u64(5);
+        let cloud = random_cloud(&mut rng, 30, Vector::new(1.0, 0.7, 0.4));
+        let (p, _) = ConvexPolyhedron::from_points(&cloud).expect("hull");
+        let bytes = postcard::to_stdvec(&p).expect("encode");
+        #[derive(serde::Serialize)]
+        struct Fields<'a> {
+            vertices: &'a Vec<Point>,
+            face_starts: &'a Vec<u32>,
+            face_indices: &'a Vec<u32>,
+            face_normals: &'a Vec<Vector>,
+            face_offsets: &'a Vec<Real>,
+            edges: &'a Vec<[u32; 2]>,
+            adjacency_starts: &'a Vec<u32>,
+            adjacency: &'a Vec<u32>,
+            bounding_radius: Real,
+            mass_properties: &'a MassProperties,
+        }
+        let fields = Fields {
+            vertices: &p.vertices,
+            face_starts: &p.face_starts,
+            face_indices: &p.face_indices,
+            face_normals: &p.face_normals,
+            face_offsets: &p.face_offsets,
+            edges: &p.edges,
+            adjacency_starts: &p.adjacency_starts,
+            adjacency: &p.adjacency,
+            bounding_radius: p.bounding_radius,
+            mass_properties: &p.mass_properties,
+        };
+        assert_eq!(
+            bytes,
+            postcard::to_stdvec(&fields).expect("encode fields"),
+            "the encoding carries more than the serialised fields"
+        );
+        let back: ConvexPolyhedron = postcard::from_bytes(&bytes).expect("decode");
+        assert_eq!(back.vertex_columns(), p.vertex_columns());
+        assert_eq!(back.vertex_columns().len(), p.vertices().len());
     }
 
     #[test]

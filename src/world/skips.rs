@@ -307,8 +307,8 @@ pub fn reject_by_cached_axis(
     let scan = a.vertices().len() <= SCAN_MAX_VERTICES && b.vertices().len() <= SCAN_MAX_VERTICES;
     let (s, pa, pb, ha, hb) = if scan {
         overlap_along(
-            &VertexScan(a.vertices()),
-            &VertexScan(b.vertices()),
+            &VertexScan(a.vertex_columns()),
+            &VertexScan(b.vertex_columns()),
             pos12,
             cache,
             &n,

@@ -64,7 +64,8 @@ pub fn all() -> Vec<Bench> {
             name: "contact",
             what: "contact queries between two convex polyhedra, per shape class: the full GJK/EPA query on \
                    20 overlapping pairs and the boolean test on 20 separated pairs, each from a cold pair \
-                   cache and again warm (the cache of a first query of the same pair)",
+                   cache and again warm (the cache of a first query of the same pair); and the full query \
+                   (GJK distance) on the 20 separated pairs from a cold cache",
             run: contact,
         },
         Bench {
@@ -272,6 +273,29 @@ fn contact(_: &Inputs, regions: &mut Regions) -> Result<(), String> {
             regions,
             format!("contact_separated_warm/{class}"),
             || test_all(&mut caches),
+            |&n| n,
+        );
+        let mut caches = vec![PairCache::default(); separated.len()];
+        measured(
+            regions,
+            format!("contact_distance_cold/{class}"),
+            || {
+                let mut apart = 0u64;
+                for (p, cache) in separated.iter().zip(&mut caches) {
+                    let g = query_polyhedra_with(
+                        &p.pos1,
+                        &p.a,
+                        &p.pos2,
+                        &p.b,
+                        &tol,
+                        cache,
+                        &mut scratch,
+                        &mut counters,
+                    );
+                    apart += u64::from(g.distance > 0.0);
+                }
+                apart
+            },
             |&n| n,
         );
     }
