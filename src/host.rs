@@ -86,13 +86,9 @@ const YIELD_AFTER: Duration = Duration::from_micros(20);
 /// times. `None` on a pool of one thread, or when one wait outlasts `timeout` (a busy host left a
 /// thread unrun).
 ///
-/// Why: on the 2-core virtual machine this project runs on, the reading takes different levels for
-/// minutes at a time (41–60, 94–160 and 419–499 ns seen; by their size, the last is two dies of
-/// the host's processor apart, which the guest cannot see directly). Measured between whole runs of sphere bed a
-/// (3000 steps, each run of two threads beside the round trip just before and after it):
-/// round trips of 96–113 ns went with two-thread runs of 0.334–0.353 s, of 419–486 ns with 0.419–0.442
-/// s, while one-thread runs took 0.605–0.647 s throughout and two independent one-thread runs at once
-/// lost at most 5 % in either state. A run on two threads passes cache lines between the cores every
+/// Why: on a virtual machine the reading can take different levels for minutes at a time (two vCPUs
+/// placed on one die or on two), and two-thread runs of the sphere beds slow down with it while
+/// one-thread runs do not (figures: `docs/tuning.md`). A run on two threads passes cache lines between the cores every
 /// step (its barriers, the spheres at the split, the gathered loads), so its speed-up depends on the
 /// state the host is in; speed reports print this reading beside it.
 pub fn core_round_trip_ns(trips: u32, timeout: Duration) -> Option<f64> {
@@ -171,7 +167,7 @@ mod tests {
 
     /// One thread has no partner; two threads pass the line back and forth: a positive, finite mean
     /// time per trip. No bound on it: the tests of this binary run beside it on the same cores, and a
-    /// trip then waits for the scheduler (416 µs per trip was seen in `cargo test` on 2 cores).
+    /// trip then waits for the scheduler, hundreds of µs on a loaded 2-core machine.
     #[test]
     fn core_round_trip_needs_two_threads_and_gives_a_time() {
         let pool = |threads: usize| {

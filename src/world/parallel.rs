@@ -38,28 +38,10 @@
 //!
 //! # Where the thresholds come from
 //! A region of `n` items of cost `c` on two threads saves `n c / 2` and costs a fork/join overhead `o`, so
-//! it pays from `n* = 2 o / c`. Measured figures (2-core KVM guest):
-//! - `o`, the region overhead: `cargo run --release --example perf_threads -- --overhead` runs the step's
-//!   own [`for_each_item`] over 10³–10⁴ items of ~12 ns, with a serial gap between regions as in a step:
-//!   while the pool's threads still spin (gap ~100 µs) a region costs ~2.5–3 µs more than half the serial
-//!   time (best of 5000 regions, load average 7.6: 1000 items 8.5 µs against 12.2 µs serial,
-//!   4000 items 27.5 against 48.7 µs). Once they have fallen asleep (gaps of ~1 ms, or an idle machine
-//!   where the vCPU halts), waking them costs far more: the quiet-machine runs behind the old defaults
-//!   (5000 bodies, below) show ~55 µs per region. The thresholds take the sleeping case, so
-//!   that a region never costs more than it saves on an idle machine.
-//! - `c` per candidate: ~90 ns for one the cached axis or the bounding spheres reject (the cheapest; the
-//!   polyhedra box of `reference/polyhedra_box` at rest), ~400–500 ns on average in the settling bed of 10⁴
-//!   polyhedra (stage timers of `perf_threads` on one thread), ~40–70 ns in the bed of 10⁴ spheres.
-//! - `c` per unit of integration work (a sphere's kick or drift): ~16–17 ns (5000 bodies at rest: 160 ms
-//!   over 2000 steps of two passes; 10⁴ spheres: 26 % of a 1.3 ms step over two passes).
-//!
-//! Hence: candidates `n* = 2 · 55 µs / 90 ns ≈ 1200` for the cheapest candidates (and a region holds the
-//! force sums as well): [`DEFAULT_MIN_CANDIDATES`] = 4096 keeps a margin of ~3 (the 1000-body box at
-//! ~1540 candidates per step measured slower on two threads, 5000 bodies at ~7700 candidates 1.33× faster).
-//! Integration `n* = 2 · 55 µs / 16.5 ns ≈ 6700` units: [`DEFAULT_MIN_BODIES`] = 8192, so that 10⁴ spheres
-//! integrate in parallel (they stayed serial below the old 20 000, ~26 % of their step: the largest serial
-//! part of the sphere scene) while a few thousand bodies at rest, where the region could cost more than it
-//! saves, stay serial.
+//! it pays from `n* = 2 o / c`. Waking threads that have fallen asleep costs far more than handing work
+//! to spinning ones, and the thresholds take that case, so that a region never costs more than it saves
+//! on an idle machine. The measured `o` and `c` and the resulting `n*` are in `docs/tuning.md`
+//! (`cargo run --release --example perf_threads -- --overhead` measures them again).
 
 use rayon::prelude::*;
 
@@ -77,28 +59,20 @@ use super::region_profile;
 /// the ~360 candidates of a 10⁴-polyhedra bed (~150 µs each) cost nothing measurable.
 pub const CHUNKS_PER_THREAD: usize = 32;
 
-/// Default [`Parallelism::min_candidates`]: 4096 candidate pairs (see the module docs: a region pays from
-/// ~1200 of the cheapest candidates). On a 2-core VM a parallel region costs up to ~55 µs of thread
-/// wake-up, and a candidate that the cached axis or the bounding spheres reject costs ~90 ns, so a region
-/// must hold a few hundred µs of work to pay. Measured with `polydem run` on the
-/// polyhedra box of `reference/polyhedra_box` (quiet machine, RAYON_NUM_THREADS 1 vs 2): 1000
-/// bodies, ~1540 candidates per step: narrow phase 1131 ms serial vs 1244 ms parallel over 8000 steps
-/// (slower); 5000 bodies, ~7700 candidates: 1109 vs 831 ms over 2000 steps (1.33× faster).
+/// Default [`Parallelism::min_candidates`]: 4096 candidate pairs, about three times the break-even count
+/// of the cheapest candidates (those the cached axis or the bounding spheres reject), since a region
+/// also holds the force sums (figures: `docs/tuning.md`).
 pub const DEFAULT_MIN_CANDIDATES: usize = 4096;
 
-/// Default [`Parallelism::min_bodies`]: 8192 units of integration work ([`integration_work`]). A half
-/// kick and drift cost only ~16 ns per body at rest or nearly (quiet machine: 5000 bodies,
-/// integration 160 ms over 2000 steps serial, while the two-thread version took 300 ms, i.e. ~55 µs of
-/// fork/join per region of ~40 µs of work). A region pays from `2 · 55 µs / 16.5 ns ≈ 6700` units (module
-/// docs); 8192 keeps a small margin above it and lets 10⁴ spheres (~170 µs per pass) integrate in parallel.
-/// Tumbling polyhedra cost several times more ([`ANISOTROPIC_WEIGHT`]): 2048 of them are enough.
+/// Default [`Parallelism::min_bodies`]: 8192 units of integration work ([`integration_work`]), a small
+/// margin above the break-even count of a sphere's kick and drift (figures: `docs/tuning.md`): 10⁴ spheres
+/// integrate in parallel, a few thousand bodies at rest stay serial. Tumbling polyhedra cost several
+/// times more ([`ANISOTROPIC_WEIGHT`]): 2048 of them are enough.
 pub const DEFAULT_MIN_BODIES: usize = 8192;
 
 /// Weight of a dynamic body with unequal principal moments in the integration's work
 /// ([`integration_work`]): its rotation splitting (three sub-rotations per drift) costs about this many
-/// sphere kicks and drifts. Measured with `examples/perf_threads.rs` (1 thread, load ~10, so
-/// both inflated alike): 10^4 spinning polyhedra 3.3 ms of integration per step, 10^4 spheres 0.74 ms
-/// (ratio 4.4, the spheres' time including their cheaper isotropic turn): 4.
+/// sphere kicks and drifts (the ratio of the two measured with `examples/perf_threads.rs`: `docs/tuning.md`).
 pub const ANISOTROPIC_WEIGHT: usize = 4;
 
 /// When the step uses more than one thread. Threads come from rayon's current pool (the global pool, or

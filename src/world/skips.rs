@@ -44,21 +44,10 @@
 //! bits. `tests/world_skip_motion_bound.rs` checks the bound against the exact test over random motions
 //! and the trajectories of a polyhedral bed with the switch on and off.
 //!
-//! # Measured (callgrind instruction counts, same machine and build profile)
-//! Trajectories unchanged: the beds (`bed_rocks.csv`), packing traces and penetration monitors of
-//! `polydem rockfill` are byte-identical with and without the two skips, and so are the GJK/EPA counts.
-//!
-//! | scene (command) | without the skips | with them | per rock- or body-step |
-//! |---|---|---|---|
-//! | quick packing, deposition capped (copy of `scenes/rockfill/quick.toml` with `max_deposition_time = 1.2`, `compaction_speed = 2.0`, `hold_time = 0.02`: 9 800 + 2 288 + 163 steps, 351 rocks; `polydem rockfill --config FILE`, inclusive cost of `rockfill::packing::pack`) | 103.3e9 | 75.5e9 | 24.0e3 → 17.6e3 |
-//! | quick penetration from the saved quick bed (`polydem rockfill --bed DIR`, 882 steps, 351 rocks; `penetrate_with`) | 12.54e9 | 9.87e9 | 40.5e3 → 31.9e3 |
-//! | `examples/perf_threads.rs --scenes poly --threads 1 --warm-up 100 --steps 100` (10⁴ polyhedra, 200 steps from the lattice; `world::step::step`) | 2.71e9 | 1.98e9 | 1.36e3 → 0.99e3 |
-//!
-//! Of the 6.07e7 rock-pair tests that the cached axis would reject in the full quick packing, the motion
-//! bound skips 98.7 % in deposition, 99.4 % in compaction, 99.6 % in hold, 96.9 % in the penetration; the
-//! motion bound alone took the capped packing from 103.3e9 to 78.6e9, the warm overlap the rest.
-//! Re-measure: `valgrind --tool=callgrind polydem rockfill --config FILE --out DIR` with the file above,
-//! then `callgrind_annotate --inclusive=yes` (the `pack` line), and `--bed DIR` for the penetration.
+//! # Effect
+//! The trajectories, packing traces and penetration monitors of `polydem rockfill` are byte-identical with
+//! and without the two skips; they cut the instructions of the rockfill packing by about a quarter and of
+//! a 10⁴-polyhedra step by about a quarter (counts and commands: `docs/tuning.md`).
 
 use crate::contact::contact_polyhedron_polyhedron::SCAN_MAX_VERTICES;
 use crate::contact::minkowski::{MinkowskiPair, VertexScan};

@@ -45,8 +45,7 @@
 //! carries several rock weights, and 1 % of the weight is a fraction of a per mille of the contact forces.
 //! The explicit step hands any disturbance on by one contact per step (through the dashpots at once, through
 //! the springs after a few steps), so at that sensitivity a disturbance anywhere wakes the whole bed within
-//! tens of steps — far ahead of the physical wave (measured on the quick rockfill bed: all 351 rocks awake
-//! 40 steps after the end walls were removed, at Δt = 4.8 µs). A limit of a fraction of the contact forces
+//! tens of steps — far ahead of the physical wave (`docs/tuning.md`). A limit of a fraction of the contact forces
 //! keeps the region woken to where the forces really change.
 //!
 //! [`put_to_sleep`] puts bodies to sleep at once (a bed loaded from a checkpoint of a packing at rest), in

@@ -19,9 +19,8 @@ use super::NeighbourList;
 /// **Middles.** The spheres of the middle between blocks k and k + 1 are shared out at run time: when
 /// thread k has run its block it takes pieces of the middle from the front, thread k + 1 from the back,
 /// until they meet ([`super::team::TwoEnded`]). So a thread that its core runs slower for a while (a
-/// shared host) does less of the middle instead of holding the other at the barrier: on bed c, with
-/// blocks only, the two threads' pair loops differed by 2–18 µs per step of ~70 µs, which thread was
-/// slower changing from run to run (per-thread timers). Every sphere of a middle is
+/// shared host) does less of the middle instead of holding the other at the barrier (with blocks only,
+/// the slower thread changes from run to run: `docs/tuning.md`). Every sphere of a middle is
 /// gathered, since either thread may run its row: that costs its kick about two kicks' time more
 /// (below), the price of the middle's size ([`TeamSplit::middle_share`]).
 ///
@@ -104,8 +103,8 @@ impl Blocks {
             };
         }
         // In contact: the pair's flag, which a build sets when the pair holds a spring and an
-        // evaluation when it overlaps (blocks made for a new pool between builds). Formerly the
-        // springs themselves were read: ~40 µs of ~55 µs per build of bed c.
+        // evaluation when it overlaps (blocks made for a new pool between builds); one byte per pair,
+        // where reading the springs would cost most of a build.
         let cost = |in_contact: &[bool]| -> usize {
             in_contact
                 .iter()
@@ -136,12 +135,9 @@ impl Blocks {
         for range in &middles {
             gathered[range.clone()].fill(true);
         }
-        // The kick: a gathered sphere also sums its pairs, which took about two kicks' time (per-thread
-        // timestamps on bed c: with the pair blocks' split the thread of the second
-        // block, ~1700 spheres of which ~160 gathered, kicked in ~21 µs against ~13 µs for ~1300).
-        // The last thread also forms the walls' sums in the kick phase (`super::fused`): counted as
-        // one more item of a third of a kick per body–wall pair (the sums took 1.2–2.6 µs per step and
-        // a kick ~9 ns per sphere on beds a and c, with a few hundred to a thousand wall pairs listed).
+        // The kick: a gathered sphere also sums its pairs, about two kicks' more work. The last thread
+        // also forms the walls' sums in the kick phase (`super::fused`): counted as one more item of a
+        // third of a kick per body–wall pair (both weights measured: `docs/tuning.md`).
         let mut kick_weights: Vec<usize> =
             gathered.iter().map(|&g| 1 + 2 * usize::from(g)).collect();
         kick_weights.push(list.wall_pairs() / 3);
@@ -226,10 +222,9 @@ fn blocks_and_middles(
 /// were made (a step in which the host left the thread unrun for a while does not count), blended half
 /// and half with the previous estimate.
 ///
-/// Why: on the shared 2-core host one core ran 20–40 % slower than the other for seconds at a time, in
-/// every pass alike, and which one changed from run to run (per-thread timers of the fused step on beds
-/// a and c: pair loops of 123 against 96 µs, kicks of 21.6 against 16.5, drifts of 13.0
-/// against 11.8): blocks of equal weight then leave the faster thread waiting at each barrier. The
+/// Why: on a shared host one core can run a fifth to two fifths slower than the other for seconds at a
+/// time, in every pass alike, and which one changes from run to run (`docs/tuning.md`): blocks of equal
+/// weight then leave the faster thread waiting at each barrier. The
 /// blocks are made anew at each build of the lists (every ~40–80 steps on the sphere beds), soon enough
 /// to follow such a change. The bits do not depend on the split.
 #[derive(Clone, Debug, Default)]
@@ -317,18 +312,10 @@ pub struct TeamSplit {
 }
 
 impl Default for TeamSplit {
-    /// Middles of 0.1 in the pair loop, 0.3 in the drift and the kick, shares that follow the speeds.
-    /// Measured against [`TeamSplit::fixed`] on two threads, the variants taking turns every 300 steps
-    /// in one process (`examples/sphere_flat_threads --splits`), on beds a / b / c:
-    /// - 1.070 / 1.050 / 1.059 times as fast (medians of 8 rounds of 3000 steps, rounds 0.98–1.16);
-    ///   middles of 0.05 in the pair loop: 1.058 / 1.031 / 1.051; of 0.15: 1.065 / 1.029 / 1.057;
-    /// - a second run, with one-thread turns between them: 0.99 / 1.05 / 1.00 (the two-thread speed-ups
-    ///   over one thread, medians of 6 rounds: 1.559 against 1.574, 1.757 against 1.675, 1.507 against
-    ///   1.511).
-    ///
-    /// Larger middles of the pair loop gained nothing (0.3 with the drift and kick split fixed: 1.02 /
-    /// 1.06 / 0.97): every sphere of a middle has its loads gathered, which took ~17 µs per step more
-    /// in the kicks of bed c with middles of 0.3 (per-thread timers).
+    /// Middles of 0.1 in the pair loop, 0.3 in the drift and the kick, shares that follow the speeds:
+    /// the best of the splits compared with `examples/sphere_flat_threads --splits` on the sphere beds
+    /// (`docs/tuning.md`). Larger middles of the pair loop cost more than they balance, since every
+    /// sphere of a middle has its loads gathered.
     fn default() -> Self {
         Self {
             middle_share: 0.1,
@@ -363,11 +350,9 @@ impl TeamSplit {
 /// A listed pair's weight in the split into blocks when its spring holds a contact at the build (such a
 /// pair mostly stays in contact until the next build), against 1 for one that does not: the law costs
 /// several times the distance test, and the contacts crowd where the projectile strikes and at the
-/// floor, so blocks of equal pair counts are not blocks of equal work. 8 is the best of 1, 4, 6, 8, 12
-/// and 16 measured on the sphere beds a–c on two threads (`examples/sphere_flat_threads`, medians of 4–5
-/// runs: 1.43 / 1.67 / 1.43× over one thread with 1, 1.79 / 1.79 / 1.63× with 8); the
-/// 10^4-sphere settling scene came out slightly slower (medians 1.39–1.51× against 1.51–1.57×, not
-/// understood). A frictionless law keeps no spring, so its pairs all weigh 1, as before.
+/// floor, so blocks of equal pair counts are not blocks of equal work. The weight is the best measured
+/// on the sphere beds on two threads (`examples/sphere_flat_threads`; figures in `docs/tuning.md`). A
+/// frictionless law keeps no spring, so its pairs all weigh 1.
 const CONTACT_WEIGHT: usize = 8;
 
 #[cfg(test)]

@@ -2,12 +2,10 @@
 //! step's team job ([`super::fused`]) is handed to threads that are already running instead of being
 //! started and joined as a new rayon job every step.
 //!
-//! Why: starting a `rayon::broadcast` and joining it took 0.3–7.7 µs and 0.9–8.4 µs per step on the
-//! 2-core VM (per-thread timestamps of the fused job on sphere beds a, b and c, steps of
-//! 80–240 µs on two threads), about as much as the two threads' imbalance; held in a crew, 0.1–0.6 µs
-//! and 0.8–5.4 µs (the upper ends in rounds where the host was busy). The thread that
-//! waits for the others' part of a broadcast soon sleeps in rayon's idle loop, and waking it is a
-//! system call.
+//! Why: starting and joining a `rayon::broadcast` every step costs about as much as the two threads'
+//! imbalance on a step of the sphere beds, several times what handing a task to a running crew costs
+//! (figures: `docs/tuning.md`). The thread that waits for the others' part of a broadcast soon sleeps
+//! in rayon's idle loop, and waking it is a system call.
 //!
 //! How: [`Crew::hold`] runs one broadcast for the run. Thread 0 of the pool leads: it runs the caller's
 //! closure (the steps). Every other thread serves: it waits for a task, runs its part of it, and while

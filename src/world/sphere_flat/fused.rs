@@ -1,10 +1,9 @@
 //! Stages 1–8 of a flat step as one job of the team: the drift, the pair loop and the kick run one
 //! after the other on every thread, separated by barriers, instead of as three jobs.
 //!
-//! Why: each job of the team (`rayon::broadcast`) cost ~4–10 µs to start and join on the 2-core VM, on
-//! top of the work of its parts (a pass's wall time less its slowest part's, per-part timestamps on the
-//! sphere beds): about 20 µs of a two-thread step of ~200 µs. A barrier between two phases of
-//! one job costs the wait for the slower thread only. In a run of steps ([`SphereSim::run_steps`]) the
+//! Why: each job of the team (`rayon::broadcast`) costs a start and a join on top of the work of its
+//! parts, about a tenth of a two-thread step of the sphere beds (`docs/tuning.md`). A barrier between
+//! two phases of one job costs the wait for the slower thread only. In a run of steps ([`SphereSim::run_steps`]) the
 //! job is a task of the run's [`Crew`], whose threads are already running, instead of a broadcast.
 //!
 //! How: thread k runs part k of each pass, then takes pieces of the pass's middles until it meets the
@@ -472,8 +471,8 @@ impl Job<'_> {
         pass.run(bodies.start, part)
     }
 
-    /// Stage 9's wall sums, taken inside the job: serially by the lead after it they cost 1.2–2.6 µs of a
-    /// two-thread step of 80–130 µs on the sphere beds.
+    /// Stage 9's wall sums, taken inside the job: serially by the lead after it they would add a
+    /// serial stretch of a few per cent of a two-thread step.
     ///
     /// # Safety
     /// Called in the kick phase, which only reads the wall outputs and flags.

@@ -742,7 +742,7 @@ pub enum StepFlatError {
 }
 
 /// From this many spheres on, the per-sphere passes run on the pool when it has several threads (one
-/// pass over 1024 spheres is ~30 µs of work, well above the cost of a fork/join on a busy pool).
+/// pass over 1024 spheres is well above the cost of a fork/join on a busy pool: `docs/tuning.md`).
 pub const MIN_PARALLEL_BODIES: usize = 1024;
 
 /// From this many listed pairs on, the pair loop runs on the pool when it has several threads.

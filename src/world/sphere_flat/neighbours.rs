@@ -34,11 +34,8 @@
 //! its first body, both sorted), and a new pair starts with no spring, as the general contact store does.
 //! The merge's result is kept (`carried_from`): the pair's constants (√R*, m*, and the owner's prepared
 //! law) are functions of its two bodies, so they are carried by it too instead of formed again — the
-//! same bits. A build fills the vectors of the build before the last (`spare`) instead of fresh ones.
-//! Both together took a build of the 3000-sphere bed c from ~0.8–1.3 ms to ~0.55–0.65 ms beside the
-//! search (one thread, per-phase timers; the search itself, ~1 ms, is unchanged) and
-//! its minor page faults over 5000 steps from 11 788 to 4 868. Now each chunk of the
-//! search also merges its bodies' rows and copies their springs and constants (in parallel on several
+//! same bits. A build fills the vectors of the build before the last (`spare`) instead of fresh ones,
+//! which spares page faults (`docs/tuning.md`). Each chunk of the search also merges its bodies' rows and copies their springs and constants (in parallel on several
 //! threads), and the build only joins the chunks' vectors; the walls' springs likewise.
 
 use rayon::prelude::*;
@@ -548,8 +545,7 @@ impl NeighbourList {
         };
         // Per chunk of bodies, independently: their rows, walls, and each pair's spring and constants
         // carried over (the constants are functions of the two bodies: the same bits as forming them
-        // again), or imported, or new. Formerly everything after the search ran serially,
-        // ~0.45 ms of a build of ~1.4 ms on two threads (bed c).
+        // again), or imported, or new: in parallel, since this is a third of a build on two threads.
         let search = |(range, rows): (std::ops::Range<usize>, &mut ChunkRows)| {
             rows.clear();
             for i in range {

@@ -63,7 +63,7 @@ impl SphereSim {
         debug_assert_eq!(self.params.damping, crate::dynamics::ViscousDamping::None);
 
         // The walls move first: their moves do not depend on the spheres (the drift is the same either
-        // way; formerly they moved after it).
+        // way).
         let t = Instant::now();
         for (wall, plane) in self.walls.iter_mut().zip(&mut self.planes) {
             wall.pose.translation.vector += dt * wall.velocity;
@@ -380,8 +380,8 @@ impl SphereSim {
             });
             pl.summed = Some(found.work);
             self.outs_valid = true;
-            // Formerly this returned without joining the wall warnings to the list:
-            // a step on one block reported no overlap warning against a wall.
+            // The wall warnings join the list here too: a step on one block reports its overlap
+            // warnings against walls like any other.
             return found.finish();
         }
         let mut ledger = LedgerPart {

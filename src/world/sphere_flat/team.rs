@@ -12,8 +12,8 @@
 //! them, and most records still stay on one core.
 //!
 //! A thread that ends its part first spins until the others end theirs ([`spin_until_all`]) instead of
-//! returning to rayon, whose idle loop soon puts it to sleep: starting and joining the other thread cost
-//! ~3–8 µs per pass on the 2-core VM (per-thread timestamps). Now a step
+//! returning to rayon, whose idle loop soon puts it to sleep and makes waking it cost more than the
+//! spin (`docs/tuning.md`). A step
 //! whose lists hold runs its three passes as one job, with a [`Barrier`] between them and the arrays
 //! shared as [`PhaseSlice`]s (`super::fused`); [`for_each_part`] runs the passes of the other steps.
 //!
@@ -166,9 +166,8 @@ pub(super) struct TwoEnded {
     ends: AtomicU64,
 }
 
-/// The smallest piece of a [`TwoEnded`]: 16 spheres' rows are ~0.5–1 µs of the pair loop on the
-/// sphere beds (~40 ns per sphere on one thread), against ~0.1–0.2 µs for a compare-and-swap whose
-/// cache line the other core holds.
+/// The smallest piece of a [`TwoEnded`]: 16 spheres' rows of the pair loop cost several times a
+/// compare-and-swap whose cache line the other core holds (`docs/tuning.md`).
 const MIN_PIECE: usize = 16;
 
 impl TwoEnded {

@@ -24,8 +24,8 @@ pub(super) fn non_finite_quantity(
 /// First one sum of them all, formed as a tree of vector sums: finite only if every term is (inf − inf
 /// and NaN propagate), so a finite sum answers `None` at once; otherwise the quantities are tested one
 /// by one (which also clears a sum that overflowed from finite terms). Every body of every step takes
-/// the test: as a chain of 18 scalar additions the sum took ~5 % of a step of the flat sphere path
-/// (`perf record`, bed c).
+/// the test, so its cost matters: a chain of 18 scalar additions would serialise on the adder
+/// (`docs/tuning.md`).
 #[inline(always)]
 pub(crate) fn first_non_finite(
     force: &Vector,
