@@ -101,6 +101,6 @@ pub struct Simulation {
 impl Simulation {
     /// The orientation of body `i`'s own (input) frame, as the scene gave it.
     pub fn input_orientation(&self, i: usize) -> Rotation {
-        self.world.bodies[i].orientation * self.frames[i].rotation.inverse()
+        self.world.bodies()[i].orientation * self.frames[i].rotation.inverse()
     }
 }
