@@ -51,7 +51,7 @@ fn polyhedra_settle_in_a_box_at_rest_above_the_floor_with_an_exact_broad_phase()
         if bp.rebuilds() != last_rebuilds {
             last_rebuilds = bp.rebuilds();
             // Positions do not change after the evaluation that rebuilt the list.
-            let oracle = brute_force_pairs(&centres, &w.radii(), bp.skin());
+            let oracle = brute_force_pairs(&centres, w.radii(), bp.skin());
             assert_eq!(
                 bp.pairs(),
                 oracle.as_slice(),
@@ -60,7 +60,7 @@ fn polyhedra_settle_in_a_box_at_rest_above_the_floor_with_an_exact_broad_phase()
             );
             rebuilds_checked += 1;
         }
-        for pair in brute_force_pairs(&centres, &w.radii(), 0.0) {
+        for pair in brute_force_pairs(&centres, w.radii(), 0.0) {
             assert!(
                 bp.pairs().binary_search(&pair).is_ok(),
                 "step {}: bounding spheres of {pair:?} overlap but the pair is not a candidate",

@@ -98,7 +98,7 @@ fn the_ledger_switch_changes_only_the_ledger() {
     if let Some(d) = first_difference(&with, &without) {
         panic!("{SCENE}, {STEPS} steps, ledger on against off: {d}");
     }
-    let (l_on, l_off) = (&with.ledger(), &without.ledger());
+    let (l_on, l_off) = (with.ledger(), without.ledger());
     // With the ledger the dissipation of this run is booked (so the comparison below can fail) ...
     assert!(
         l_on.dissipated_damping > 0.0 && l_on.dissipated_friction > 0.0,

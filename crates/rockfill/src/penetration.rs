@@ -29,8 +29,7 @@ use polydem::dynamics::{Motion, RigidBody, ViscousDamping};
 use polydem::math::{Point, Pose, Real, Vector};
 use polydem::shape::Shape;
 use polydem::world::{
-    sleeping, step, ContactKey, EnergyLedger, StepCounters, StepError, StepParams, StepScratch,
-    World, WorldError,
+    sleeping, step, ContactKey, StepCounters, StepError, StepParams, StepScratch, World, WorldError,
 };
 
 /// Why a penetration run failed.
