@@ -59,7 +59,7 @@ use super::time_step::TimeStepInfo;
 /// sim.set_end_time(0.02)?; // a short run
 ///
 /// let schedule = Schedule {
-///     start_step: sim.world.step_index,
+///     start_step: sim.world.step_index(),
 ///     last_step: sim.steps,
 ///     every: Some(10),
 ///     at_start: true,
