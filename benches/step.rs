@@ -224,7 +224,9 @@ fn skips(c: &mut Criterion) {
                 tangential: TangentialLaw::spring(0.5 * spec.stiffness, 0.0).expect("spring"),
                 ..bed::model_of(&spec)
             };
-            b.world.materials.set_model(0, 0, model);
+            let mut laws = b.world.materials().clone();
+            laws.set_model(0, 0, model);
+            b.world.set_materials(laws).expect("the same materials");
         })
     });
     skip_pair(c, &frictionless, "frictionless_history", |s| {
@@ -237,7 +239,9 @@ fn skips(c: &mut Criterion) {
                 damping: DampingLaw::Viscous { coefficient: 0.0 },
                 ..bed::model_of(&spec)
             };
-            b.world.materials.set_model(0, 0, model);
+            let mut laws = b.world.materials().clone();
+            laws.set_model(0, 0, model);
+            b.world.set_materials(laws).expect("the same materials");
         })
     });
     skip_pair(c, &undamped, "undamped_contacts", |s| {
@@ -252,9 +256,14 @@ fn skips(c: &mut Criterion) {
             ..bed::BedSpec::rocks([50, 40, 1], 1, 2)
         };
         bed_scene(spec, |b| {
-            for (body, r) in b.world.bodies.iter_mut().zip(&b.world.radii) {
-                body.angular_momentum = Vector::zeros();
-                body.position.z = r + 1e-4;
+            for i in 0..b.world.body_count() {
+                let r = b.world.radii()[i];
+                b.world
+                    .edit_body(i, |body| {
+                        body.angular_momentum = Vector::zeros();
+                        body.position.z = r + 1e-4;
+                    })
+                    .expect("a body");
             }
         })
     });
@@ -272,10 +281,14 @@ fn skips(c: &mut Criterion) {
     // Fixed bodies: a polyhedral bed whose lower half is fixed.
     let half_fixed = Lazy::new("poly_bed_2000_half_fixed", 2000, || {
         bed_scene(lattice([10, 10, 20], 0, 2), |b| {
-            for body in b.world.bodies.iter_mut().take(1000) {
-                body.motion = Motion::Fixed;
-                body.velocity = Vector::zeros();
-                body.angular_momentum = Vector::zeros();
+            for i in 0..1000.min(b.world.body_count()) {
+                b.world
+                    .edit_body(i, |body| {
+                        body.motion = Motion::Fixed;
+                        body.velocity = Vector::zeros();
+                        body.angular_momentum = Vector::zeros();
+                    })
+                    .expect("a body");
             }
         })
     });
@@ -308,8 +321,8 @@ fn sleeping(c: &mut Criterion) {
         }
         eprintln!(
             "sleeping bench: {} of {} bodies asleep before the impact",
-            b.world.sleep.sleeping,
-            b.world.bodies.len()
+            b.world.sleep().sleeping,
+            b.world.bodies().len()
         );
         Scene {
             world: b.world,

@@ -149,7 +149,7 @@ fn cpu_time() -> Duration {
 
 /// The bits of every body's state, for the identity check between thread counts.
 fn state_bits(w: &World) -> Vec<u64> {
-    w.bodies
+    w.bodies()
         .iter()
         .flat_map(|b| {
             b.position
@@ -225,7 +225,7 @@ fn main() {
         for _ in 0..o.warm_up {
             step(&b.params, &mut b.world, &mut scratch).expect("warm-up step");
         }
-        let bodies = b.world.bodies.len();
+        let bodies = b.world.bodies().len();
         println!(
             "== {name}: {bodies} bodies, {} steps from the state after {} warm-up steps (dt {:.3e} s; \
              parallel from {} candidates, {} integration units)",
@@ -447,15 +447,15 @@ fn write_scenes(dir: &std::path::Path, o: &Options) -> Result<(), String> {
              --write-scenes DIR` from the seeded builder of tests/support/bed.rs (do not edit; regenerate).\n\
              # {} bodies; {steps} steps of the given time step. Run: RAYON_NUM_THREADS=1 polydem run THIS.toml --out OUT\n\
              [simulation]\ngravity = {}\nend_time = {:?}\noutput_interval = {:?}\ntime_step = {:?}\nskin = {:?}\n",
-            w.bodies.len(),
-            v(&w.gravity),
+            w.bodies().len(),
+            v(&w.gravity()),
             b.params.dt * steps as f64,
             b.params.dt * steps as f64,
             b.params.dt,
-            w.broad_phase.skin()
+            w.broad_phase().skin()
         );
         // The projectile (a 7800 kg/m³ sphere) is its own material with the same law.
-        let projectile = w.names.iter().position(|n| n == "projectile");
+        let projectile = w.names().iter().position(|n| n == "projectile");
         let mut materials = vec![("rock", spec.density)];
         if projectile.is_some() {
             materials.push(("steel", 7800.0));
@@ -476,7 +476,7 @@ fn write_scenes(dir: &std::path::Path, o: &Options) -> Result<(), String> {
                 );
             }
         }
-        for (k, shape) in w.shapes.iter().enumerate() {
+        for (k, shape) in w.shapes().iter().enumerate() {
             match shape {
                 Shape::Polyhedron(p) => {
                     let points: Vec<String> = p.vertices().iter().map(|x| v(&x.coords)).collect();
@@ -497,14 +497,14 @@ fn write_scenes(dir: &std::path::Path, o: &Options) -> Result<(), String> {
                 _ => return Err(format!("{name}: shape s{k} has no [[shape]] kind to write")),
             }
         }
-        for (i, body) in w.bodies.iter().enumerate() {
+        for (i, body) in w.bodies().iter().enumerate() {
             let q = body.orientation.quaternion();
             let _ = writeln!(
                 t,
                 "[[body]]\nname = \"{}\"\nshape = \"s{}\"\nmaterial = \"{}\"\nposition = {}\n\
                  orientation = [{:?}, {:?}, {:?}, {:?}]\nvelocity = {}\nangular_velocity = {}\n",
-                w.names[i],
-                w.shape_of[i],
+                w.names()[i],
+                w.shape_indices()[i],
                 if Some(i) == projectile {
                     "steel"
                 } else {
@@ -519,7 +519,7 @@ fn write_scenes(dir: &std::path::Path, o: &Options) -> Result<(), String> {
                 v(&body.angular_velocity())
             );
         }
-        for wall in &w.walls {
+        for wall in w.walls() {
             let normal = wall.pose.rotation * wall.plane.normal();
             let point =
                 wall.pose * polydem::math::Point::from(wall.plane.normal() * wall.plane.offset());
@@ -533,7 +533,7 @@ fn write_scenes(dir: &std::path::Path, o: &Options) -> Result<(), String> {
         }
         let path = dir.join(format!("{name}.toml"));
         std::fs::write(&path, t).map_err(|e| format!("{}: {e}", path.display()))?;
-        println!("wrote {} ({} bodies)", path.display(), w.bodies.len());
+        println!("wrote {} ({} bodies)", path.display(), w.bodies().len());
     }
     Ok(())
 }

@@ -157,7 +157,7 @@ fn child(scene: &Path) -> Result<(), String> {
     let work = sim.world.setup_stats().total();
     println!(
         "{seconds} {before} {after} {} {work}",
-        sim.world.bodies.len()
+        sim.world.bodies().len()
     );
     Ok(())
 }

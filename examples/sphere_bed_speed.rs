@@ -35,7 +35,6 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use polydem::scene::{load_scene, RunSummary};
-use polydem::world::broad_phase::BroadPhase;
 use polydem::world::{SphereSim, TimeStepCheck};
 
 struct Options {
@@ -146,10 +145,10 @@ fn main() -> anyhow::Result<()> {
             sim.params.time_step_check = check;
         }
         if let Some(skin) = o.skin {
-            sim.world.broad_phase = BroadPhase::new(skin);
+            sim.world.set_skin(skin);
         }
         sim.steps = sim.steps.min(o.steps);
-        let particles = sim.world.bodies.len();
+        let particles = sim.world.bodies().len();
         let load_before = load_average();
         let (summary, wall, cpu, round_trips) = pool.install(|| {
             // On several threads: the state of the host's cores before and after the run.
@@ -169,7 +168,7 @@ fn main() -> anyhow::Result<()> {
         });
         let summary = summary?;
         let mut hash: u64 = 0xcbf2_9ce4_8422_2325;
-        for b in &sim.world.bodies {
+        for b in sim.world.bodies() {
             for x in b.position.iter().chain(b.velocity.iter()) {
                 hash = (hash ^ x.to_bits()).wrapping_mul(0x0100_0000_01b3);
             }
@@ -192,7 +191,7 @@ fn main() -> anyhow::Result<()> {
             summary.steps,
             if sim.params.energy_ledger { "on" } else { "off" },
             sim.params.time_step_check,
-            sim.world.broad_phase.skin(),
+            sim.world.broad_phase().skin(),
             cpu.map_or("n/a".into(), |c| format!("{c:.3}")),
             wall,
             cpu.map_or("n/a".into(), |c| format!("{:.3e}", particles as f64 * steps / c)),

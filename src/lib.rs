@@ -69,8 +69,8 @@
 //!     let report = step(&sim.params, &mut sim.world, &mut scratch)?;
 //!     assert_eq!(report.contacts, 0); // still falling: no contact yet
 //! }
-//! let cube = &sim.world.bodies[0];
-//! let t = sim.world.time;
+//! let cube = sim.world.body(0);
+//! let t = sim.world.time();
 //! // Free fall from rest: z = z0 − g t²/2 (leapfrog is exact for a constant force, up to round-off).
 //! let expected = 0.2 - 0.5 * 9.81 * t * t;
 //! assert!((cube.position.z - expected).abs() < 1e-9 * 0.2, "z = {}, expected {expected}", cube.position.z);

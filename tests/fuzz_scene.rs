@@ -370,7 +370,7 @@ fn check_simulation(sim: &Simulation) -> Result<(), String> {
     if sim.steps < 1 {
         return Err("no steps".into());
     }
-    for (i, b) in sim.world.bodies.iter().enumerate() {
+    for (i, b) in sim.world.bodies().iter().enumerate() {
         let finite = b.position.coords.iter().all(|x| x.is_finite())
             && b.velocity.iter().all(|x| x.is_finite())
             && b.orientation.coords.iter().all(|x| x.is_finite())
@@ -385,7 +385,7 @@ fn check_simulation(sim: &Simulation) -> Result<(), String> {
             return Err(format!("body {i} has principal moments {:?}", b.inertia.0));
         }
     }
-    for (w, wall) in sim.world.walls.iter().enumerate() {
+    for (w, wall) in sim.world.walls().iter().enumerate() {
         if !wall.normal_world().iter().all(|x| x.is_finite()) {
             return Err(format!("wall {w} has a non-finite normal"));
         }

@@ -193,5 +193,5 @@ name_prefix = "s"
     let sim = polydem::scene::load_scene(&dir.join("scene.toml"));
     std::fs::remove_dir_all(&dir).ok();
     let sim = sim.unwrap_or_else(|e| panic!("scene and body file with a byte-order mark: {e}"));
-    assert_eq!(sim.world.bodies.len(), 2, "bodies read from spheres.csv");
+    assert_eq!(sim.world.bodies().len(), 2, "bodies read from spheres.csv");
 }

@@ -8,6 +8,7 @@
 //! sphere and wall contacts with tangential history, and a wall pose that moved (the lid reaches the rocks
 //! after the checkpoint, so its work enters the ledger in the compared part).
 
+use polydem::dynamics::RigidBody;
 use std::path::{Path, PathBuf};
 
 use polydem::io::checkpoint::{self, CheckpointError, FORMAT_VERSION, HEADER_LEN, MAGIC};
@@ -79,7 +80,7 @@ fn temp_dir(case: &str) -> PathBuf {
 
 /// First body whose state differs bitwise, with both values.
 fn first_body_difference(a: &Simulation, b: &Simulation) -> Option<String> {
-    for (i, (x, y)) in a.world.bodies.iter().zip(&b.world.bodies).enumerate() {
+    for (i, (x, y)) in a.world.bodies().iter().zip(b.world.bodies()).enumerate() {
         let bits = |s: &polydem::dynamics::RigidBody| -> Vec<u64> {
             let q = s.orientation.quaternion();
             [
@@ -118,7 +119,7 @@ fn restarted_run_continues_bit_for_bit() {
     let mut first_half = scene();
     run_to(&mut first_half, N / 2);
     // The checkpoint must carry real per-contact history, or this test would prove little.
-    let store = &first_half.world.contacts;
+    let store = &first_half.world.contacts();
     let sliding_history = store
         .states()
         .iter()
@@ -130,7 +131,7 @@ fn restarted_run_continues_bit_for_bit() {
         .zip(store.states())
         .filter(|(k, s)| matches!(k, ContactKey::Body { .. }) && s.is_active())
         .count();
-    let lid_moved = first_half.world.walls[5].pose.translation.vector.z - 0.2;
+    let lid_moved = first_half.world.walls()[5].pose.translation.vector.z - 0.2;
     assert!(
         sliding_history >= 5 && body_contacts >= 5 && lid_moved < -0.05,
         "at the checkpoint (step {}): {sliding_history} active contacts with tangential history, \
@@ -143,10 +144,10 @@ fn restarted_run_continues_bit_for_bit() {
     let bytes = checkpoint::save(&file, &first_half).expect("save");
     assert_eq!(bytes, std::fs::metadata(&file).unwrap().len());
     let mut restarted = checkpoint::load(&file).expect("load").simulation;
-    assert_eq!(restarted.world.step_index, N / 2);
+    assert_eq!(restarted.world.step_index(), N / 2);
     run_to(&mut restarted, N);
 
-    assert_eq!(restarted.world.step_index, N);
+    assert_eq!(restarted.world.step_index(), N);
     if let Some(diff) = first_body_difference(&straight, &restarted) {
         panic!(
             "after {N} steps, straight vs restarted at step {}: {diff}",
@@ -154,16 +155,22 @@ fn restarted_run_continues_bit_for_bit() {
         );
     }
     assert_eq!(
-        straight.world.ledger, restarted.world.ledger,
+        straight.world.ledger(),
+        restarted.world.ledger(),
         "energy ledger after {N} steps"
     );
     assert_eq!(
-        straight.world.time.to_bits(),
-        restarted.world.time.to_bits()
+        straight.world.time().to_bits(),
+        restarted.world.time().to_bits()
     );
-    assert_eq!(straight.world.walls, restarted.world.walls, "wall poses");
     assert_eq!(
-        straight.world.contacts, restarted.world.contacts,
+        straight.world.walls(),
+        restarted.world.walls(),
+        "wall poses"
+    );
+    assert_eq!(
+        straight.world.contacts(),
+        restarted.world.contacts(),
         "contact store (keys, tangential springs, warm starts, geometry)"
     );
     // The whole state, every byte: the checkpoints of both end states are identical.
@@ -189,7 +196,7 @@ fn restart_without_the_contact_store_diverges() {
     let mut bytes_restored = checkpoint::decode(&checkpoint::encode(&half).unwrap())
         .unwrap()
         .simulation;
-    bytes_restored.world.contacts = Default::default();
+    bytes_restored.world.clear_contacts();
     run_to(&mut bytes_restored, N);
     assert!(
         first_body_difference(&straight, &bytes_restored).is_some(),
@@ -296,7 +303,7 @@ fn damaged_foreign_and_future_files_are_refused_with_typed_errors() {
             .unwrap()
             .simulation
             .world
-            .step_index,
+            .step_index(),
         50
     );
     let _ = std::fs::remove_dir_all(&dir);
@@ -308,7 +315,10 @@ fn damaged_foreign_and_future_files_are_refused_with_typed_errors() {
 fn inconsistent_state_with_a_valid_checksum_is_refused() {
     let mut sim = scene();
     run_to(&mut sim, 10);
-    sim.world.shape_of[3] = 99;
+    // The API keeps shape indices valid: the impossible state is written into the serialised world.
+    let mut state = serde_json::to_value(&sim.world).expect("world to JSON");
+    state["shape_of"][3] = 99.into();
+    sim.world = serde_json::from_value(state).expect("world from JSON");
     let bytes = checkpoint::encode(&sim).unwrap();
     match checkpoint::decode(&bytes) {
         Err(CheckpointError::Invalid { what }) => {
@@ -363,13 +373,20 @@ fn a_checkpoint_with_a_non_finite_body_state_is_refused() {
     type Damage = fn(&mut Simulation);
     let cases: [(&str, Damage); 3] = [
         ("orientation", |s| {
-            let q = s.world.bodies[2].orientation.quaternion().coords;
-            s.world.bodies[2].orientation = nalgebra::UnitQuaternion::new_unchecked(
-                nalgebra::Quaternion::new(f64::NAN, q.x, q.y, q.z),
-            );
+            let q = s.world.bodies()[2].orientation.quaternion().coords;
+            let nan = nalgebra::Quaternion::new(f64::NAN, q.x, q.y, q.z);
+            let edit =
+                |b: &mut RigidBody| b.orientation = nalgebra::UnitQuaternion::new_unchecked(nan);
+            s.world.edit_body(2, edit).expect("body 2");
         }),
-        ("velocity", |s| s.world.bodies[2].velocity.y = f64::INFINITY),
-        ("position", |s| s.world.bodies[2].position.z = f64::NAN),
+        ("velocity", |s| {
+            let edit = |b: &mut RigidBody| b.velocity.y = f64::INFINITY;
+            s.world.edit_body(2, edit).expect("body 2")
+        }),
+        ("position", |s| {
+            let edit = |b: &mut RigidBody| b.position.z = f64::NAN;
+            s.world.edit_body(2, edit).expect("body 2")
+        }),
     ];
     for (what, damage) in cases {
         let mut bad = good.clone();

@@ -202,11 +202,11 @@ fn frames_parse_back_with_the_world_geometry_and_fields(encoding: VtkEncoding) {
         .write_frame(&sim.world)
         .expect("frame after 8000 steps");
     let world = &sim.world;
-    let step = world.step_index;
+    let step = world.step_index();
 
     // Polyhedra: counts, faces, coordinates, fields.
     let p = piece(&dir.join(format!("vtk/polyhedra_{step:09}.vtu")));
-    let bodies: Vec<usize> = (0..world.bodies.len())
+    let bodies: Vec<usize> = (0..world.bodies().len())
         .filter(|&i| matches!(world.shape(i), Shape::Polyhedron(_)))
         .collect();
     assert_eq!(bodies.len(), 20);
@@ -233,7 +233,7 @@ fn frames_parse_back_with_the_world_geometry_and_fields(encoding: VtkEncoding) {
         };
         let pose = world.pose(i);
         let size = world.length_scale(i);
-        let body = &world.bodies[i];
+        let body = &world.bodies()[i];
         for (v, local) in poly.vertices().iter().enumerate() {
             let k = base + v;
             let expected = pose * local;
@@ -274,13 +274,13 @@ fn frames_parse_back_with_the_world_geometry_and_fields(encoding: VtkEncoding) {
             close(
                 &format!("body {i} contact force"),
                 &force[3 * cell..3 * cell + 3],
-                &world.loads.forces[i],
-                world.loads.forces[i].norm(),
+                &world.loads().forces[i],
+                world.loads().forces[i].norm(),
             );
             start = end;
             cell += 1;
         }
-        if world.loads.forces[i].norm() > 0.0 {
+        if world.loads().forces[i].norm() > 0.0 {
             nonzero_forces += 1;
         }
         base += poly.vertices().len();
@@ -305,7 +305,7 @@ fn frames_parse_back_with_the_world_geometry_and_fields(encoding: VtkEncoding) {
     let diameter: Vec<f64> = array(&s.data.point, "diameter");
     let sphere_omega: Vec<f64> = array(&s.data.point, "angular_velocity");
     for (k, i) in [20usize, 21].into_iter().enumerate() {
-        let b = &world.bodies[i];
+        let b = &world.bodies()[i];
         close(
             &format!("sphere {i} centre"),
             &centres[3 * k..3 * k + 3],
@@ -328,12 +328,12 @@ fn frames_parse_back_with_the_world_geometry_and_fields(encoding: VtkEncoding) {
 
     // Walls: each polygon on its plane, on the free side of the other walls, force as in the world.
     let w = piece(&dir.join(format!("vtk/walls_{step:09}.vtu")));
-    assert_eq!(w.cells.types.len(), world.walls.len());
+    assert_eq!(w.cells.types.len(), world.walls().len());
     let wall_points: Vec<f64> = w.points.cast_into().unwrap();
     let (conn, offsets) = connectivity(&w);
     let wall_force: Vec<f64> = array(&w.data.cell, "contact_force");
     let mut start = 0;
-    for (k, wall) in world.walls.iter().enumerate() {
+    for (k, wall) in world.walls().iter().enumerate() {
         let end = offsets[k] as usize;
         assert!(
             end - start >= 3,
@@ -354,7 +354,7 @@ fn frames_parse_back_with_the_world_geometry_and_fields(encoding: VtkEncoding) {
                 d.abs() <= tolerance,
                 "wall {k} vertex {x:?} at distance {d} from its plane, tolerance {tolerance:e}"
             );
-            for (j, other) in world.walls.iter().enumerate() {
+            for (j, other) in world.walls().iter().enumerate() {
                 let dj = other.signed_distance(&x);
                 assert!(
                     dj >= -tolerance,
@@ -365,8 +365,8 @@ fn frames_parse_back_with_the_world_geometry_and_fields(encoding: VtkEncoding) {
         close(
             &format!("wall {k} force"),
             &wall_force[3 * k..3 * k + 3],
-            &world.loads.wall_forces[k],
-            world.loads.wall_forces[k].norm(),
+            &world.loads().wall_forces[k],
+            world.loads().wall_forces[k].norm(),
         );
         start = end;
     }
@@ -387,7 +387,7 @@ fn frames_parse_back_with_the_world_geometry_and_fields(encoding: VtkEncoding) {
             .iter()
             .map(|n| n.attribute("timestep").unwrap().parse().unwrap())
             .collect();
-        assert_eq!(times, vec![0.0, world.time], "{series}.pvd times");
+        assert_eq!(times, vec![0.0, world.time()], "{series}.pvd times");
         for n in &sets {
             let file = dir.join(n.attribute("file").unwrap());
             assert!(file.exists(), "{} listed in {series}.pvd", file.display());
@@ -444,7 +444,10 @@ fn a_restarted_run_continues_the_series_of_the_earlier_run() {
         straight.steps = target;
         straight.run(|_| Ok(()), |_, _| Ok(())).expect("run");
         writer.write_frame(&straight.world).unwrap();
-        frames.push((straight.world.time, format!("vtk/spheres_{target:09}.vtu")));
+        frames.push((
+            straight.world.time(),
+            format!("vtk/spheres_{target:09}.vtu"),
+        ));
     }
     assert_eq!(pvd_entries(&dir.join("spheres.pvd")), frames);
 

@@ -293,15 +293,15 @@ fn sphere_bed(scene: &'static str, steps: u64, expected: &Pin) {
     let world = run_scene(scene, steps, expected);
     run_scene_flat(scene, steps, expected);
     let projectile = world
-        .names
+        .names()
         .iter()
         .position(|name| name == "projectile")
         .expect("the sphere bed has a body named 'projectile'") as u32;
     let touching = world
-        .contacts
+        .contacts()
         .keys()
         .iter()
-        .zip(world.contacts.states())
+        .zip(world.contacts().states())
         .filter(|(key, state)| {
             state.is_active()
                 && match **key {
@@ -484,16 +484,22 @@ struct Pin {
 
 impl Pin {
     fn of(world: &World) -> Self {
-        let bodies = &world.bodies;
+        let bodies = &world.bodies();
         let per_body = |f: &dyn Fn(&mut Fnv1a, &polydem::dynamics::RigidBody)| {
             let mut h = Fnv1a::new();
             bodies.iter().for_each(|b| f(&mut h, b));
             h.finish()
         };
-        let store = || world.contacts.keys().iter().zip(world.contacts.states());
+        let store = || {
+            world
+                .contacts()
+                .keys()
+                .iter()
+                .zip(world.contacts().states())
+        };
 
         let mut state = Fnv1a::new();
-        for b in bodies {
+        for b in bodies.iter() {
             state.point(&b.position);
             state.vector(&b.velocity);
             state.rotation(&b.orientation);
@@ -510,14 +516,14 @@ impl Pin {
             candidates.u64(entry.since_step);
         }
         let mut loads = Fnv1a::new();
-        let l = &world.loads;
+        let l = &world.loads();
         for v in l.forces.iter().chain(&l.torques).chain(&l.wall_forces) {
             loads.vector(v);
         }
 
         Self {
-            time_bits: world.time.to_bits(),
-            step_index: world.step_index,
+            time_bits: world.time().to_bits(),
+            step_index: world.step_index(),
             bodies: bodies.len(),
             active_contacts: store().filter(|(_, s)| s.is_active()).count(),
             positions: per_body(&|h, b| h.point(&b.position)),
@@ -607,13 +613,13 @@ fn check(
         return;
     }
     if let Some(lines) = differences(&context, measured, expected) {
-        let body0 = world.bodies.first().map_or("none".to_owned(), |b| {
+        let body0 = world.bodies().first().map_or("none".to_owned(), |b| {
             format!("{:?}", b.position.coords.as_slice())
         });
         panic!(
             "{lines}\n({context}: {} bodies, {} overlapping contacts, time {} s, first body at {body0}; if the \
              change must move these bits, re-pin with POLYDEM_PIN_PRINT=1 in a commit of its own that says why)",
-            measured.bodies, measured.active_contacts, world.time
+            measured.bodies, measured.active_contacts, world.time()
         );
     }
 }
@@ -659,7 +665,12 @@ impl ContactKinds {
     fn of(world: &World) -> Self {
         let is_sphere = |i: u32| matches!(world.shape(i as usize), Shape::Sphere(_));
         let mut kinds = Self::default();
-        for (key, state) in world.contacts.keys().iter().zip(world.contacts.states()) {
+        for (key, state) in world
+            .contacts()
+            .keys()
+            .iter()
+            .zip(world.contacts().states())
+        {
             if !state.is_active() {
                 continue;
             }

@@ -36,11 +36,13 @@ fn density_scale_multiplies_masses_and_inertias_by_s_and_the_packing_step_by_sqr
     let mut config = small();
     config.packing.packing_steps_per_contact = Some(10.0);
     let mut world = loose(&config);
-    for (k, b) in world.bodies.iter_mut().enumerate() {
-        b.velocity = Vector::new(0.0, 0.1, -1.0 - 0.01 * k as Real);
-        b.set_angular_velocity(&Vector::new(0.3, -0.2, 0.1 * k as Real));
+    for k in 0..world.body_count() {
+        let v = Vector::new(0.0, 0.1, -1.0 - 0.01 * k as Real);
+        world.set_body_velocity(k, v).expect("a rock");
+        let w = Vector::new(0.3, -0.2, 0.1 * k as Real);
+        world.set_body_angular_velocity(k, w).expect("a rock");
     }
-    let before = world.bodies.clone();
+    let before = world.bodies().to_vec();
     let e0 = world.energy();
     let (dt0, tc0) = packing_time_step(&config, &world).unwrap();
     for s in [4.0, 16.0, 100.0] {
@@ -56,7 +58,7 @@ fn density_scale_multiplies_masses_and_inertias_by_s_and_the_packing_step_by_sqr
                 s.sqrt()
             );
         }
-        for (i, (b, b0)) in scaled.bodies.iter().zip(&before).enumerate() {
+        for (i, (b, b0)) in scaled.bodies().iter().zip(before.iter()).enumerate() {
             let rel = |a: Real, e: Real| (a - e).abs() / e.abs().max(Real::MIN_POSITIVE);
             assert!(
                 rel(b.mass, s * b0.mass) <= 1e-14,
@@ -127,9 +129,9 @@ fn packing_with_density_scale_ends_at_the_true_masses_with_the_ledger_closed_and
          the true Δt {dt_true} s)",
         report.restore_steps
     );
-    for i in 0..world.bodies.len() {
+    for i in 0..world.bodies().len() {
         let (mass, inertia) = true_mass_properties(&config, &world, i);
-        let b = &world.bodies[i];
+        let b = &world.bodies()[i];
         assert!(
             b.mass == mass && b.inertia.0 == inertia,
             "rock {i}: mass {} kg, moments {:?} after the restore; true {mass} kg, {inertia:?} (bit for bit)",

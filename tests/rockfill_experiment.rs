@@ -21,7 +21,7 @@ fn packed_bed_stays_in_the_container_and_reloads_bit_for_bit() {
     let d = config.rock.mean_size;
     // Every vertex inside the box, up to the largest overlap a wall contact may have (1 % of the size).
     let tol = 0.01 * d;
-    for i in 0..world.bodies.len() {
+    for i in 0..world.bodies().len() {
         let Shape::Polyhedron(p) = world.shape(i) else {
             panic!("rock {i} is not a polyhedron")
         };
@@ -60,9 +60,9 @@ fn packed_bed_stays_in_the_container_and_reloads_bit_for_bit() {
     save_bed(&world, &dir).unwrap();
     let loaded = load_bed(&config, &dir).unwrap();
     std::fs::remove_dir_all(&dir).ok();
-    assert_eq!(loaded.bodies.len(), world.bodies.len());
-    assert_eq!(loaded.walls.len(), KEPT_WALLS + 2);
-    for (i, (a, b)) in world.bodies.iter().zip(&loaded.bodies).enumerate() {
+    assert_eq!(loaded.bodies().len(), world.bodies().len());
+    assert_eq!(loaded.walls().len(), KEPT_WALLS + 2);
+    for (i, (a, b)) in world.bodies().iter().zip(loaded.bodies()).enumerate() {
         let scale = world.length_scale(i);
         assert_eq!(a.velocity, b.velocity, "rock {i} velocity");
         assert_eq!(

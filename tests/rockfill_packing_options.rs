@@ -62,43 +62,46 @@ fn loose(config: &ExperimentConfig) -> polydem::world::World {
 fn local_damping_on_a_world_skips_free_rocks_and_books_what_it_removes() {
     let config = small();
     let mut world = loose(&config);
-    assert!(world.bodies.len() >= 3, "{} rocks", world.bodies.len());
-    for (k, b) in world.bodies.iter_mut().enumerate() {
-        b.velocity = Vector::new(0.1 * k as Real, -0.2, -1.0);
+    assert!(world.bodies().len() >= 3, "{} rocks", world.bodies().len());
+    for k in 0..world.body_count() {
+        let v = Vector::new(0.1 * k as Real, -0.2, -1.0);
+        world.set_body_velocity(k, v).expect("a rock");
     }
-    let n = world.bodies.len();
-    world.loads.forces = vec![Vector::zeros(); n];
-    world.loads.torques = vec![Vector::zeros(); n];
+    let n = world.bodies().len();
     // Rock 0: a contact force that more than balances its weight; rock 1: a torque only; the rest free.
-    let m0 = world.bodies[0].mass;
-    world.loads.forces[0] = Vector::new(5.0, 0.0, 3.0 * m0 * 9.81);
-    world.bodies[1].set_angular_velocity(&Vector::new(1.0, 2.0, 3.0));
-    world.loads.torques[1] = Vector::new(-1.0, 1.0, 1.0);
-    let before: Vec<_> = world.bodies.clone();
+    let m0 = world.bodies()[0].mass;
+    let w = Vector::new(1.0, 2.0, 3.0);
+    world.set_body_angular_velocity(1, w).expect("rock 1");
+    let loads = world.loads_mut_unchecked();
+    loads.forces = vec![Vector::zeros(); n];
+    loads.torques = vec![Vector::zeros(); n];
+    loads.forces[0] = Vector::new(5.0, 0.0, 3.0 * m0 * 9.81);
+    loads.torques[1] = Vector::new(-1.0, 1.0, 1.0);
+    let before: Vec<_> = world.bodies().to_vec();
     let kinetic = |b: &polydem::dynamics::RigidBody| {
         b.translational_kinetic_energy() + b.rotational_kinetic_energy()
     };
     let dt = 1e-3;
     let removed = apply_local_damping(&mut world, 0.3, dt);
-    for (k, (b, b0)) in world.bodies.iter().zip(&before).enumerate().skip(2) {
+    for (k, (b, b0)) in world.bodies().iter().zip(&before).enumerate().skip(2) {
         assert_eq!(
             (b.velocity, b.angular_momentum),
             (b0.velocity, b0.angular_momentum),
             "rock {k} carries no load and was damped"
         );
     }
-    let unbalanced = world.loads.forces[0] + m0 * world.gravity;
+    let unbalanced = world.loads().forces[0] + m0 * world.gravity();
     let v0 = before[0].velocity;
     let expected = local_damping(&v0, &v0, &unbalanced, 0.3, dt / m0);
-    assert_eq!(world.bodies[0].velocity, expected);
+    assert_eq!(world.bodies()[0].velocity, expected);
     assert!(
-        world.bodies[1].angular_momentum.norm() < before[1].angular_momentum.norm(),
+        world.bodies()[1].angular_momentum.norm() < before[1].angular_momentum.norm(),
         "rock 1: angular momentum {:?} -> {:?}",
         before[1].angular_momentum,
-        world.bodies[1].angular_momentum
+        world.bodies()[1].angular_momentum
     );
     let drop: Real = (0..2)
-        .map(|k| kinetic(&before[k]) - kinetic(&world.bodies[k]))
+        .map(|k| kinetic(&before[k]) - kinetic(&world.bodies()[k]))
         .sum();
     let scale = kinetic(&before[0]) + kinetic(&before[1]);
     assert!(
@@ -148,7 +151,7 @@ fn packing_with_local_damping_and_a_drop_speed_settles_the_small_bed() {
     config.packing.drop_speed = Some(2.0);
     let mut world = loose(&config);
     let potential0: Real = world
-        .bodies
+        .bodies()
         .iter()
         .map(|b| b.mass * 9.81 * b.position.z)
         .sum();
@@ -172,7 +175,7 @@ fn packing_with_local_damping_and_a_drop_speed_settles_the_small_bed() {
         deposition.abs() < 0.01,
         "deposition: ledger balance / initial potential {deposition}, tol 0.01"
     );
-    let booked = world.ledger.dissipated_viscous / potential0;
+    let booked = world.ledger().dissipated_viscous / potential0;
     assert!(
         booked > 0.1,
         "local damping booked {booked} of the initial potential energy, expected more than 0.1"

@@ -72,14 +72,14 @@ fn example_scene_places_the_file_poses_exactly() {
     let csv = std::fs::read_to_string(path.with_extension("csv")).unwrap();
     let rows = csv_rows(&csv);
     assert_eq!(
-        sim.world.bodies.len(),
+        sim.world.bodies().len(),
         rows.len(),
         "one body per row of {csv:?}"
     );
     for row in &rows {
         let name = format!("rock_{}", text(row, "id"));
-        let i = sim.world.names.iter().position(|n| *n == name).unwrap();
-        let body = &sim.world.bodies[i];
+        let i = sim.world.names().iter().position(|n| *n == name).unwrap();
+        let body = &sim.world.bodies()[i];
         let frame = &sim.frames[i];
         let q = Rotation::from_quaternion(nalgebra::Quaternion::new(
             get(row, "qw"),
@@ -119,8 +119,8 @@ fn example_scene_places_the_file_poses_exactly() {
     let scene = std::fs::read_to_string(&path).unwrap();
     let twin =
         parse_scene(&as_body_entries(&scene, &rows), &path).expect("the [[body]] twin loads");
-    assert_eq!(twin.world.names, sim.world.names);
-    assert_eq!(twin.world.bodies, sim.world.bodies);
+    assert_eq!(twin.world.names(), sim.world.names());
+    assert_eq!(twin.world.bodies(), sim.world.bodies());
     assert_eq!(twin.frames, sim.frames);
     assert_eq!(twin.tracked, sim.tracked);
     assert_eq!(twin.time_step, sim.time_step);
@@ -250,19 +250,19 @@ fn velocities_from_a_file_without_them_and_zeroed_velocities() {
     let sim = result.expect("velocities = \"zero\" loads");
     assert!(
         sim.world
-            .bodies
+            .bodies()
             .iter()
             .all(|b| b.velocity == Vector::zeros()),
         "velocities = \"zero\" left {:?}",
         sim.world
-            .bodies
+            .bodies()
             .iter()
             .map(|b| b.velocity)
             .collect::<Vec<_>>()
     );
     let (_, _, _, result) = load_with("from_file", GOOD, "");
     assert_eq!(
-        result.expect("loads").world.bodies[1].velocity,
+        result.expect("loads").world.bodies()[1].velocity,
         Vector::new(0.0, 0.0, -1.0)
     );
 }

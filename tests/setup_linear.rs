@@ -148,7 +148,7 @@ fn material_checks_report_the_missing_law_of_the_full_scan() {
         for i in 0..40 {
             if i == 20 && !walls.is_empty() {
                 // Walls removed between adds (as a penetration run removes the container's sides).
-                world.walls.truncate(walls.len() - 1);
+                world.truncate_walls(walls.len() - 1);
                 walls.pop();
             }
             let m = rng.random_range(0..5);

@@ -38,7 +38,7 @@ fn add_sphere(world: &mut World, material: u32, radius: Real, x: Point, v: Vecto
     let inertia = PrincipalInertia::new(props.principal_moments * DENSITY).expect("inertia");
     let mut body = RigidBody::new_dynamic(x, props.volume * DENSITY, inertia).expect("body");
     body.velocity = v;
-    let n = world.bodies.len();
+    let n = world.bodies().len();
     world
         .add_body(&format!("s{n}"), shape, material, body)
         .expect("body added") as usize
@@ -77,7 +77,7 @@ fn impact(model: ContactModel, vn: Real, vt: Real) -> (World, World) {
         Point::new(RADIUS + gap, 0.0, 0.0),
         Vector::new(-0.5 * vn, 0.5 * vt, 0.0),
     );
-    let mass = world.bodies[0].mass;
+    let mass = world.bodies()[0].mass;
     let t_c = model.normal.elastic_contact_time(0.5 * mass, vn);
     let mut params = StepParams::new(t_c / 2000.0);
     params.energy_ledger = false;
@@ -94,7 +94,7 @@ fn impact(model: ContactModel, vn: Real, vt: Real) -> (World, World) {
 }
 
 fn assert_same_bits(label: &str, a: &World, b: &World) {
-    for (i, (x, y)) in a.bodies.iter().zip(&b.bodies).enumerate() {
+    for (i, (x, y)) in a.bodies().iter().zip(b.bodies()).enumerate() {
         let bits = |b: &RigidBody| {
             [b.position.coords, b.velocity, b.angular_momentum]
                 .iter()
@@ -114,7 +114,7 @@ fn head_on_impact_rebounds_with_the_restitution() {
     let (e, vn) = (0.5, 1.0);
     let (flat, general) = impact(hertz(1e9, e, 0.3), vn, 0.0);
     assert_same_bits("head-on impact", &flat, &general);
-    let rebound = flat.bodies[1].velocity.x - flat.bodies[0].velocity.x;
+    let rebound = flat.bodies()[1].velocity.x - flat.bodies()[0].velocity.x;
     let measured = rebound / vn;
     let tolerance = 2e-3;
     assert!(
@@ -136,7 +136,7 @@ fn oblique_sliding_impact_transfers_mu_times_the_normal_impulse() {
     model.normal = model.normal.with_force_limit();
     let (flat, general) = impact(model, vn, vt);
     assert_same_bits("oblique impact", &flat, &general);
-    let body = &flat.bodies[1];
+    let body = &flat.bodies()[1];
     let (mass, moment) = (body.mass, body.inertia.0.x);
     let normal_impulse = mass * (body.velocity.x - (-0.5 * vn));
     let tangential_change = body.velocity.y - 0.5 * vt;
@@ -217,10 +217,10 @@ fn lists_hold_every_touching_pair_after_motions_of_several_skins() {
     params.energy_ledger = false;
     let mut flat = SphereSim::from_world(&world, &params).expect("flat path");
     let radii: Vec<Real> = world
-        .bodies
+        .bodies()
         .iter()
         .enumerate()
-        .map(|(i, _)| world.radii[i])
+        .map(|(i, _)| world.radii()[i])
         .collect();
     let n = radii.len();
     let mut builds_checked = 0;
@@ -270,7 +270,7 @@ fn lists_hold_every_touching_pair_after_motions_of_several_skins() {
         }
     }
     let moved = (0..n)
-        .map(|i| (flat.position(i) - world.bodies[i].position).norm())
+        .map(|i| (flat.position(i) - world.bodies()[i].position).norm())
         .fold(0.0, Real::max);
     assert!(
         builds_checked >= 5 && moved > 5.0 * skin,

@@ -69,7 +69,7 @@ fn flat(params: &polydem::world::StepParams, world: &World, steps: u64, threads:
 
 /// The ledger's terms and the last step's contact terms, named.
 fn ledger_values(w: &World) -> [(&'static str, f64); 9] {
-    let l = &w.ledger;
+    let l = &w.ledger();
     [
         ("initial_total", l.initial_total.unwrap_or(f64::NAN)),
         ("dissipated_damping", l.dissipated_damping),
@@ -77,11 +77,11 @@ fn ledger_values(w: &World) -> [(&'static str, f64); 9] {
         ("dissipated_viscous", l.dissipated_viscous),
         ("external_work", l.external_work),
         ("tangential_stiffness_work", l.tangential_stiffness_work),
-        ("loads.damping_work", w.loads.damping_work),
-        ("loads.friction_dissipation", w.loads.friction_dissipation),
+        ("loads.damping_work", w.loads().damping_work),
+        ("loads.friction_dissipation", w.loads().friction_dissipation),
         (
             "loads.tangential_stiffness_work",
-            w.loads.tangential_stiffness_work,
+            w.loads().tangential_stiffness_work,
         ),
     ]
 }
@@ -103,7 +103,7 @@ fn difference(general: &World, flat: &World) -> Option<String> {
 /// the overlap (Hertz–Mindlin; zero for the linear spring's constant k_t), so that the comparison can
 /// fail.
 fn assert_booked(file: &str, w: &World) {
-    let l = &w.ledger;
+    let l = &w.ledger();
     let mindlin = !file.contains("linear");
     assert!(
         l.dissipated_damping > 0.0

@@ -38,10 +38,10 @@ fn orientation_tracking_changes_nothing_but_the_orientations() {
     let (_, frozen) = run(false);
     let mut spun = 0;
     for (i, ((a, b), s)) in tracked
-        .bodies
+        .bodies()
         .iter()
-        .zip(&frozen.bodies)
-        .zip(&start.bodies)
+        .zip(frozen.bodies())
+        .zip(start.bodies())
         .enumerate()
     {
         let bits = |b: &polydem::dynamics::RigidBody| {
@@ -74,8 +74,8 @@ fn orientation_tracking_changes_nothing_but_the_orientations() {
         }
     }
     let (la, lb) = (
-        world_bits::load_values(&tracked, &[tracked.time]),
-        world_bits::load_values(&frozen, &[frozen.time]),
+        world_bits::load_values(&tracked, &[tracked.time()]),
+        world_bits::load_values(&frozen, &[frozen.time()]),
     );
     if let Some((k, x, y)) = world_bits::first_value_difference(&la, &lb) {
         panic!(
@@ -84,7 +84,7 @@ fn orientation_tracking_changes_nothing_but_the_orientations() {
         );
     }
     assert!(
-        tracked.contacts == frozen.contacts,
+        tracked.contacts() == frozen.contacts(),
         "the written-back contact stores (springs, forces) differ"
     );
     // The comparison must be able to fail: with tracking on, spheres did turn.

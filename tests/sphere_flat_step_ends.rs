@@ -5,6 +5,7 @@
 //! reports it. It guards any change of the step's passes (such as leaving each step's second half kick to
 //! the next step's first pass).
 
+use polydem::dynamics::RigidBody;
 use std::path::Path;
 
 use polydem::math::Real;
@@ -28,7 +29,7 @@ fn bed_c() -> (Simulation, World, StepScratch, SphereSim) {
 #[test]
 fn accessors_show_every_step_end_as_the_general_step() {
     let (sim, mut world, mut scratch, mut flat) = bed_c();
-    let n = world.bodies.len();
+    let n = world.bodies().len();
     // The projectile (last body), and a spread of bed spheres.
     let watched: Vec<usize> = (0..n).step_by(97).chain([n - 1]).collect();
     // The ball lands at step ~50: contacts open, persist and close in these steps.
@@ -36,7 +37,7 @@ fn accessors_show_every_step_end_as_the_general_step() {
         step(&sim.params, &mut world, &mut scratch).unwrap();
         flat.step().unwrap();
         for &i in &watched {
-            let b = &world.bodies[i];
+            let b = &world.bodies()[i];
             let pairs = [
                 ("position", b.position.coords, flat.position(i).coords),
                 ("velocity", b.velocity, flat.velocity(i)),
@@ -45,8 +46,8 @@ fn accessors_show_every_step_end_as_the_general_step() {
                     b.angular_momentum,
                     flat.angular_momentum(i),
                 ),
-                ("force", world.loads.forces[i], flat.forces()[i]),
-                ("torque", world.loads.torques[i], flat.torques()[i]),
+                ("force", world.loads().forces[i], flat.forces()[i]),
+                ("torque", world.loads().torques[i], flat.torques()[i]),
             ];
             for (what, general, ours) in pairs {
                 let bits = |v: &polydem::math::Vector| v.map(Real::to_bits);
@@ -81,10 +82,11 @@ fn non_finite_state_is_the_general_steps_error(threads: usize) {
     }
     // A NaN velocity on a bed sphere, put in both states between steps.
     let body = 1234;
-    world.bodies[body].velocity.y = Real::NAN;
+    let nan = |b: &mut RigidBody| b.velocity.y = Real::NAN;
+    world.edit_body(body, nan).expect("a body");
     let mut broken = sim.world.clone();
     flat.write_back(&mut broken);
-    broken.bodies[body].velocity.y = Real::NAN;
+    broken.edit_body(body, nan).expect("a body");
     let mut flat = SphereSim::from_world(&broken, &sim.params).expect("a sphere-only world");
     let general_error = step(&sim.params, &mut world, &mut scratch).expect_err("NaN carried on");
     let flat_error = match flat.step() {

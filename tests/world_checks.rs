@@ -57,7 +57,8 @@ fn a_non_finite_velocity_is_an_error_naming_body_and_step() {
     for _ in 0..3 {
         step(&params, &mut world, &mut scratch).expect("finite steps");
     }
-    world.bodies[1].velocity.y = Real::NAN;
+    let nan = |b: &mut polydem::dynamics::RigidBody| b.velocity.y = Real::NAN;
+    world.edit_body(1, nan).expect("body 1");
     let err = step(&params, &mut world, &mut scratch).expect_err("NaN velocity carried on");
     match &err {
         StepError::NonFinite {

@@ -104,8 +104,8 @@ fn tilted_ellipsoid_bouncing_on_a_wall_conserves_energy() {
     let e = world.energy();
     // The wall's impulse per unit mass: the velocity gained over free fall (most of the impact goes into
     // spin for this eccentric, end-first contact).
-    let free_fall = v0.z - g * world.time;
-    let gained = world.bodies[0].velocity.z - free_fall;
+    let free_fall = v0.z - g * world.time();
+    let gained = world.bodies()[0].velocity.z - free_fall;
     assert!(
         contact_steps > 50 && gained > 0.5,
         "the wall stopped the fall: {contact_steps} contact steps, velocity gained over free fall {gained} m/s"

@@ -42,7 +42,7 @@ fn elastic_vertex_face_collision_conserves_energy_through_the_engine() {
         1e-2 * e0
     );
     assert_eq!(
-        sim.world.contacts.len(),
+        sim.world.contacts().len(),
         1,
         "the pair stays a broad-phase candidate"
     );
@@ -53,7 +53,7 @@ fn elastic_vertex_face_collision_conserves_energy_through_the_engine() {
         sim.params.dt
     );
     let dp = (sim.world.linear_momentum() - p0).norm();
-    let scale = sim.world.bodies.iter().map(|b| b.mass * 1.0).sum::<f64>();
+    let scale = sim.world.bodies().iter().map(|b| b.mass * 1.0).sum::<f64>();
     assert!(
         dp <= 1e-12 * scale,
         "momentum change {dp:e} kg·m/s, tolerance 1e-12 × Σm·1 m/s = {:e}",

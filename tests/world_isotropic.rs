@@ -48,21 +48,21 @@ fn sphere_bed_with_and_without_the_isotropic_fast_path_agree_within_tolerance() 
     };
     let (off, _, _) = run_bed(off_skips);
     assert!(
-        (0..on.bodies.len()).all(|i| matches!(on.shape(i), Shape::Sphere(_))),
+        (0..on.bodies().len()).all(|i| matches!(on.shape(i), Shape::Sphere(_))),
         "the bed must be all spheres"
     );
     let spinning = on
-        .bodies
+        .bodies()
         .iter()
         .filter(|b| b.angular_momentum.norm() > 0.0)
         .count();
     assert!(
-        spinning > on.bodies.len() / 2,
+        spinning > on.bodies().len() / 2,
         "only {spinning} of {} spheres spin: the fast path would not be exercised",
-        on.bodies.len()
+        on.bodies().len()
     );
     let (mut dx, mut dv, mut angle) = (0.0f64, 0.0f64, 0.0f64);
-    for (a, b) in on.bodies.iter().zip(&off.bodies) {
+    for (a, b) in on.bodies().iter().zip(off.bodies()) {
         assert!(
             matches!(a.motion, polydem::dynamics::Motion::Dynamic),
             "bed bodies are dynamic"
@@ -107,7 +107,7 @@ fn free_sphere_follows_the_closed_form_rotation_with_the_fast_path_only() {
         let mut materials = MaterialTable::default();
         let m = materials.add_material("m");
         materials.set_model(m, m, bed::model_of(&bed::BedSpec::rocks([1, 1, 1], 1, 0)));
-        world.materials = materials;
+        world.set_materials(materials).expect("no body yet");
         let mut body = RigidBody::new_dynamic(
             Point::origin(),
             mass,
@@ -126,7 +126,7 @@ fn free_sphere_follows_the_closed_form_rotation_with_the_fast_path_only() {
         for _ in 0..1000 {
             step(&params, &mut world, &mut scratch).expect("step");
         }
-        world.bodies[0].orientation
+        world.bodies()[0].orientation
     };
     let t = 1.0;
     let exact = Rotation::from_scaled_axis(l * (t / moments.x)) * q0;

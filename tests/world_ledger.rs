@@ -54,9 +54,9 @@ fn a_prescribed_wall_does_the_work_the_ledger_reports() {
     let steps = ((0.02 + t_c + 0.05) / params.dt) as usize;
     for _ in 0..steps {
         step(&params, &mut world, &mut scratch).expect("step");
-        max_wall_force = max_wall_force.max(-world.loads.wall_forces[0].z);
+        max_wall_force = max_wall_force.max(-world.loads().wall_forces[0].z);
     }
-    let v = world.bodies[0].velocity.z;
+    let v = world.bodies()[0].velocity.z;
     assert!(
         (v - 2.0 * u).abs() <= 1e-3 * u,
         "final velocity {v} m/s, expected 2u = {} m/s, tolerance 1e-3 u",
@@ -81,9 +81,9 @@ fn a_prescribed_wall_does_the_work_the_ledger_reports() {
         "peak reaction on the wall {max_wall_force} N, expected u√(km) = {peak} N"
     );
     assert!(
-        world.contacts.is_empty(),
+        world.contacts().is_empty(),
         "the pair should have left the store: {:?}",
-        world.contacts.keys()
+        world.contacts().keys()
     );
 }
 
@@ -136,9 +136,9 @@ fn oblique_spinning_bounce(per_contact: Real) -> (Real, Real) {
         step(&params, &mut world, &mut scratch).expect("step");
     }
     assert!(
-        world.bodies[0].velocity.z > 0.0 && world.contacts.is_empty(),
+        world.bodies()[0].velocity.z > 0.0 && world.contacts().is_empty(),
         "the sphere should have bounced off: v = {:?}",
-        world.bodies[0].velocity
+        world.bodies()[0].velocity
     );
     let e = world.energy();
     (e.balance, e.dissipated_friction)

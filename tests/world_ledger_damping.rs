@@ -95,7 +95,7 @@ fn sphere_body(world: &mut World, material: u32, shape: u32, x: Point, v: Vector
     .unwrap();
     body.velocity = v;
     body.set_angular_velocity(&w);
-    let name = format!("s{}", world.bodies.len());
+    let name = format!("s{}", world.bodies().len());
     world.add_body(&name, shape, material, body).unwrap();
 }
 
@@ -347,13 +347,15 @@ fn sphere_bed_a_ledger_over_the_first_3_ms() {
         for refinement in [1u32, 2, 4] {
             let mut sim = polydem::scene::load_scene(&path).expect("scene");
             if frictionless {
-                let n = sim.world.materials.len() as u32;
+                let n = sim.world.materials().len() as u32;
                 for a in 0..n {
                     for b in 0..n {
-                        if let Some(m) = sim.world.materials.model(a, b).copied() {
+                        if let Some(m) = sim.world.materials().model(a, b).copied() {
                             let mut m = m;
                             m.tangential = TangentialLaw::None;
-                            sim.world.materials.set_model(a, b, m);
+                            let mut laws = sim.world.materials().clone();
+                            laws.set_model(a, b, m);
+                            sim.world.set_materials(laws).expect("the same materials");
                         }
                     }
                 }

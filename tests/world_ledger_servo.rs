@@ -69,15 +69,16 @@ fn servo_run(per_contact: Real, steps: usize) -> (Real, Real, usize) {
     let mut switches = 0;
     let mut last_moving = false;
     for _ in 0..steps {
-        let force = world.loads.wall_forces.get(1).map_or(0.0, |f| f.z);
+        let force = world.loads().wall_forces.get(1).map_or(0.0, |f| f.z);
         let moving = force < cap;
         switches += usize::from(moving != last_moving);
         last_moving = moving;
-        world.walls[1].velocity = if moving {
+        let velocity = if moving {
             Vector::new(0.0, 0.0, -speed)
         } else {
             Vector::zeros()
         };
+        world.set_wall_velocity(1, velocity).expect("wall 1");
         step(&params, &mut world, &mut scratch).expect("step");
     }
     let e = world.energy();

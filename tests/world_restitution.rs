@@ -19,14 +19,14 @@ fn sphere_on_wall_rebounds_with_the_input_restitution() {
     let mut v_before = 0.0;
     let mut ratios = Vec::new();
     for _ in 0..sim.steps {
-        let v_previous = sim.world.bodies[0].velocity.z;
+        let v_previous = sim.world.bodies()[0].velocity.z;
         let report = step(&sim.params, &mut sim.world, &mut scratch).expect("step");
         let touching = report.contacts > 0;
         if touching && !in_contact {
             v_before = v_previous;
         }
         if !touching && in_contact {
-            ratios.push(-sim.world.bodies[0].velocity.z / v_before);
+            ratios.push(-sim.world.bodies()[0].velocity.z / v_before);
         }
         in_contact = touching;
     }

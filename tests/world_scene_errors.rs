@@ -86,8 +86,8 @@ fn assert_names(message: &str, path: &std::path::Path, line: usize, field: &str)
 fn the_valid_scene_loads() {
     let (_, result) = load("valid", VALID);
     let sim = result.expect("valid scene");
-    assert_eq!(sim.world.bodies.len(), 1);
-    assert_eq!(sim.world.walls.len(), 1);
+    assert_eq!(sim.world.bodies().len(), 1);
+    assert_eq!(sim.world.walls().len(), 1);
 }
 
 #[test]
@@ -233,7 +233,7 @@ fn the_documented_example_loads() {
             path.display()
         )
     });
-    assert_eq!(sim.world.bodies.len(), 2);
+    assert_eq!(sim.world.bodies().len(), 2);
     assert_eq!(sim.tracked.len(), 2);
 }
 
@@ -295,14 +295,14 @@ const GOOD_CSV: &str = "# two glass beads\nid,x,y,z,radius,vx,vy,vz\n1,0.003,0.0
 fn sphere_scene_with_box_and_body_file_loads() {
     let (_, _, result) = load_with_csv("spheres_ok", SPHERES, GOOD_CSV);
     let sim = result.expect("valid sphere scene");
-    assert_eq!(sim.world.bodies.len(), 2);
-    assert_eq!(sim.world.names, vec!["g1".to_owned(), "g2".to_owned()]);
-    assert_eq!(sim.world.walls.len(), 5, "an open-top box has five walls");
-    assert_eq!(sim.world.bodies[1].velocity.z, -0.5);
+    assert_eq!(sim.world.bodies().len(), 2);
+    assert_eq!(sim.world.names(), vec!["g1".to_owned(), "g2".to_owned()]);
+    assert_eq!(sim.world.walls().len(), 5, "an open-top box has five walls");
+    assert_eq!(sim.world.bodies()[1].velocity.z, -0.5);
     // Walls face inwards: the x+ face's normal is −x and its plane passes through max.
     let xp = sim
         .world
-        .walls
+        .walls()
         .iter()
         .find(|w| w.name == "bin.x+")
         .expect("wall bin.x+");

@@ -46,25 +46,25 @@ fn polyhedra_settle_in_a_box_at_rest_above_the_floor_with_an_exact_broad_phase()
         step(&sim.params, &mut sim.world, &mut scratch).expect("step");
         cost += t.elapsed();
         let w = &sim.world;
-        let centres: Vec<Point> = w.bodies.iter().map(|b| b.position).collect();
-        let bp = &w.broad_phase;
+        let centres: Vec<Point> = w.bodies().iter().map(|b| b.position).collect();
+        let bp = &w.broad_phase();
         if bp.rebuilds() != last_rebuilds {
             last_rebuilds = bp.rebuilds();
             // Positions do not change after the evaluation that rebuilt the list.
-            let oracle = brute_force_pairs(&centres, &w.radii, bp.skin());
+            let oracle = brute_force_pairs(&centres, w.radii(), bp.skin());
             assert_eq!(
                 bp.pairs(),
                 oracle.as_slice(),
                 "broad phase differs from brute force at step {}",
-                w.step_index
+                w.step_index()
             );
             rebuilds_checked += 1;
         }
-        for pair in brute_force_pairs(&centres, &w.radii, 0.0) {
+        for pair in brute_force_pairs(&centres, w.radii(), 0.0) {
             assert!(
                 bp.pairs().binary_search(&pair).is_ok(),
                 "step {}: bounding spheres of {pair:?} overlap but the pair is not a candidate",
-                w.step_index
+                w.step_index()
             );
         }
     }
@@ -74,23 +74,23 @@ fn polyhedra_settle_in_a_box_at_rest_above_the_floor_with_an_exact_broad_phase()
     );
 
     let w = &sim.world;
-    let g = w.gravity.norm();
-    let size: Real = w.radii.iter().sum::<Real>() * 2.0 / w.radii.len() as Real;
+    let g = w.gravity().norm();
+    let size: Real = w.radii().iter().sum::<Real>() * 2.0 / w.radii().len() as Real;
     let rest_speed = 0.01 * (g * size).sqrt();
-    for (i, b) in w.bodies.iter().enumerate() {
+    for (i, b) in w.bodies().iter().enumerate() {
         let v = b.velocity.norm();
-        let omega_r = b.angular_velocity().norm() * w.radii[i];
+        let omega_r = b.angular_velocity().norm() * w.radii()[i];
         assert!(
             v < rest_speed && omega_r < rest_speed,
             "body {i} ('{}') not at rest at t = {} s: |v| = {v:e} m/s, |ω| r = {omega_r:e} m/s, threshold 0.01 √(g d) = {rest_speed:e} m/s",
-            w.names[i],
-            w.time
+            w.names()[i],
+            w.time()
         );
         let z = lowest_z(&sim, i);
         assert!(
             z > -0.01 * size,
             "body {i} ('{}') reaches z = {z:e} m below the floor, tolerance 1 % of the mean size {size} m",
-            w.names[i]
+            w.names()[i]
         );
         assert!(
             b.position.z > 0.0,
@@ -98,7 +98,7 @@ fn polyhedra_settle_in_a_box_at_rest_above_the_floor_with_an_exact_broad_phase()
             b.position.z
         );
     }
-    let per_body_step = cost.as_secs_f64() / (sim.steps as f64 * w.bodies.len() as f64);
+    let per_body_step = cost.as_secs_f64() / (sim.steps as f64 * w.bodies().len() as f64);
     eprintln!(
         "settling box: {} steps, {:.3} µs per body per step, final kinetic energy {:e} J, balance {:e} J",
         sim.steps,
@@ -121,15 +121,20 @@ fn two_runs_are_bit_identical() {
     };
     let (a, b) = (run(), run());
     assert!(
-        a.world.contacts.states().iter().any(|s| s.is_active()),
+        a.world.contacts().states().iter().any(|s| s.is_active()),
         "no contact after 5000 steps"
     );
-    for i in 0..a.world.bodies.len() {
+    for i in 0..a.world.bodies().len() {
         assert_eq!(
-            a.world.bodies[i], b.world.bodies[i],
+            a.world.bodies()[i],
+            b.world.bodies()[i],
             "body {i} differs between two runs"
         );
     }
-    assert_eq!(a.world.contacts, b.world.contacts, "contact stores differ");
-    assert_eq!(a.world.loads, b.world.loads, "loads differ");
+    assert_eq!(
+        a.world.contacts(),
+        b.world.contacts(),
+        "contact stores differ"
+    );
+    assert_eq!(a.world.loads(), b.world.loads(), "loads differ");
 }

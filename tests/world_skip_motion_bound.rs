@@ -460,13 +460,17 @@ fn assert_same_run(
         same_work(c_off),
         "{label}: queries, GJK/EPA work and results differ with the skip on ({c_on:?}) and off ({c_off:?})"
     );
-    for (i, (a, b)) in on.bodies.iter().zip(&off.bodies).enumerate() {
+    for (i, (a, b)) in on.bodies().iter().zip(off.bodies()).enumerate() {
         for (name, x, y) in [
             ("position", a.position.coords, b.position.coords),
             ("velocity", a.velocity, b.velocity),
             ("angular momentum", a.angular_momentum, b.angular_momentum),
-            ("contact force", on.loads.forces[i], off.loads.forces[i]),
-            ("contact torque", on.loads.torques[i], off.loads.torques[i]),
+            ("contact force", on.loads().forces[i], off.loads().forces[i]),
+            (
+                "contact torque",
+                on.loads().torques[i],
+                off.loads().torques[i],
+            ),
         ] {
             assert_eq!(
                 bits(x.as_slice()),
@@ -483,10 +487,10 @@ fn assert_same_run(
         );
     }
     for (w, (x, y)) in on
-        .loads
+        .loads()
         .wall_forces
         .iter()
-        .zip(&off.loads.wall_forces)
+        .zip(&off.loads().wall_forces)
         .enumerate()
     {
         assert_eq!(
@@ -504,18 +508,18 @@ fn assert_same_run(
     // The store: the same pairs, forces, springs and warm starts; only a skipped pair's separated geometry,
     // support hints and kept proof may be older with the skip on.
     assert_eq!(
-        on.contacts.keys(),
-        off.contacts.keys(),
+        on.contacts().keys(),
+        off.contacts().keys(),
         "{label}: store keys differ"
     );
     for (k, (s, t)) in on
-        .contacts
+        .contacts()
         .states()
         .iter()
-        .zip(off.contacts.states())
+        .zip(off.contacts().states())
         .enumerate()
     {
-        let key = on.contacts.keys()[k];
+        let key = on.contacts().keys()[k];
         assert_eq!(
             (s.history, s.force_on_b, s.damping_force, s.since_step),
             (t.history, t.force_on_b, t.damping_force, t.since_step),

@@ -18,6 +18,7 @@
 mod bed;
 
 use polydem::dynamics::Motion;
+use polydem::dynamics::RigidBody;
 use polydem::law::{ContactModel, DampingLaw, TangentialLaw};
 use polydem::math::Vector;
 use polydem::world::{step, Skips, StepScratch, World};
@@ -53,7 +54,7 @@ fn bits(v: &[f64]) -> Vec<u64> {
 }
 
 fn assert_bodies_bit_identical(label: &str, on: &World, off: &World) {
-    for (i, (a, b)) in on.bodies.iter().zip(&off.bodies).enumerate() {
+    for (i, (a, b)) in on.bodies().iter().zip(off.bodies()).enumerate() {
         for (name, x, y) in [
             ("position", a.position.coords, b.position.coords),
             ("velocity", a.velocity, b.velocity),
@@ -106,13 +107,15 @@ fn frictionless_pairs_without_tangential_history_are_bit_identical() {
     };
     let build = || {
         let mut b = bed::build(&s);
-        b.world.materials.set_model(0, 0, model);
+        let mut laws = b.world.materials().clone();
+        laws.set_model(0, 0, model);
+        b.world.set_materials(laws).expect("the same materials");
         b
     };
     let (on, _) = run(build(), Skips::all(true));
     let (off, _) = run(build(), only(|k| k.frictionless_history = false));
     assert!(
-        on.contacts
+        on.contacts()
             .states()
             .iter()
             .filter(|c| c.is_active())
@@ -133,7 +136,9 @@ fn zero_damping_coefficient_skipped_is_bit_identical() {
     };
     let build = || {
         let mut b = bed::build(&s);
-        b.world.materials.set_model(0, 0, model);
+        let mut laws = b.world.materials().clone();
+        laws.set_model(0, 0, model);
+        b.world.set_materials(laws).expect("the same materials");
         b
     };
     let (on, _) = run(build(), Skips::all(true));
@@ -148,10 +153,13 @@ fn pairs_of_fixed_bodies_skipped_leave_the_dynamic_bodies_bit_identical() {
     let build = || {
         let mut b = bed::build(&s);
         // The bottom layer (the first 36 bodies) is fixed: its neighbours are pairs of fixed bodies.
-        for body in b.world.bodies.iter_mut().take(36) {
-            body.motion = Motion::Fixed;
-            body.velocity = Vector::zeros();
-            body.angular_momentum = Vector::zeros();
+        for i in 0..36 {
+            let fix = |body: &mut RigidBody| {
+                body.motion = Motion::Fixed;
+                body.velocity = Vector::zeros();
+                body.angular_momentum = Vector::zeros();
+            };
+            b.world.edit_body(i, fix).expect("a body");
         }
         b
     };
@@ -173,10 +181,14 @@ fn bodies_without_angular_momentum_skip_the_rotation_exactly() {
     };
     let build = || {
         let mut b = bed::build(&s);
-        for (body, r) in b.world.bodies.iter_mut().zip(&b.world.radii) {
-            body.angular_momentum = Vector::zeros();
-            // 0.1 mm above the floor: it lands after ~140 steps.
-            body.position.z = r + 1e-4;
+        for i in 0..b.world.body_count() {
+            let r = b.world.radii()[i];
+            let place = |body: &mut RigidBody| {
+                body.angular_momentum = Vector::zeros();
+                // 0.1 mm above the floor: it lands after ~140 steps.
+                body.position.z = r + 1e-4;
+            };
+            b.world.edit_body(i, place).expect("a body");
         }
         b
     };
@@ -190,11 +202,11 @@ fn bodies_without_angular_momentum_skip_the_rotation_exactly() {
         }),
     );
     assert!(
-        on.loads.wall_forces[0].z < 0.0,
+        on.loads().wall_forces[0].z < 0.0,
         "the spheres must reach the floor: force on the floor {:?}",
-        on.loads.wall_forces[0]
+        on.loads().wall_forces[0]
     );
-    for (i, (a, b)) in on.bodies.iter().zip(&off.bodies).enumerate() {
+    for (i, (a, b)) in on.bodies().iter().zip(off.bodies()).enumerate() {
         assert_eq!(a.angular_momentum, Vector::zeros(), "body {i} gained spin");
         assert_eq!(
             bits(a.position.coords.as_slice()),
@@ -241,7 +253,7 @@ fn query_skips_and_verlet_skin_agree_with_full_queries_within_tolerance() {
     );
     let d = bed::build(&s).diameter;
     let (mut dx, mut dv) = (0.0f64, 0.0f64);
-    for (a, b) in on.bodies.iter().zip(&off.bodies) {
+    for (a, b) in on.bodies().iter().zip(off.bodies()) {
         dx = dx.max((a.position - b.position).norm());
         dv = dv.max((a.velocity - b.velocity).norm());
     }
@@ -251,7 +263,7 @@ fn query_skips_and_verlet_skin_agree_with_full_queries_within_tolerance() {
         e_on.translational_kinetic + e_on.rotational_kinetic,
         e_off.translational_kinetic + e_off.rotational_kinetic,
     );
-    let floor = rel(on.loads.wall_forces[0].z, off.loads.wall_forces[0].z);
+    let floor = rel(on.loads().wall_forces[0].z, off.loads().wall_forces[0].z);
     eprintln!(
         "query skips on vs off after {STEPS} steps: max |Δx|/d = {:e}, max |Δv|/v0 = {:e}, kinetic energy {ke:e}, floor force {floor:e}; counters on {c_on:?} off {c_off:?}",
         dx / d,

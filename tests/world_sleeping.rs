@@ -85,7 +85,7 @@ fn strike(sleeping: bool, threads: usize) -> Outcome {
         let mut floor_while_asleep = None;
         let weight: Real = b
             .world
-            .bodies
+            .bodies()
             .iter()
             .enumerate()
             .filter(|(i, _)| *i != p)
@@ -94,13 +94,15 @@ fn strike(sleeping: bool, threads: usize) -> Outcome {
         for _ in 0..STEPS {
             let r = step(&b.params, &mut b.world, &mut scratch).expect("step");
             counters.merge(&r.counters);
-            max_sleeping = max_sleeping.max(b.world.sleep.sleeping);
-            if b.world.sleep.sleeping == b.world.bodies.len() - 1 && floor_while_asleep.is_none() {
-                floor_while_asleep = Some((-b.world.loads.wall_forces[0].z, weight));
+            max_sleeping = max_sleeping.max(b.world.sleep().sleeping);
+            if b.world.sleep().sleeping == b.world.bodies().len() - 1
+                && floor_while_asleep.is_none()
+            {
+                floor_while_asleep = Some((-b.world.loads().wall_forces[0].z, weight));
             }
         }
         Outcome {
-            velocity: b.world.bodies[p].velocity,
+            velocity: b.world.bodies()[p].velocity,
             counters,
             max_sleeping,
             floor_while_asleep,
@@ -279,7 +281,7 @@ fn strike_column(sleeping: bool, steps: usize) -> ColumnRun {
         let n = sleeping::put_to_sleep(&sleep, &mut world, 0..COLUMN);
         assert_eq!(n, COLUMN, "every sphere of the column falls asleep");
     }
-    let g = world.gravity.norm();
+    let g = world.gravity().norm();
     let mut first = vec![None; COLUMN];
     let mut top_segment = true;
     let mut counters = StepCounters::default();
@@ -287,13 +289,13 @@ fn strike_column(sleeping: bool, steps: usize) -> ColumnRun {
         let r = step(&params, &mut world, &mut scratch).expect("step");
         counters.merge(&r.counters);
         for (j, f) in first.iter_mut().enumerate() {
-            let body = &world.bodies[j];
+            let body = &world.bodies()[j];
             let disturbed = if sleeping {
-                !world.sleep.is_asleep(j)
+                !world.sleep().is_asleep(j)
             } else {
-                let net = world.loads.forces[j] + body.mass * world.gravity;
+                let net = world.loads().forces[j] + body.mass * world.gravity();
                 net.norm() > sleep.rest_force * body.mass * g
-                    || world.loads.torques[j].norm() > sleep.rest_force * body.mass * g * RADIUS
+                    || world.loads().torques[j].norm() > sleep.rest_force * body.mass * g * RADIUS
             };
             if disturbed && f.is_none() {
                 *f = Some(s);
@@ -302,17 +304,17 @@ fn strike_column(sleeping: bool, steps: usize) -> ColumnRun {
         if sleeping {
             // Awake spheres (index from the floor up) must be a top segment: no sleeping sphere above one
             // that woke.
-            let lowest_awake = (0..COLUMN).find(|&j| !world.sleep.is_asleep(j));
+            let lowest_awake = (0..COLUMN).find(|&j| !world.sleep().is_asleep(j));
             if let Some(low) = lowest_awake {
-                top_segment &= (low..COLUMN).all(|j| !world.sleep.is_asleep(j));
+                top_segment &= (low..COLUMN).all(|j| !world.sleep().is_asleep(j));
             }
         }
     }
     ColumnRun {
         first,
         top_segment,
-        positions: world.bodies.iter().map(|b| b.position).collect(),
-        striker_velocity: world.bodies[p].velocity,
+        positions: world.bodies().iter().map(|b| b.position).collect(),
+        striker_velocity: world.bodies()[p].velocity,
         sleeping_body_steps: counters.sleeping_body_steps,
     }
 }
@@ -394,7 +396,7 @@ fn far_part_of_a_touching_column_stays_asleep_and_in_place() {
         "only {far} spheres far from the front: the test needs a far part"
     );
     for j in 0..far {
-        let moved_awake = (awake.positions[j] - world.bodies[j].position).norm();
+        let moved_awake = (awake.positions[j] - world.bodies()[j].position).norm();
         assert!(
             moved_awake <= 1e-9 * diameter,
             "sphere {j} moved {moved_awake:e} m without sleeping: the far part is not at rest (tolerance 1e-9 \
@@ -405,7 +407,8 @@ fn far_part_of_a_touching_column_stays_asleep_and_in_place() {
             "sphere {j} (far from the struck top, below sphere {reached_lowest} where the pulse ended) woke"
         );
         assert_eq!(
-            asleep.positions[j], world.bodies[j].position,
+            asleep.positions[j],
+            world.bodies()[j].position,
             "sleeping sphere {j} moved"
         );
     }

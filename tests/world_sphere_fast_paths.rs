@@ -53,7 +53,7 @@ fn run_world(params: StepParams, mut world: World, steps: u64) -> World {
 
 /// The ledger's terms, as bits.
 fn ledger_bits(w: &World) -> Vec<u64> {
-    let l = &w.ledger;
+    let l = &w.ledger();
     [
         l.dissipated_damping,
         l.dissipated_friction,
@@ -79,7 +79,7 @@ fn first_difference(a: &World, b: &World) -> Option<String> {
     if let Some((k, x, y)) = world_bits::first_value_difference(&la, &lb) {
         return Some(format!("loads differ at value {k}: {x} against {y}"));
     }
-    if a.contacts != b.contacts {
+    if a.contacts() != b.contacts() {
         return Some("contact stores differ".into());
     }
     None
@@ -98,7 +98,7 @@ fn the_ledger_switch_changes_only_the_ledger() {
     if let Some(d) = first_difference(&with, &without) {
         panic!("{SCENE}, {STEPS} steps, ledger on against off: {d}");
     }
-    let (l_on, l_off) = (&with.ledger, &without.ledger);
+    let (l_on, l_off) = (with.ledger(), without.ledger());
     // With the ledger the dissipation of this run is booked (so the comparison below can fail) ...
     assert!(
         l_on.dissipated_damping > 0.0 && l_on.dissipated_friction > 0.0,
@@ -194,11 +194,11 @@ fn the_sphere_kernel_is_bit_identical_to_the_general_path_on_the_sphere_beds() {
             ledger_bits(&fast),
             ledger_bits(&general),
             "{file}, ledger {ledger}, {STEPS} steps: the ledger differs with the sphere kernel on ({:?}) and off ({:?})",
-            fast.ledger,
-            general.ledger
+            fast.ledger(),
+            general.ledger()
         );
         let touching = fast
-            .contacts
+            .contacts()
             .states()
             .iter()
             .filter(|c| c.is_active())
@@ -267,8 +267,8 @@ fn the_sphere_step_gives_the_same_bits_on_one_and_two_threads() {
             ledger_bits(&one),
             ledger_bits(&two),
             "{SCENE}, ledger {ledger}, {STEPS} steps: the ledger differs on one ({:?}) and two ({:?}) threads",
-            one.ledger,
-            two.ledger
+            one.ledger(),
+            two.ledger()
         );
     }
 }

@@ -95,7 +95,7 @@ fn impact_at_099_of_the_limit(
 
 fn kinetic(sim: &Simulation) -> Real {
     sim.world
-        .bodies
+        .bodies()
         .iter()
         .map(|b| 0.5 * b.mass * b.velocity.norm_squared())
         .sum()
@@ -215,7 +215,13 @@ fn warn_reports_the_fast_impact_and_moves_no_bit_of_the_run() {
         error_off.is_none() && error_warn.is_none(),
         "off: {error_off:?}, warn: {error_warn:?}"
     );
-    for (i, (a, b)) in off.world.bodies.iter().zip(&warn.world.bodies).enumerate() {
+    for (i, (a, b)) in off
+        .world
+        .bodies()
+        .iter()
+        .zip(warn.world.bodies())
+        .enumerate()
+    {
         assert!(
             a.position == b.position && a.velocity == b.velocity,
             "body {i}: off {:?} {:?}, warn {:?} {:?}",
@@ -271,7 +277,9 @@ fn body_at_a_million_metres_per_second_stops_instead_of_passing_through() {
     let speed = 1e6;
     let unchecked = |check: &str| {
         let mut sim = impact_at_099_of_the_limit(speed, 0.05, 0.0, Some(check));
-        sim.world.bodies[1].velocity = Vector::zeros();
+        sim.world
+            .set_body_velocity(1, Vector::zeros())
+            .expect("a body");
         sim
     };
     // Off: the body ends beyond the other, no contact.
@@ -280,8 +288,8 @@ fn body_at_a_million_metres_per_second_stops_instead_of_passing_through() {
     assert!(error.is_none(), "{error:?}");
     let contacts: usize = reports.iter().map(|r| r.contacts).sum();
     let (x0, x1) = (
-        off.world.bodies[0].position.x,
-        off.world.bodies[1].position.x,
+        off.world.bodies()[0].position.x,
+        off.world.bodies()[1].position.x,
     );
     assert!(
         x0 > x1 + 2.0 * RADIUS && contacts == 0,
@@ -323,13 +331,17 @@ fn body_at_a_million_metres_per_second_stops_instead_of_passing_through() {
 #[test]
 fn moves_beyond_half_the_skin_are_counted_per_body_and_step() {
     let mut sim = impact_at_099_of_the_limit(1.0, 0.05, 0.0, None);
-    let skin = sim.world.broad_phase.skin();
+    let skin = sim.world.broad_phase().skin();
     let dt = sim.params.dt;
     // 0.75 of the skin per step: beyond half of it, far below the diameter.
     let speed = 0.75 * skin / dt;
     assert!(2.0 * speed * dt < RADIUS, "skin {skin} m, step {dt} s");
-    sim.world.bodies[0].velocity = Vector::new(-speed, 0.0, 0.0);
-    sim.world.bodies[1].velocity = Vector::new(speed, 0.0, 0.0);
+    sim.world
+        .set_body_velocity(0, Vector::new(-speed, 0.0, 0.0))
+        .expect("a body");
+    sim.world
+        .set_body_velocity(1, Vector::new(speed, 0.0, 0.0))
+        .expect("a body");
     let steps = 5;
     let (error, reports) = run_general(&mut sim.clone(), steps);
     assert!(error.is_none(), "{error:?}");
@@ -380,8 +392,12 @@ fn two_bodies_closing_by_more_than_the_smallest_radius_per_step_stop() {
     for (fraction, stops) in [(0.6, true), (0.4, false)] {
         let mut sim = impact_at_099_of_the_limit(1.0, 1.0, 0.0, None);
         let speed = fraction * RADIUS / sim.params.dt;
-        sim.world.bodies[0].velocity = Vector::new(speed, 0.0, 0.0);
-        sim.world.bodies[1].velocity = Vector::new(-speed, 0.0, 0.0);
+        sim.world
+            .set_body_velocity(0, Vector::new(speed, 0.0, 0.0))
+            .expect("a body");
+        sim.world
+            .set_body_velocity(1, Vector::new(-speed, 0.0, 0.0))
+            .expect("a body");
         for (path, error) in [
             ("general step", run_general(&mut sim.clone(), 3).0),
             ("flat layout", run_flat(&sim, 3).0),

@@ -89,7 +89,7 @@ fn overlap_statistic_reports_the_exact_depth_of_a_cube_sunk_by_a_wide_band() {
     let exact = deepest_below_floor(&sim.world);
     let law_depth = sim
         .world
-        .contacts
+        .contacts()
         .get(&ContactKey::Wall { body: 0, wall: 0 })
         .map(|s| s.geometry.depth)
         .unwrap_or(0.0);

@@ -70,7 +70,7 @@ pub fn run<'py>(owner: &Bound<'py, PySimulation>, request: RunRequest<'py>) -> P
             Some(open_for(sim, dir, plan, request.last)?)
         }
     };
-    let start = owner.borrow().sim.world.step_index;
+    let start = owner.borrow().sim.world.step_index();
     let progress_every = ((request.last.saturating_sub(start)) / 100).max(scene::PROGRESS_STEPS);
     let chunk = if request.progress.is_some() {
         request.callback_every.min(progress_every)
@@ -80,7 +80,7 @@ pub fn run<'py>(owner: &Bound<'py, PySimulation>, request: RunRequest<'py>) -> P
     let mut next_callback = start.saturating_add(request.callback_every);
     let mut signals = SignalCheck::new();
     loop {
-        let done = owner.borrow().sim.world.step_index;
+        let done = owner.borrow().sim.world.step_index();
         if done >= request.last {
             break;
         }

@@ -62,7 +62,7 @@ impl PyScene {
     /// Number of bodies.
     #[getter]
     fn num_bodies(&self) -> usize {
-        self.sim.world.bodies.len()
+        self.sim.world.bodies().len()
     }
 
     /// Time step (s), given or derived from the contact time.
@@ -82,7 +82,7 @@ impl PyScene {
 /// handler that raises stops it early, at a step boundary ([`Interruptible`]).
 fn advance(sim: &mut Simulation, n: u64, signals: &mut SignalCheck) -> Result<(), scene::RunError> {
     let end = sim.steps;
-    sim.steps = sim.world.step_index.saturating_add(n);
+    sim.steps = sim.world.step_index().saturating_add(n);
     let result = sim.run_observed(&mut Interruptible {
         inner: Unobserved,
         signals,
@@ -131,7 +131,7 @@ impl PySimulation {
         width: usize,
         row: impl Fn(usize) -> Vec<Real>,
     ) -> PyResult<Bound<'py, PyArray2<Real>>> {
-        let rows: Vec<Vec<Real>> = (0..self.sim.world.bodies.len()).map(row).collect();
+        let rows: Vec<Vec<Real>> = (0..self.sim.world.bodies().len()).map(row).collect();
         if rows.is_empty() {
             return Ok(PyArray2::zeros(py, [0, width], false));
         }
@@ -139,8 +139,8 @@ impl PySimulation {
     }
 
     fn current_loads(&self) -> PyResult<&Loads> {
-        let loads = &self.sim.world.loads;
-        if loads.current && loads.forces.len() == self.sim.world.bodies.len() {
+        let loads = &self.sim.world.loads();
+        if loads.current && loads.forces.len() == self.sim.world.bodies().len() {
             Ok(loads)
         } else {
             Err(PyRuntimeError::new_err(
@@ -271,13 +271,13 @@ impl PySimulation {
     /// Simulated time (s).
     #[getter]
     fn time(&self) -> Real {
-        self.sim.world.time
+        self.sim.world.time()
     }
 
     /// Number of steps done since the start of the scene.
     #[getter]
     fn step_index(&self) -> u64 {
-        self.sim.world.step_index
+        self.sim.world.step_index()
     }
 
     /// Time step (s).
@@ -289,7 +289,7 @@ impl PySimulation {
     /// Number of bodies.
     #[getter]
     fn num_bodies(&self) -> usize {
-        self.sim.world.bodies.len()
+        self.sim.world.bodies().len()
     }
 
     /// End time of the scene (s); `step` may go past it.
@@ -307,18 +307,18 @@ impl PySimulation {
     /// Body names in body order.
     #[getter]
     fn names(&self) -> Vec<String> {
-        self.sim.world.names.clone()
+        self.sim.world.names().to_vec()
     }
 
     /// Centre-of-mass positions (m), a new (N, 3) array (a copy of the engine's state).
     fn positions<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<Real>>> {
-        let bodies = &self.sim.world.bodies;
+        let bodies = &self.sim.world.bodies();
         self.rows(py, 3, |i| bodies[i].position.coords.as_slice().to_vec())
     }
 
     /// Velocities of the centres of mass (m/s), a new (N, 3) array (a copy).
     fn velocities<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<Real>>> {
-        let bodies = &self.sim.world.bodies;
+        let bodies = &self.sim.world.bodies();
         self.rows(py, 3, |i| bodies[i].velocity.as_slice().to_vec())
     }
 
@@ -334,7 +334,7 @@ impl PySimulation {
 
     /// Angular velocities in the world frame (rad/s), a new (N, 3) array (a copy).
     fn angular_velocities<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<Real>>> {
-        let bodies = &self.sim.world.bodies;
+        let bodies = &self.sim.world.bodies();
         self.rows(py, 3, |i| bodies[i].angular_velocity().as_slice().to_vec())
     }
 

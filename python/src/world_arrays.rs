@@ -3,7 +3,7 @@
 use numpy::{PyArray1, PyArray2, PyArrayMethods};
 use polydem::math::{Point, Real, Vector};
 use polydem::world::{ContactKey, World};
-use pyo3::exceptions::PyKeyError;
+use pyo3::exceptions::{PyKeyError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
@@ -16,7 +16,7 @@ fn vectors<'py>(py: Python<'py>, rows: &[Vector]) -> PyResult<Bound<'py, PyArray
 /// The active contacts of the world's contact store, in the store's order (the rows of
 /// `contacts.csv`).
 pub fn contacts<'py>(py: Python<'py>, world: &World) -> PyResult<Bound<'py, PyDict>> {
-    let store = &world.contacts;
+    let store = &world.contacts();
     let (mut wall, mut a, mut b) = (Vec::new(), Vec::new(), Vec::new());
     let (mut point, mut normal, mut depth, mut force) =
         (Vec::new(), Vec::new(), Vec::new(), Vec::new());
@@ -50,21 +50,21 @@ pub fn contacts<'py>(py: Python<'py>, world: &World) -> PyResult<Bound<'py, PyDi
 
 /// The walls: names, a point of each plane, normals, velocities and the contact force on each.
 pub fn walls<'py>(py: Python<'py>, world: &World) -> PyResult<Bound<'py, PyDict>> {
-    let names: Vec<&str> = world.walls.iter().map(|w| w.name.as_str()).collect();
+    let names: Vec<&str> = world.walls().iter().map(|w| w.name.as_str()).collect();
     let points: Vec<Vector> = world
-        .walls
+        .walls()
         .iter()
         .map(|w| {
             let local = Point::from(w.plane.normal() * w.plane.offset());
             (w.pose * local).coords
         })
         .collect();
-    let normals: Vec<Vector> = world.walls.iter().map(|w| w.normal_world()).collect();
-    let velocities: Vec<Vector> = world.walls.iter().map(|w| w.velocity).collect();
-    let forces: Vec<Vector> = if world.loads.wall_forces.len() == world.walls.len() {
-        world.loads.wall_forces.clone()
+    let normals: Vec<Vector> = world.walls().iter().map(|w| w.normal_world()).collect();
+    let velocities: Vec<Vector> = world.walls().iter().map(|w| w.velocity).collect();
+    let forces: Vec<Vector> = if world.loads().wall_forces.len() == world.walls().len() {
+        world.loads().wall_forces.clone()
     } else {
-        vec![Vector::zeros(); world.walls.len()]
+        vec![Vector::zeros(); world.walls().len()]
     };
     let d = PyDict::new(py);
     d.set_item("names", names)?;
@@ -78,13 +78,12 @@ pub fn walls<'py>(py: Python<'py>, world: &World) -> PyResult<Bound<'py, PyDict>
 /// Sets the prescribed velocity of the wall `name`; a `KeyError` listing the walls if there is none.
 pub fn set_wall_velocity(world: &mut World, name: &str, velocity: [Real; 3]) -> PyResult<()> {
     let velocity = Vector::from(velocity);
-    match world.walls.iter_mut().find(|w| w.name == name) {
-        Some(wall) => {
-            wall.velocity = velocity;
-            Ok(())
-        }
+    match world.wall_index(name) {
+        Some(k) => world
+            .set_wall_velocity(k, velocity)
+            .map_err(|e| PyValueError::new_err(e.to_string())),
         None => {
-            let known: Vec<&str> = world.walls.iter().map(|w| w.name.as_str()).collect();
+            let known: Vec<&str> = world.walls().iter().map(|w| w.name.as_str()).collect();
             Err(PyKeyError::new_err(format!(
                 "no wall named {name:?}; the walls are {known:?}"
             )))

@@ -311,12 +311,12 @@ fn check_body_state(body: &RigidBody) -> Result<(), String> {
 
 fn check_consistency(sim: &Simulation) -> Result<(), String> {
     let w = &sim.world;
-    let n = w.bodies.len();
+    let n = w.bodies().len();
     let lengths = [
-        ("shape_of", w.shape_of.len()),
-        ("material_of", w.material_of.len()),
-        ("radii", w.radii.len()),
-        ("names", w.names.len()),
+        ("shape_of", w.shape_indices().len()),
+        ("material_of", w.body_materials().len()),
+        ("radii", w.radii().len()),
+        ("names", w.names().len()),
         ("frames", sim.frames.len()),
     ];
     for (what, len) in lengths {
@@ -324,74 +324,78 @@ fn check_consistency(sim: &Simulation) -> Result<(), String> {
             return Err(format!("{n} bodies but {len} entries in {what}"));
         }
     }
-    for (k, shape) in w.shapes.iter().enumerate() {
+    for (k, shape) in w.shapes().iter().enumerate() {
         if let Shape::Polyhedron(p) = shape {
             p.check_structure().map_err(|e| format!("shape {k}: {e}"))?;
         }
     }
     for i in 0..n {
-        let name = &w.names[i];
-        match w.shapes.get(w.shape_of[i] as usize) {
+        let name = &w.names()[i];
+        match w.shapes().get(w.shape_indices()[i] as usize) {
             None => {
                 return Err(format!(
                     "body {i} ('{name}'): shape {} of {}",
-                    w.shape_of[i],
-                    w.shapes.len()
+                    w.shape_indices()[i],
+                    w.shapes().len()
                 ))
             }
             Some(Shape::Plane(_)) => return Err(format!("body {i} ('{name}'): a plane shape")),
             Some(_) => {}
         }
-        if w.material_of[i] as usize >= w.materials.len() {
+        if w.body_materials()[i] as usize >= w.materials().len() {
             return Err(format!(
                 "body {i} ('{name}'): material {} of {}",
-                w.material_of[i],
-                w.materials.len()
+                w.body_materials()[i],
+                w.materials().len()
             ));
         }
-        if !(w.radii[i].is_finite() && w.radii[i] >= 0.0) {
+        if !(w.radii()[i].is_finite() && w.radii()[i] >= 0.0) {
             return Err(format!(
                 "body {i} ('{name}'): bounding radius {}",
-                w.radii[i]
+                w.radii()[i]
             ));
         }
-        check_body_state(&w.bodies[i]).map_err(|what| format!("body {i} ('{name}'): {what}"))?;
+        check_body_state(&w.bodies()[i]).map_err(|what| format!("body {i} ('{name}'): {what}"))?;
     }
-    if !(w.time.is_finite() && sim.params.dt.is_finite() && sim.params.dt > 0.0) {
-        return Err(format!("time {} s, time step {} s", w.time, sim.params.dt));
+    if !(w.time().is_finite() && sim.params.dt.is_finite() && sim.params.dt > 0.0) {
+        return Err(format!(
+            "time {} s, time step {} s",
+            w.time(),
+            sim.params.dt
+        ));
     }
-    for (k, wall) in w.walls.iter().enumerate() {
-        if wall.material as usize >= w.materials.len() {
+    for (k, wall) in w.walls().iter().enumerate() {
+        if wall.material as usize >= w.materials().len() {
             return Err(format!(
                 "wall {k} ('{}'): material {} of {}",
                 wall.name,
                 wall.material,
-                w.materials.len()
+                w.materials().len()
             ));
         }
     }
     if let Some(&t) = sim.tracked.iter().find(|&&t| t >= n) {
         return Err(format!("tracked body {t} of {n}"));
     }
-    if w.loads.current
-        && (w.loads.forces.len() != n
-            || w.loads.torques.len() != n
-            || w.loads.wall_forces.len() != w.walls.len())
+    if w.loads().current
+        && (w.loads().forces.len() != n
+            || w.loads().torques.len() != n
+            || w.loads().wall_forces.len() != w.walls().len())
     {
         return Err(format!(
             "loads for {} / {} bodies and {} walls, world has {n} bodies and {} walls",
-            w.loads.forces.len(),
-            w.loads.torques.len(),
-            w.loads.wall_forces.len(),
-            w.walls.len()
+            w.loads().forces.len(),
+            w.loads().torques.len(),
+            w.loads().wall_forces.len(),
+            w.walls().len()
         ));
     }
-    let keys = w.contacts.keys();
-    if keys.len() != w.contacts.states().len() {
+    let keys = w.contacts().keys();
+    if keys.len() != w.contacts().states().len() {
         return Err(format!(
             "contact store: {} keys, {} states",
             keys.len(),
-            w.contacts.states().len()
+            w.contacts().states().len()
         ));
     }
     if !keys.windows(2).all(|k| k[0] < k[1]) {
@@ -399,13 +403,13 @@ fn check_consistency(sim: &Simulation) -> Result<(), String> {
     }
     let key_ok = |k: &ContactKey| match *k {
         ContactKey::Body { a, b } => a < b && (b as usize) < n,
-        ContactKey::Wall { body, wall } => (body as usize) < n && (wall as usize) < w.walls.len(),
+        ContactKey::Wall { body, wall } => (body as usize) < n && (wall as usize) < w.walls().len(),
     };
     if let Some(k) = keys.iter().find(|k| !key_ok(k)) {
         return Err(format!("contact store key {k:?} out of range"));
     }
     if let Some(p) = w
-        .broad_phase
+        .broad_phase()
         .pairs()
         .iter()
         .find(|&&(i, j)| !(i < j && (j as usize) < n))

@@ -59,7 +59,7 @@ impl Output for CheckpointSeries {
         self.written.push(CheckpointRecord {
             file,
             step,
-            time: sim.world.time,
+            time: sim.world.time(),
             bytes,
             seconds: seconds.as_secs_f64(),
         });

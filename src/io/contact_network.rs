@@ -63,9 +63,9 @@ impl ContactNetwork {
     /// steps before its step are kept; the rest is rewritten as the run passes it again.
     pub fn continue_at(out_dir: &Path, world: &World, schedule: Schedule) -> io::Result<Self> {
         let path = out_dir.join("contacts.csv");
-        let csv = continue_csv(&path, CONTACTS_HEADER, world.time)
+        let csv = continue_csv(&path, CONTACTS_HEADER, world.time())
             .map_err(|e| in_file(&path, "cannot continue", e))?;
-        let frames = earlier_frames(out_dir, world.step_index)?;
+        let frames = earlier_frames(out_dir, world.step_index())?;
         Self::with(out_dir, csv, frames, schedule)
     }
 
@@ -87,13 +87,13 @@ impl ContactNetwork {
     }
 
     fn write_frame(&mut self, rows: &[Row], world: &World) -> io::Result<()> {
-        let relative = frame_name(world.step_index);
+        let relative = frame_name(world.step_index());
         let text = vtp(rows);
         let path = self.out_dir.join(&relative);
         std::fs::write(&path, &text).map_err(|e| in_file(&path, "cannot write", e))?;
         self.bytes_written += text.len() as u64;
         self.frames.retain(|(_, f)| *f != relative);
-        self.frames.push((world.time, relative));
+        self.frames.push((world.time(), relative));
         // The collection is replaced whole, so a reader never sees half of it.
         let pvd = self.out_dir.join("contacts.pvd");
         let partial = self.out_dir.join("contacts.pvd.partial");
@@ -143,7 +143,7 @@ fn earlier_frames(out_dir: &Path, step: u64) -> io::Result<Vec<(Real, String)>> 
 
 /// The active contacts of the world's contact store, in the store's order.
 fn active_contacts(world: &World) -> Vec<Row> {
-    let store = &world.contacts;
+    let store = &world.contacts();
     store
         .keys()
         .iter()
@@ -152,18 +152,18 @@ fn active_contacts(world: &World) -> Vec<Row> {
         .map(|(key, state)| match *key {
             ContactKey::Body { a, b } => Row {
                 wall: false,
-                a: world.names[a as usize].clone(),
-                b: world.names[b as usize].clone(),
-                from: world.bodies[a as usize].position,
-                to: world.bodies[b as usize].position,
+                a: world.names()[a as usize].clone(),
+                b: world.names()[b as usize].clone(),
+                from: world.bodies()[a as usize].position,
+                to: world.bodies()[b as usize].position,
                 state: *state,
             },
             ContactKey::Wall { body, wall } => Row {
                 wall: true,
-                a: world.walls[wall as usize].name.clone(),
-                b: world.names[body as usize].clone(),
+                a: world.walls()[wall as usize].name.clone(),
+                b: world.names()[body as usize].clone(),
                 from: state.geometry.point,
-                to: world.bodies[body as usize].position,
+                to: world.bodies()[body as usize].position,
                 state: *state,
             },
         })
@@ -265,7 +265,7 @@ impl Output for ContactNetwork {
 
     fn write(&mut self, sim: &Simulation, _step: u64) -> io::Result<()> {
         let rows = active_contacts(&sim.world);
-        write_csv_rows(&mut self.csv, sim.world.time, &rows)?;
+        write_csv_rows(&mut self.csv, sim.world.time(), &rows)?;
         self.write_frame(&rows, &sim.world)
     }
 

@@ -25,16 +25,29 @@ pub fn write_bodies_header(out: &mut impl Write) -> io::Result<()> {
 
 /// Writes one row per tracked body at the simulation's current time.
 pub fn write_bodies_rows(out: &mut impl Write, sim: &Simulation) -> io::Result<()> {
-    let t = sim.world.time;
+    let t = sim.world.time();
     for &i in &sim.tracked {
-        let b = &sim.world.bodies[i];
+        let b = &sim.world.bodies()[i];
         let q = sim.input_orientation(i);
         let w = b.angular_velocity();
         let (x, v) = (b.position, b.velocity);
         writeln!(
             out,
             "{t},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
-            sim.world.names[i], x.x, x.y, x.z, v.x, v.y, v.z, q.w, q.i, q.j, q.k, w.x, w.y, w.z
+            sim.world.names()[i],
+            x.x,
+            x.y,
+            x.z,
+            v.x,
+            v.y,
+            v.z,
+            q.w,
+            q.i,
+            q.j,
+            q.k,
+            w.x,
+            w.y,
+            w.z
         )?;
     }
     Ok(())
@@ -60,11 +73,11 @@ pub fn write_walls_header(out: &mut impl Write) -> io::Result<()> {
 
 /// Writes one row per wall: the contact force on it from the last evaluation (zero before the first step).
 pub fn write_walls_rows(out: &mut impl Write, sim: &Simulation) -> io::Result<()> {
-    let t = sim.world.time;
-    for (w, wall) in sim.world.walls.iter().enumerate() {
+    let t = sim.world.time();
+    for (w, wall) in sim.world.walls().iter().enumerate() {
         let f = sim
             .world
-            .loads
+            .loads()
             .wall_forces
             .get(w)
             .copied()

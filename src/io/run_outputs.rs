@@ -133,7 +133,7 @@ pub fn open_outputs<'a>(
         }
     };
     let schedule = |every: Option<u64>, at_start: bool| Schedule {
-        start_step: sim.world.step_index,
+        start_step: sim.world.step_index(),
         last_step: sim.steps,
         every,
         at_start,
@@ -144,7 +144,7 @@ pub fn open_outputs<'a>(
     let csv = schedule(Some(sim.output_every), true);
     outputs.push(
         if restarted {
-            CsvSeries::continue_at(out_dir, sim.world.time, csv)
+            CsvSeries::continue_at(out_dir, sim.world.time(), csv)
         } else {
             CsvSeries::create(out_dir, csv)
         }

@@ -72,7 +72,7 @@ fn rates(sim: &Simulation, summary: &RunSummary) -> (Real, Real, Real) {
     let steps = summary.steps as Real / secs;
     (
         steps,
-        steps * sim.world.bodies.len() as Real,
+        steps * sim.world.bodies().len() as Real,
         summary.counters.contacts as Real / secs,
     )
 }
@@ -91,9 +91,9 @@ pub fn summary_json(
         "polydem_version": env!("CARGO_PKG_VERSION"),
         "source": origin.source,
         "restarted": origin.restarted,
-        "bodies": sim.world.bodies.len(),
-        "walls": sim.world.walls.len(),
-        "shapes": sim.world.shapes.len(),
+        "bodies": sim.world.bodies().len(),
+        "walls": sim.world.walls().len(),
+        "shapes": sim.world.shapes().len(),
         "time_step": {
             "dt": sim.time_step.dt,
             "derived": sim.time_step.derived,
@@ -101,10 +101,10 @@ pub fn summary_json(
             "stability_limit": sim.time_step.stability_limit,
         },
         "start_step": origin.start_step,
-        "end_step": sim.world.step_index,
+        "end_step": sim.world.step_index(),
         "steps_run": summary.steps,
         "start_time": origin.start_time,
-        "end_time": sim.world.time,
+        "end_time": sim.world.time(),
         "wall_time_s": secs(summary.wall_time),
         "steps_per_second": steps_per_second,
         "particle_steps_per_second": particle_steps_per_second,
@@ -127,7 +127,7 @@ pub fn summary_json(
             "contacts": c.contacts,
             "contacts_created": c.contacts_created,
             "contacts_dropped": c.contacts_dropped,
-            "contact_store_entries_at_end": sim.world.contacts.len(),
+            "contact_store_entries_at_end": sim.world.contacts().len(),
         },
         "queries": c.query,
         "max_overlap_ratio": summary.max_overlap_ratio,
@@ -169,9 +169,9 @@ pub fn summary_text(
         },
         origin.source,
         origin.start_step,
-        sim.world.step_index,
+        sim.world.step_index(),
         origin.start_time,
-        sim.world.time,
+        sim.world.time(),
     );
     text.push_str(&format!(
         "rates: {steps_per_second:.3e} steps/s, particle-steps per second {particle_steps_per_second:.3e}, contacts per second {contacts_per_second:.3e}\n"

@@ -200,7 +200,8 @@ impl VtkWriter {
         let encoding = encoding.into();
         encoding.check()?;
         std::fs::create_dir_all(out_dir.join("vtk"))?;
-        let has = |pred: fn(&Shape) -> bool| (0..world.bodies.len()).any(|i| pred(world.shape(i)));
+        let has =
+            |pred: fn(&Shape) -> bool| (0..world.bodies().len()).any(|i| pred(world.shape(i)));
         let mut series = Vec::new();
         if has(|s| matches!(s, Shape::Polyhedron(_))) {
             series.push((SeriesKind::Polyhedra, Vec::new()));
@@ -208,7 +209,7 @@ impl VtkWriter {
         if has(|s| matches!(s, Shape::Sphere(_))) {
             series.push((SeriesKind::Spheres, Vec::new()));
         }
-        if !world.walls.is_empty() {
+        if !world.walls().is_empty() {
             series.push((SeriesKind::Walls, Vec::new()));
         }
         if has(|s| surface_body(s).is_some()) {
@@ -248,7 +249,7 @@ impl VtkWriter {
                 )
             })?;
             entries.extend(earlier.into_iter().filter(|(_, file)| {
-                frame_step(kind.name(), file).is_some_and(|step| step < world.step_index)
+                frame_step(kind.name(), file).is_some_and(|step| step < world.step_index())
             }));
         }
         Ok(writer)
@@ -262,7 +263,7 @@ impl VtkWriter {
     /// Writes one frame of every series at the world's current time and step, and rewrites the `.pvd` files.
     pub fn write_frame(&mut self, world: &World) -> io::Result<()> {
         let (mut points, mut cells, mut connectivity) = (0usize, 0usize, 0usize);
-        for i in 0..world.bodies.len() {
+        for i in 0..world.bodies().len() {
             if let Shape::Polyhedron(p) = world.shape(i) {
                 points += p.vertices().len();
                 cells += p.num_faces();
@@ -273,7 +274,7 @@ impl VtkWriter {
         }
         check_int32(PieceCounts { points, cells }, connectivity)?;
         for (kind, entries) in &mut self.series {
-            let relative = format!("vtk/{}_{:09}.vtu", kind.name(), world.step_index);
+            let relative = format!("vtk/{}_{:09}.vtu", kind.name(), world.step_index());
             let mut text = String::new();
             match kind {
                 SeriesKind::Polyhedra => polyhedra_vtu(&mut text, world, self.encoding),
@@ -284,7 +285,7 @@ impl VtkWriter {
             std::fs::write(self.out_dir.join(&relative), &text)?;
             self.bytes_written += text.len() as u64;
             entries.retain(|(_, f)| *f != relative);
-            entries.push((world.time, relative));
+            entries.push((world.time(), relative));
             // Replaced whole (written aside, then renamed), so a reader or a restart never sees half of it.
             let pvd = self.out_dir.join(format!("{}.pvd", kind.name()));
             let partial = self.out_dir.join(format!("{}.pvd.partial", kind.name()));
@@ -362,7 +363,7 @@ fn frame_step(series: &str, file: &str) -> Option<u64> {
 
 /// The `.vtu` text of the polyhedral bodies (see the module docs).
 pub fn polyhedra_vtu(out: &mut String, world: &World, format: VtkEncoding) -> PieceCounts {
-    let items: Vec<(usize, &ConvexPolyhedron)> = (0..world.bodies.len())
+    let items: Vec<(usize, &ConvexPolyhedron)> = (0..world.bodies().len())
         .filter_map(|i| match world.shape(i) {
             Shape::Polyhedron(p) => Some((i, p.as_ref())),
             _ => None,
@@ -374,7 +375,7 @@ pub fn polyhedra_vtu(out: &mut String, world: &World, format: VtkEncoding) -> Pi
 /// The `.vtu` text of the bodies of the other bounded shapes (ellipsoids, …) as their
 /// [`ConvexShape::surface_mesh`](crate::shape::ConvexShape::surface_mesh), written like the polyhedra.
 pub fn surfaces_vtu(out: &mut String, world: &World, format: VtkEncoding) -> PieceCounts {
-    let meshes: Vec<(usize, SurfaceMesh)> = (0..world.bodies.len())
+    let meshes: Vec<(usize, SurfaceMesh)> = (0..world.bodies().len())
         .filter_map(|i| surface_body(world.shape(i)).map(|m| (i, m)))
         .collect();
     let items: Vec<(usize, &SurfaceMesh)> = meshes.iter().map(|(i, m)| (*i, m)).collect();
@@ -510,7 +511,7 @@ fn mesh_vtu<M: MeshView + ?Sized>(
     data_array(out, format, "point_velocity", "Real", 3, |s| {
         for &i in &bodies {
             let pose = world.pose(i);
-            let body = &world.bodies[i];
+            let body = &world.bodies()[i];
             for v in poly(i).vertices() {
                 s.vec(&body.velocity_at(&(pose * v)));
             }
@@ -523,7 +524,7 @@ fn mesh_vtu<M: MeshView + ?Sized>(
 
 /// The `.vtu` text of the spherical bodies (see the module docs).
 pub fn spheres_vtu(out: &mut String, world: &World, format: VtkEncoding) -> PieceCounts {
-    let spheres: Vec<(usize, Real)> = (0..world.bodies.len())
+    let spheres: Vec<(usize, Real)> = (0..world.bodies().len())
         .filter_map(|i| match world.shape(i) {
             Shape::Sphere(s) => Some((i, s.radius())),
             _ => None,
@@ -537,7 +538,7 @@ pub fn spheres_vtu(out: &mut String, world: &World, format: VtkEncoding) -> Piec
     out.push_str("      <Points>\n");
     data_array(out, format, "Points", "Real", 3, |s| {
         for &(i, _) in &spheres {
-            s.vec(&world.bodies[i].position.coords);
+            s.vec(&world.bodies()[i].position.coords);
         }
     });
     out.push_str("      </Points>\n");
@@ -576,7 +577,7 @@ pub fn spheres_vtu(out: &mut String, world: &World, format: VtkEncoding) -> Piec
 pub fn walls_vtu(out: &mut String, world: &World, format: VtkEncoding) -> PieceCounts {
     let (lo, hi) = scene_box(world);
     let planes: Vec<(Vector, Point)> = world
-        .walls
+        .walls()
         .iter()
         .map(|w| {
             let n = w.normal_world();
@@ -632,13 +633,13 @@ pub fn walls_vtu(out: &mut String, world: &World, format: VtkEncoding) -> PieceC
         (0..polygons.len()).for_each(|k| s.int(k))
     });
     data_array(out, format, "velocity", "Real", 3, |s| {
-        world.walls.iter().for_each(|w| s.vec(&w.velocity))
+        world.walls().iter().for_each(|w| s.vec(&w.velocity))
     });
     data_array(out, format, "contact_force", "Real", 3, |s| {
-        (0..world.walls.len()).for_each(|k| {
+        (0..world.walls().len()).for_each(|k| {
             s.vec(
                 &world
-                    .loads
+                    .loads()
                     .wall_forces
                     .get(k)
                     .copied()
@@ -662,11 +663,11 @@ pub fn scene_box(world: &World) -> (Point, Point) {
         }
     };
     let mut largest_radius: Real = 0.0;
-    for (b, &r) in world.bodies.iter().zip(&world.radii) {
+    for (b, &r) in world.bodies().iter().zip(world.radii()) {
         grow(&b.position, r);
         largest_radius = largest_radius.max(r);
     }
-    for w in &world.walls {
+    for w in world.walls() {
         grow(
             &(w.pose * Point::from(w.plane.normal() * w.plane.offset())),
             0.0,
@@ -675,7 +676,7 @@ pub fn scene_box(world: &World) -> (Point, Point) {
     if !lo.x.is_finite() {
         return (Point::origin(), Point::origin());
     }
-    let margin = if world.bodies.is_empty() {
+    let margin = if world.bodies().is_empty() {
         1.0
     } else {
         0.05 * (hi - lo).norm() + largest_radius
@@ -765,13 +766,17 @@ pub fn clip_polygon(poly: &[Point], n: &Vector, p: &Point) -> Vec<Point> {
 #[allow(clippy::type_complexity)]
 fn body_vectors() -> [(&'static str, fn(&World, usize) -> Vector); 4] {
     [
-        ("velocity", |w, i| w.bodies[i].velocity),
-        ("angular_velocity", |w, i| w.bodies[i].angular_velocity()),
+        ("velocity", |w, i| w.bodies()[i].velocity),
+        ("angular_velocity", |w, i| w.bodies()[i].angular_velocity()),
         ("contact_force", |w, i| {
-            w.loads.forces.get(i).copied().unwrap_or_else(Vector::zeros)
+            w.loads()
+                .forces
+                .get(i)
+                .copied()
+                .unwrap_or_else(Vector::zeros)
         }),
         ("contact_torque", |w, i| {
-            w.loads
+            w.loads()
                 .torques
                 .get(i)
                 .copied()

@@ -119,11 +119,11 @@ impl Simulation {
         let start = Instant::now();
         let mut scratch = StepScratch::default();
         let mut summary = RunSummary::default();
-        let first = self.world.step_index + 1;
+        let first = self.world.step_index() + 1;
         on_output(self)?;
         for n in first..=self.steps {
             let report = step(&self.params, &mut self.world, &mut scratch)?;
-            summary.add(&report, self.world.step_index);
+            summary.add(&report, self.world.step_index());
             if n % self.output_every == 0 || n == self.steps {
                 on_output(self)?;
             }
@@ -144,7 +144,7 @@ impl Simulation {
         observer: &mut impl RunObserver,
     ) -> Result<RunSummary, RunError> {
         let start = Instant::now();
-        let first = self.world.step_index;
+        let first = self.world.step_index();
         observer.observe(self, first)?;
         observer.progress(first);
         let mut summary = match SphereSim::from_world(&self.world, &self.params) {
@@ -152,7 +152,7 @@ impl Simulation {
             Err(StepFlatError::NotSphereOnly(_)) => self.run_general(observer)?,
             Err(StepFlatError::Step(e)) => return Err(e.into()),
         };
-        summary.steps = self.world.step_index - first;
+        summary.steps = self.world.step_index() - first;
         summary.wall_time = start.elapsed();
         Ok(summary)
     }
@@ -169,11 +169,11 @@ impl Simulation {
     fn run_general(&mut self, observer: &mut impl RunObserver) -> Result<RunSummary, RunError> {
         let mut scratch = StepScratch::default();
         let mut summary = RunSummary::default();
-        while self.world.step_index < self.steps {
-            let end = self.stretch_end(self.world.step_index, observer);
-            while self.world.step_index < end {
+        while self.world.step_index() < self.steps {
+            let end = self.stretch_end(self.world.step_index(), observer);
+            while self.world.step_index() < end {
                 let report = step(&self.params, &mut self.world, &mut scratch)?;
-                summary.add(&report, self.world.step_index);
+                summary.add(&report, self.world.step_index());
             }
             self.after_stretch(observer, end)?;
         }
@@ -233,11 +233,11 @@ impl Simulation {
             return Err(EndTimeError::NotPositive { end_time });
         }
         let steps = step_count(end_time, dt, max_steps)?;
-        if steps < self.world.step_index {
+        if steps < self.world.step_index() {
             return Err(EndTimeError::BeforeNow {
                 end_time,
-                time: self.world.time,
-                step: self.world.step_index,
+                time: self.world.time(),
+                step: self.world.step_index(),
             });
         }
         self.end_time = end_time;

@@ -59,7 +59,7 @@ use super::time_step::TimeStepInfo;
 /// sim.set_end_time(0.02)?; // a short run
 ///
 /// let schedule = Schedule {
-///     start_step: sim.world.step_index,
+///     start_step: sim.world.step_index(),
 ///     last_step: sim.steps,
 ///     every: Some(10),
 ///     at_start: true,
@@ -101,6 +101,6 @@ pub struct Simulation {
 impl Simulation {
     /// The orientation of body `i`'s own (input) frame, as the scene gave it.
     pub fn input_orientation(&self, i: usize) -> Rotation {
-        self.world.bodies[i].orientation * self.frames[i].rotation.inverse()
+        self.world.bodies()[i].orientation * self.frames[i].rotation.inverse()
     }
 }

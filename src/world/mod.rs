@@ -10,6 +10,7 @@
 //! - [`parallel`]: deterministic per-item parallelism of the step's stages (rayon).
 //! - [`sphere_flat`]: a world of free spheres stepped from flat per-sphere arrays and a half neighbour list.
 
+mod access;
 mod body_inputs;
 pub mod broad_phase;
 pub mod contact_store;

@@ -66,6 +66,33 @@ pub enum WorldError {
         /// Second material of the pair.
         b: String,
     },
+    /// A body index that does not exist.
+    #[error("body index {body} does not exist ({count} bodies)")]
+    UnknownBody {
+        /// The index given.
+        body: usize,
+        /// Number of bodies in the world.
+        count: usize,
+    },
+    /// A wall index that does not exist.
+    #[error("wall index {wall} does not exist ({count} walls)")]
+    UnknownWall {
+        /// The index given.
+        wall: usize,
+        /// Number of walls in the world.
+        count: usize,
+    },
+    /// A body's position or velocity given to a setter is not finite.
+    #[error("body '{body}': {what} must be finite")]
+    NonFiniteBody {
+        /// Name of the body.
+        body: String,
+        /// Which quantity.
+        what: &'static str,
+    },
+    /// The gravity given is not finite.
+    #[error("gravity must be finite")]
+    NonFiniteGravity,
     /// A wall's position or velocity is not finite.
     #[error("wall '{wall}': {what} must be finite")]
     NonFiniteWall {
@@ -206,9 +233,9 @@ pub struct Loads {
 /// let mut lowest: f64 = 0.5;
 /// for _ in 0..4000 {
 ///     step(&params, &mut world, &mut scratch)?;
-///     lowest = lowest.min(world.bodies[0].position.z);
+///     lowest = lowest.min(world.body(0).position.z);
 /// }
-/// let ball = &world.bodies[0];
+/// let ball = world.body(0);
 /// assert!(lowest < 0.1, "the ball reached the floor (lowest centre {lowest} m)");
 /// assert!(ball.velocity.z > 0.0 || ball.position.z > lowest, "and bounced");
 /// // No damping, no friction: the mechanical energy is kept (the balance closes to the step's error).
@@ -219,37 +246,37 @@ pub struct Loads {
 #[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub struct World {
     /// The shapes the bodies refer to (by index).
-    pub shapes: Vec<Shape>,
+    pub(in crate::world) shapes: Vec<Shape>,
     /// State of each body (pose, velocities, mass properties, motion).
-    pub bodies: Vec<RigidBody>,
+    pub(in crate::world) bodies: Vec<RigidBody>,
     /// Index into `shapes` of each body's shape.
-    pub shape_of: Vec<u32>,
+    pub(in crate::world) shape_of: Vec<u32>,
     /// Material id of each body.
-    pub material_of: Vec<u32>,
+    pub(in crate::world) material_of: Vec<u32>,
     /// Bounding-sphere radius of each body about its centre of mass (m).
-    pub radii: Vec<Real>,
+    pub(in crate::world) radii: Vec<Real>,
     /// Name of each body.
-    pub names: Vec<String>,
+    pub(in crate::world) names: Vec<String>,
     /// The walls (planes).
-    pub walls: Vec<Wall>,
+    pub(in crate::world) walls: Vec<Wall>,
     /// Materials and the contact law of each pair.
-    pub materials: MaterialTable,
+    pub(in crate::world) materials: MaterialTable,
     /// Gravitational acceleration (m/s²).
-    pub gravity: Vector,
+    pub(in crate::world) gravity: Vector,
     /// Persistent contacts with their history (tangential springs, solver caches).
-    pub contacts: ContactStore,
+    pub(in crate::world) contacts: ContactStore,
     /// Broad phase: grid, neighbour list and Verlet skin.
-    pub broad_phase: BroadPhase,
+    pub(in crate::world) broad_phase: BroadPhase,
     /// Resultant loads of the last force evaluation.
-    pub loads: Loads,
+    pub(in crate::world) loads: Loads,
     /// Energy dissipated and work done so far.
-    pub ledger: EnergyLedger,
+    pub(in crate::world) ledger: EnergyLedger,
     /// Which bodies are asleep (see [`super::sleeping`]); empty until the first step.
-    pub sleep: SleepState,
+    pub(in crate::world) sleep: SleepState,
     /// Simulated time (s).
-    pub time: Real,
+    pub(in crate::world) time: Real,
     /// Completed steps.
-    pub step_index: u64,
+    pub(in crate::world) step_index: u64,
     /// The materials the bodies use, for the set-up checks (rebuilt after a checkpoint is read).
     #[serde(skip)]
     presence: MaterialPresence,

@@ -208,7 +208,7 @@ pub fn build(spec: &BedSpec) -> Bed {
                 lightest = lightest.min(mass);
                 let inertia = PrincipalInertia::new(moments * spec.density).expect("inertia");
                 let orientation = random_rotation(&mut rng);
-                let (below, above) = z_extent(&world.shapes[shape as usize], &orientation);
+                let (below, above) = z_extent(&world.shapes()[shape as usize], &orientation);
                 let top = &mut column_top[i + spec.cells[0] * j];
                 let z = *top + spec.gap * diameter + below;
                 *top = z + above;
@@ -278,9 +278,9 @@ pub fn add_projectile(
     let shape = bed.world.add_shape(Shape::Sphere(sphere));
     let top = bed
         .world
-        .bodies
+        .bodies()
         .iter()
-        .zip(&bed.world.radii)
+        .zip(bed.world.radii())
         .map(|(b, r)| b.position.z + r)
         .fold(0.0, Real::max);
     let mut body = RigidBody::new_dynamic(

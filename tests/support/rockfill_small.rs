@@ -23,7 +23,7 @@ pub fn small() -> ExperimentConfig {
 #[allow(dead_code)] // not every test file that includes this module packs a bed
 pub fn assert_rocks_above_floor(world: &World) {
     let lowest = world
-        .bodies
+        .bodies()
         .iter()
         .map(|b| b.position.z)
         .fold(Real::INFINITY, Real::min);

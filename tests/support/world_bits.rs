@@ -21,9 +21,9 @@ fn bits(v: &[f64]) -> Vec<u64> {
 
 /// The first body whose state differs in bits between `a` and `b`, described with both states.
 pub fn body_difference(a: &World, b: &World) -> Option<String> {
-    a.bodies
+    a.bodies()
         .iter()
-        .zip(&b.bodies)
+        .zip(b.bodies())
         .enumerate()
         .find_map(|(i, (x, y))| {
             let (fx, fy) = (body_state(x), body_state(y));
@@ -34,13 +34,13 @@ pub fn body_difference(a: &World, b: &World) -> Option<String> {
 /// The loads as one list: body forces, torques, wall forces, elastic potential, external power, then
 /// `extra`.
 pub fn load_values(w: &World, extra: &[f64]) -> Vec<f64> {
-    w.loads
+    w.loads()
         .forces
         .iter()
-        .chain(&w.loads.torques)
-        .chain(&w.loads.wall_forces)
+        .chain(&w.loads().torques)
+        .chain(&w.loads().wall_forces)
         .flat_map(|v| v.iter().copied())
-        .chain([w.loads.elastic_potential, w.loads.external_power])
+        .chain([w.loads().elastic_potential, w.loads().external_power])
         .chain(extra.iter().copied())
         .collect()
 }

@@ -99,12 +99,12 @@ fn settle(seconds: Real, damping: Real) -> Result<()> {
     let e = sim.world.energy();
     let vmax = sim
         .world
-        .bodies
+        .bodies()
         .iter()
         .map(|b| b.velocity.norm())
         .fold(0.0, Real::max);
     // The settled state: the origin of each body's own frame (its centroid, to round-off) and orientation.
-    let names: Vec<&String> = sim.world.names.iter().collect();
+    let names: Vec<&String> = sim.world.names().iter().collect();
     for b in bodies.iter_mut() {
         let name = format!("bed{}", b.id);
         let i = names
@@ -112,7 +112,7 @@ fn settle(seconds: Real, damping: Real) -> Result<()> {
             .position(|n| **n == name)
             .with_context(|| format!("settled world lacks {name}"))?;
         let r_in = sim.input_orientation(i);
-        let body = &sim.world.bodies[i];
+        let body = &sim.world.bodies()[i];
         b.position = body.position.coords - r_in * sim.frames[i].translation.vector;
         b.orientation = r_in;
     }

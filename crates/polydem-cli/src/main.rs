@@ -192,8 +192,8 @@ fn run(args: &RunArgs) -> Result<()> {
     let origin = RunOrigin {
         source,
         restarted,
-        start_step: sim.world.step_index,
-        start_time: sim.world.time,
+        start_step: sim.world.step_index(),
+        start_time: sim.world.time(),
     };
     let out_dir = args.out.as_path();
     let mut outputs = run_outputs(args, &sim, &run)?;
@@ -278,8 +278,8 @@ fn run_header(
         "{} {}: {} bodies, {} walls, dt = {:e} s ({}), shortest contact time {:e} s, stability limit {:e} s, steps {} → {} (t = {} s)",
         if origin.restarted { "restart from" } else { "scene" },
         origin.source,
-        sim.world.bodies.len(),
-        sim.world.walls.len(),
+        sim.world.bodies().len(),
+        sim.world.walls().len(),
         info.dt,
         if info.derived { "derived: t_c / steps_per_contact" } else { "given" },
         info.contact_time,
@@ -302,7 +302,7 @@ fn progress_bar(
     } else {
         indicatif::ProgressBar::new(remaining)
     };
-    let particles = sim.world.bodies.len() as f64;
+    let particles = sim.world.bodies().len() as f64;
     bar.set_style(
         indicatif::ProgressStyle::with_template(
             "{bar:20} {pos}/{len} steps {step_rate} steps/s {particle_rate} particle-steps/s eta {eta}",

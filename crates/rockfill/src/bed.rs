@@ -100,11 +100,11 @@ pub fn save_bed_checkpoint(
             contact_time: packing.contact_time,
             stability_limit: packing.dt,
         },
-        end_time: world.time,
+        end_time: world.time(),
         steps: 0,
         output_every: 1,
         tracked: Vec::new(),
-        frames: vec![Pose::identity(); world.bodies.len()],
+        frames: vec![Pose::identity(); world.bodies().len()],
     };
     let bytes = checkpoint::save(&dir.join(BED_CHECKPOINT), &sim)?;
     let text = serde_json::to_string_pretty(info).map_err(|e| info_error(e.to_string()))?;

@@ -169,9 +169,9 @@ fn apply_experiment_laws(
     world: &mut World,
     progress: Progress,
 ) -> Result<(), ExperimentError> {
-    for i in 0..world.bodies.len() {
+    for i in 0..world.bodies().len() {
         if let polydem::shape::Shape::Polyhedron(p) = world.shape(i) {
-            let bed = world.bodies[i].mass / p.mass_properties().volume;
+            let bed = world.bodies()[i].mass / p.mass_properties().volume;
             if (bed - config.rock.density).abs() > 1e-9 * config.rock.density {
                 return Err(ExperimentError::BedDensity {
                     dir: dir.display().to_string(),
@@ -182,14 +182,16 @@ fn apply_experiment_laws(
             }
         }
     }
-    let laws = empty_world(config, world.broad_phase.skin())?.materials;
-    if world.materials != laws {
+    let laws = empty_world(config, world.broad_phase().skin())?
+        .materials()
+        .clone();
+    if *world.materials() != laws {
         progress(
             "bed",
             "the experiment file's contact laws differ from those the bed was packed with: the run uses the file's"
                 .into(),
         );
-        world.materials = laws;
+        world.set_materials(laws).map_err(PackingError::from)?;
     }
     Ok(())
 }
@@ -246,7 +248,7 @@ pub fn run_experiment_with(
                 "bed",
                 format!(
                     "{} bodies from {} ({})",
-                    world.bodies.len(),
+                    world.bodies().len(),
                     dir.display(),
                     if checkpoint { "checkpoint" } else { "CSV" }
                 ),
@@ -326,7 +328,10 @@ pub fn run_experiment_with(
     };
     let index = add_projectile(config, &mut world, &projectile)?;
     if options.start_offset != polydem::math::Vector::zeros() {
-        world.bodies[index].position += options.start_offset;
+        let position = world.body(index).position + options.start_offset;
+        world
+            .set_body_position(index, position)
+            .map_err(PackingError::from)?;
     }
     let penetration = penetrate_with(
         config,

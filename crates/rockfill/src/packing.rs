@@ -184,18 +184,18 @@ pub fn add_container(
 
 /// Height of the top wall (m).
 pub fn top_wall_height(world: &World) -> Real {
-    let w = &world.walls[TOP_WALL];
+    let w = &world.walls()[TOP_WALL];
     // The wall plane passes through pose * (offset n); its height is that point's z.
     (w.pose * Point::from(w.plane.normal() * w.plane.offset())).z
 }
 
 /// Highest point of any rock (m).
 pub fn bed_top(world: &World) -> Real {
-    (0..world.bodies.len())
-        .filter(|&i| world.bodies[i].is_dynamic())
+    (0..world.bodies().len())
+        .filter(|&i| world.bodies()[i].is_dynamic())
         .map(|i| match world.shape(i) {
             Shape::Polyhedron(p) => p.aabb(&world.pose(i)).maxs.z,
-            _ => world.bodies[i].position.z + world.radii[i],
+            _ => world.bodies()[i].position.z + world.radii()[i],
         })
         .fold(Real::NEG_INFINITY, Real::max)
 }
@@ -203,7 +203,7 @@ pub fn bed_top(world: &World) -> Real {
 /// Largest rock speed (m/s).
 pub fn max_speed(world: &World) -> Real {
     world
-        .bodies
+        .bodies()
         .iter()
         .filter(|b| b.is_dynamic())
         .map(|b| b.velocity.norm())
@@ -268,7 +268,7 @@ pub fn time_step_and_limit(
 ) -> Result<(Real, Real, Real), PackingError> {
     let models = config.contact_models()?;
     let m_min = world
-        .bodies
+        .bodies()
         .iter()
         .filter(|b| b.is_dynamic())
         .map(|b| b.mass)
@@ -276,10 +276,10 @@ pub fn time_step_and_limit(
     if !m_min.is_finite() {
         return Err(PackingError::NoRocks);
     }
-    let kappa = (0..world.bodies.len())
+    let kappa = (0..world.bodies().len())
         .map(|i| {
-            let b = &world.bodies[i];
-            1.0 + b.mass * world.radii[i].powi(2) / b.inertia.0.min()
+            let b = &world.bodies()[i];
+            1.0 + b.mass * world.radii()[i].powi(2) / b.inertia.0.min()
         })
         .fold(1.0, Real::max);
     let pairs = [
@@ -427,8 +427,8 @@ pub fn loose_world(
 /// mechanical energy (J: kinetic and gravitational change, the elastic energy does not depend on the mass).
 pub fn set_rock_density(world: &mut World, density: Real) -> Result<Real, PackingError> {
     let before = world.energy().mechanical();
-    for i in 0..world.bodies.len() {
-        if !world.bodies[i].is_dynamic() {
+    for i in 0..world.bodies().len() {
+        if !world.bodies()[i].is_dynamic() {
             continue;
         }
         let Shape::Polyhedron(shape) = world.shape(i) else {
@@ -439,11 +439,12 @@ pub fn set_rock_density(world: &mut World, density: Real) -> Result<Real, Packin
             mp.mass(density),
             PrincipalInertia::new(mp.principal_inertia(density))?,
         );
-        let b = &mut world.bodies[i];
-        let ratio = mass / b.mass;
-        b.mass = mass;
-        b.inertia = inertia;
-        b.angular_momentum *= ratio;
+        world.edit_body(i, |b| {
+            let ratio = mass / b.mass;
+            b.mass = mass;
+            b.inertia = inertia;
+            b.angular_momentum *= ratio;
+        })?;
     }
     Ok(world.energy().mechanical() - before)
 }
@@ -451,7 +452,7 @@ pub fn set_rock_density(world: &mut World, density: Real) -> Result<Real, Packin
 /// Largest and mean overlap (depth) of the active contacts in the store, over `size`.
 pub fn bed_overlap(world: &World, size: Real) -> [Real; 2] {
     let depths: Vec<Real> = world
-        .contacts
+        .contacts()
         .states()
         .iter()
         .filter(|c| c.is_active())
@@ -501,14 +502,16 @@ pub fn pack_with_stop(
         None => ViscousDamping::MassProportional(p.viscous_rate),
     };
     if let Some(v0) = p.drop_speed {
-        for b in world.bodies.iter_mut().filter(|b| b.is_dynamic()) {
-            b.velocity = Vector::new(0.0, 0.0, -v0);
+        for i in 0..world.body_count() {
+            if world.body(i).is_dynamic() {
+                world.set_body_velocity(i, Vector::new(0.0, 0.0, -v0))?;
+            }
         }
     }
     params.sleeping = config.sleeping.params(config.sleeping.packing);
     let mut scratch = StepScratch::default();
     let mut report = PackingReport {
-        rocks: world.bodies.len(),
+        rocks: world.bodies().len(),
         dt,
         contact_time,
         density_scale: scale,
@@ -516,14 +519,14 @@ pub fn pack_with_stop(
     };
     let initial_top = top_wall_height(world);
     let potential0: Real = world
-        .bodies
+        .bodies()
         .iter()
         .map(|b| b.mass * 9.81 * b.position.z)
         .sum();
     // Energy scale of the settle criterion: Σ m g d̄ (at the masses of the moment: scaled or true).
     let lift_energy = |world: &World| -> Real {
         world
-            .bodies
+            .bodies()
             .iter()
             .filter(|b| b.is_dynamic())
             .map(|b| b.mass * 9.81 * config.rock.mean_size)
@@ -539,12 +542,13 @@ pub fn pack_with_stop(
                    dt: Real|
      -> Result<(), PackingError> {
         if stop::requested(stop) {
-            return Err(PackingError::Interrupted { time: world.time });
+            return Err(PackingError::Interrupted { time: world.time() });
         }
         params.dt = dt;
         let r = step(&params, world, &mut scratch)?;
         if let Some(alpha) = local_alpha {
-            world.ledger.dissipated_viscous += apply_local_damping(world, alpha, dt);
+            let removed = apply_local_damping(world, alpha, dt);
+            world.record_viscous_dissipation(removed);
         }
         report.max_overlap_ratio = report.max_overlap_ratio.max(r.max_overlap_ratio);
         report.counters[stage].merge(&r.counters);
@@ -556,13 +560,13 @@ pub fn pack_with_stop(
         PackingSample {
             stage,
             step,
-            time: world.time,
+            time: world.time(),
             max_speed: max_speed(world),
             kinetic_energy: kinetic,
             kinetic_fraction: kinetic / lift_energy(world),
             bed_top: bed_top(world),
             top_wall: top_wall_height(world),
-            wall_force: world.loads.wall_forces.get(TOP_WALL).map_or(0.0, |f| f.z),
+            wall_force: world.loads().wall_forces.get(TOP_WALL).map_or(0.0, |f| f.z),
         }
     };
     // 1. Deposition.
@@ -581,7 +585,7 @@ pub fn pack_with_stop(
     loop {
         run(world, &mut report, DEPOSITION, dt)?;
         report.deposition_steps += 1;
-        let t = world.time;
+        let t = world.time();
         if report.deposition_steps.is_multiple_of(check_every) {
             let row = sample(world, DEPOSITION, report.deposition_steps);
             report.trace.push(row);
@@ -594,36 +598,40 @@ pub fn pack_with_stop(
             }
         }
     }
-    report.deposition_time = world.time;
+    report.deposition_time = world.time();
     report.ledger_balance_relative[0] = world.energy().balance / potential0;
     report.deposited_top = bed_top(world);
     // 2. Compaction.
     let target = config.layer.height;
-    let t0 = world.time;
+    let t0 = world.time();
     if report.deposited_top > target {
         // Place the wall on the bed (a translation along its normal, before it touches anything).
         let lift = report.deposited_top - initial_top;
-        world.walls[TOP_WALL].pose.translation.vector.z += lift;
-        world.loads.current = false;
+        let mut translation = world.walls()[TOP_WALL].pose.translation.vector;
+        translation.z += lift;
+        world.set_wall_translation(TOP_WALL, translation)?;
         // The cap scales with the weights (density scaling, see the module docs).
         let force_cap = scale * p.compaction_pressure * config.layer.length * config.layer.width;
         let mut stalled_since: Option<Real> = None;
         while top_wall_height(world) > target {
             // Servo: full speed on a loose bed, slowing to a stop as the wall force nears the cap.
-            let force = world.loads.wall_forces.get(TOP_WALL).map_or(0.0, |f| f.z);
+            let force = world.loads().wall_forces.get(TOP_WALL).map_or(0.0, |f| f.z);
             let fraction = (1.0 - force / force_cap).clamp(0.0, 1.0);
-            world.walls[TOP_WALL].velocity = Vector::new(0.0, 0.0, -p.compaction_speed * fraction);
+            world.set_wall_velocity(
+                TOP_WALL,
+                Vector::new(0.0, 0.0, -p.compaction_speed * fraction),
+            )?;
             run(world, &mut report, COMPACTION, dt)?;
             report.compaction_steps += 1;
             if report.compaction_steps.is_multiple_of(check_every) {
                 report
                     .trace
                     .push(sample(world, COMPACTION, report.compaction_steps));
-                progress("compaction", world.time, top_wall_height(world));
+                progress("compaction", world.time(), top_wall_height(world));
             }
             if fraction < STALL_FRACTION {
-                let since = *stalled_since.get_or_insert(world.time);
-                if world.time - since > p.hold_time {
+                let since = *stalled_since.get_or_insert(world.time());
+                if world.time() - since > p.hold_time {
                     report.compaction_stalled = true;
                     break;
                 }
@@ -631,31 +639,32 @@ pub fn pack_with_stop(
                 stalled_since = None;
             }
         }
-        world.walls[TOP_WALL].velocity = Vector::zeros();
+        world.set_wall_velocity(TOP_WALL, Vector::zeros())?;
     }
-    report.compaction_time = world.time - t0;
+    report.compaction_time = world.time() - t0;
     report.ledger_balance_relative[1] = world.energy().balance / potential0;
     // 3. Hold.
-    let hold_end = world.time + p.hold_time;
-    while world.time < hold_end {
+    let hold_end = world.time() + p.hold_time;
+    while world.time() < hold_end {
         run(world, &mut report, HOLD, dt)?;
         report.hold_steps += 1;
         if report.hold_steps.is_multiple_of(check_every) {
             report.trace.push(sample(world, HOLD, report.hold_steps));
-            progress("hold", world.time, bed_top(world));
+            progress("hold", world.time(), bed_top(world));
         }
     }
     report.bed_overlap_after_hold = bed_overlap(world, config.rock.mean_size);
     // 4. Restore the true density (density scaling only): a geometric ramp of the density from s ρ to ρ over
     // the first half of `restore_time`, then the true density for the second half (see the module docs).
     if p.packing_density_scale.is_some() {
-        let wall_force = |world: &World| world.loads.wall_forces.get(TOP_WALL).map_or(0.0, |f| f.z);
+        let wall_force =
+            |world: &World| world.loads().wall_forces.get(TOP_WALL).map_or(0.0, |f| f.z);
         let force0 = wall_force(world);
         let restore_time = p.restore_time.unwrap_or(0.0);
-        let (t0, top0) = (world.time, top_wall_height(world));
+        let (t0, top0) = (world.time(), top_wall_height(world));
         let mut sigma = scale;
         loop {
-            let tau = ((world.time - t0) / (0.5 * restore_time)).min(1.0);
+            let tau = ((world.time() - t0) / (0.5 * restore_time)).min(1.0);
             let next = if tau >= 1.0 {
                 1.0
             } else {
@@ -669,12 +678,12 @@ pub fn pack_with_stop(
                     config.rock.density * next
                 };
                 let changed = set_rock_density(world, density)?;
-                if world.ledger.initial_total.is_some() {
-                    world.ledger.external_work += changed;
+                if world.ledger().initial_total.is_some() {
+                    world.record_external_work(changed);
                 }
                 sigma = next;
             }
-            if world.time >= t0 + restore_time {
+            if world.time() >= t0 + restore_time {
                 break;
             }
             let (dt_now, _) = packing_time_step(config, world)?;
@@ -686,17 +695,18 @@ pub fn pack_with_stop(
             } else {
                 0.0
             };
-            world.walls[TOP_WALL].velocity = Vector::new(0.0, 0.0, p.compaction_speed * excess);
+            world
+                .set_wall_velocity(TOP_WALL, Vector::new(0.0, 0.0, p.compaction_speed * excess))?;
             run(world, &mut report, RESTORE, dt_now)?;
             report.restore_steps += 1;
             if report.restore_steps.is_multiple_of(check_every) {
                 report
                     .trace
                     .push(sample(world, RESTORE, report.restore_steps));
-                progress("restore", world.time, top_wall_height(world));
+                progress("restore", world.time(), top_wall_height(world));
             }
         }
-        world.walls[TOP_WALL].velocity = Vector::zeros();
+        world.set_wall_velocity(TOP_WALL, Vector::zeros())?;
         report.restore_dt = packing_time_step(config, world)?.0;
         report.restore_wall_rise = top_wall_height(world) - top0;
         report.restore_wall_force = [force0, wall_force(world)];
@@ -704,7 +714,7 @@ pub fn pack_with_stop(
     report.bed_overlap_final = bed_overlap(world, config.rock.mean_size);
     report.final_top = bed_top(world);
     report.top_wall = top_wall_height(world);
-    let volume: Real = (0..world.bodies.len())
+    let volume: Real = (0..world.bodies().len())
         .map(|i| match world.shape(i) {
             Shape::Polyhedron(s) => s.mass_properties().volume,
             _ => 0.0,
@@ -747,32 +757,38 @@ pub fn local_damping(
 /// force F + m g, rotation with the contact torque) and returns the kinetic energy it removed (J, ≥ 0: a
 /// change that would raise a body's kinetic energy is not applied).
 pub fn apply_local_damping(world: &mut World, alpha: Real, dt: Real) -> Real {
-    let gravity = world.gravity;
+    let gravity = world.gravity();
     let mut removed = 0.0;
-    for (i, b) in world.bodies.iter_mut().enumerate() {
-        if !b.is_dynamic() {
+    for i in 0..world.body_count() {
+        if !world.body(i).is_dynamic() {
             continue;
         }
-        let (force, torque) = match (world.loads.forces.get(i), world.loads.torques.get(i)) {
+        let loads = world.loads();
+        let (force, torque) = match (loads.forces.get(i), loads.torques.get(i)) {
             (Some(f), Some(t)) => (*f, *t),
             _ => continue,
         };
         if force == Vector::zeros() && torque == Vector::zeros() {
             continue;
         }
-        let before = b.translational_kinetic_energy() + b.rotational_kinetic_energy();
-        let (v, l) = (b.velocity, b.angular_momentum);
-        let unbalanced = force + b.mass * gravity;
-        b.velocity = local_damping(&v, &v, &unbalanced, alpha, dt / b.mass);
-        let omega = b.angular_velocity();
-        b.angular_momentum = local_damping(&l, &omega, &torque, alpha, dt);
-        let after = b.translational_kinetic_energy() + b.rotational_kinetic_energy();
-        if after > before {
-            b.velocity = v;
-            b.angular_momentum = l;
-        } else {
-            removed += before - after;
-        }
+        let damp = |b: &mut RigidBody| -> Real {
+            let before = b.translational_kinetic_energy() + b.rotational_kinetic_energy();
+            let (v, l) = (b.velocity, b.angular_momentum);
+            let unbalanced = force + b.mass * gravity;
+            b.velocity = local_damping(&v, &v, &unbalanced, alpha, dt / b.mass);
+            let omega = b.angular_velocity();
+            b.angular_momentum = local_damping(&l, &omega, &torque, alpha, dt);
+            let after = b.translational_kinetic_energy() + b.rotational_kinetic_energy();
+            if after > before {
+                b.velocity = v;
+                b.angular_momentum = l;
+                0.0
+            } else {
+                before - after
+            }
+        };
+        // The index is a body's: the edit cannot fail.
+        removed += world.edit_body(i, damp).unwrap_or(0.0);
     }
     removed
 }
@@ -791,7 +807,7 @@ pub fn save_bed(world: &World, dir: &Path) -> Result<(), PackingError> {
     let mut shapes =
         std::io::BufWriter::new(std::fs::File::create(dir.join("bed_shapes.csv")).map_err(io)?);
     writeln!(shapes, "shape,vertex,x,y,z").map_err(io)?;
-    for (s, shape) in world.shapes.iter().enumerate() {
+    for (s, shape) in world.shapes().iter().enumerate() {
         if let Shape::Polyhedron(p) = shape {
             for (v, x) in p.vertices().iter().enumerate() {
                 writeln!(shapes, "{s},{v},{},{},{}", x.x, x.y, x.z).map_err(io)?;
@@ -801,19 +817,32 @@ pub fn save_bed(world: &World, dir: &Path) -> Result<(), PackingError> {
     let mut rocks =
         std::io::BufWriter::new(std::fs::File::create(dir.join("bed_rocks.csv")).map_err(io)?);
     writeln!(rocks, "rock,shape,x,y,z,qw,qx,qy,qz,vx,vy,vz,lx,ly,lz").map_err(io)?;
-    for (i, b) in world.bodies.iter().enumerate() {
+    for (i, b) in world.bodies().iter().enumerate() {
         let (p, q, v, l) = (b.position, b.orientation, b.velocity, b.angular_momentum);
         writeln!(
             rocks,
             "{i},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
-            world.shape_of[i], p.x, p.y, p.z, q.w, q.i, q.j, q.k, v.x, v.y, v.z, l.x, l.y, l.z
+            world.shape_indices()[i],
+            p.x,
+            p.y,
+            p.z,
+            q.w,
+            q.i,
+            q.j,
+            q.k,
+            v.x,
+            v.y,
+            v.z,
+            l.x,
+            l.y,
+            l.z
         )
         .map_err(io)?;
     }
     let mut walls =
         std::io::BufWriter::new(std::fs::File::create(dir.join("bed_walls.csv")).map_err(io)?);
     writeln!(walls, "wall,nx,ny,nz,px,py,pz").map_err(io)?;
-    for w in &world.walls {
+    for w in world.walls() {
         let n = w.normal_world();
         let p = w.pose * Point::from(w.plane.normal() * w.plane.offset());
         writeln!(
@@ -917,7 +946,7 @@ pub fn load_bed(config: &ExperimentConfig, dir: &Path) -> Result<World, PackingE
         let id = world.add_shape(Shape::Polyhedron(shape));
         world.add_body(&format!("rock{r}"), id, ROCK, body)?;
     }
-    if world.bodies.is_empty() {
+    if world.bodies().is_empty() {
         return Err(PackingError::NoRocks);
     }
     Ok(world)

@@ -30,8 +30,7 @@ use polydem::dynamics::{Motion, RigidBody, ViscousDamping};
 use polydem::math::{Point, Pose, Real, Vector};
 use polydem::shape::Shape;
 use polydem::world::{
-    sleeping, step, ContactKey, EnergyLedger, StepCounters, StepError, StepParams, StepScratch,
-    World, WorldError,
+    sleeping, step, ContactKey, StepCounters, StepError, StepParams, StepScratch, World, WorldError,
 };
 
 /// Why a penetration run failed.
@@ -276,19 +275,22 @@ pub fn add_projectile(
     world: &mut World,
     projectile: &Projectile,
 ) -> Result<usize, PenetrationError> {
-    if world.walls.len() != KEPT_WALLS + 2 {
+    if world.walls().len() != KEPT_WALLS + 2 {
         return Err(PenetrationError::NotABed {
-            walls: world.walls.len(),
+            walls: world.walls().len(),
             expected: KEPT_WALLS + 2,
         });
     }
     if config.sleeping.penetration {
         // The packed bed is at rest: every rock falls asleep against the walls it was packed in, so that
         // removing the left and right walls wakes the rocks they held (see `polydem::world::sleeping`).
-        sleeping::put_to_sleep(&config.sleeping.params(true), world, 0..world.bodies.len());
+        sleeping::put_to_sleep(
+            &config.sleeping.params(true),
+            world,
+            0..world.bodies().len(),
+        );
     }
-    world.walls.truncate(KEPT_WALLS);
-    world.loads.current = false;
+    world.truncate_walls(KEPT_WALLS);
     let height = top_wall_height(world).min(super::packing::bed_top(world));
     let aim = Point::new(0.0, 0.5 * config.layer.width, 0.5 * height);
     let e0 = Vector::x();
@@ -364,14 +366,14 @@ pub fn penetrate_with(
     params.damping = ViscousDamping::None;
     params.sleeping = config.sleeping.params(config.sleeping.penetration);
     let mut scratch = StepScratch::default();
-    let start_positions: Vec<Point> = world.bodies.iter().map(|b| b.position).collect();
+    let start_positions: Vec<Point> = world.bodies().iter().map(|b| b.position).collect();
     let e0 = Vector::x();
-    let kinetic0 = world.bodies[index].translational_kinetic_energy()
-        + world.bodies[index].rotational_kinetic_energy();
+    let kinetic0 = world.bodies()[index].translational_kinetic_energy()
+        + world.bodies()[index].rotational_kinetic_energy();
     // The ledger restarts here: removing walls and adding the projectile changed the energy outside it.
-    world.ledger = EnergyLedger::default();
+    world.reset_ledger();
     let mut counters = StepCounters::default();
-    let t0 = world.time;
+    let t0 = world.time();
     let length = projectile.params.length;
     let mut rows = Vec::new();
     let mut steps = 0u64;
@@ -391,22 +393,22 @@ pub fn penetrate_with(
         if !report.overlap_warnings.is_empty() {
             warned += 1;
         }
-        let body = &world.bodies[index];
+        let body = &world.bodies()[index];
         let axis = body.orientation * projectile.axis_body;
         let tip = body.position + axis * (length - axis_offset(projectile));
-        let force = world.loads.forces[index];
+        let force = world.loads().forces[index];
         let contacts = world
-            .contacts
+            .contacts()
             .keys()
             .iter()
-            .zip(world.contacts.states())
+            .zip(world.contacts().states())
             .filter(|(k, s)| {
                 matches!(k, ContactKey::Body { b, .. } if *b as usize == index)
                     && s.force_on_b != Vector::zeros()
             })
             .count();
         let row = MonitorRow {
-            time: world.time - t0,
+            time: world.time() - t0,
             position: body.position,
             tip,
             velocity: body.velocity,
@@ -431,7 +433,7 @@ pub fn penetrate_with(
         if body.velocity.norm() < 0.01 * imp.speed {
             break Outcome::Stopped;
         }
-        if world.time - t0 >= imp.max_time {
+        if world.time() - t0 >= imp.max_time {
             break Outcome::TimeLimit;
         }
         if options.max_steps.is_some_and(|max| steps >= max) {
@@ -442,15 +444,15 @@ pub fn penetrate_with(
     if !options.snapshot_tip_x.is_empty() {
         snapshots.push(snapshot(world, last.time, last.tip));
     }
-    let body = &world.bodies[index];
+    let body = &world.bodies()[index];
     // Disturbed zone.
     let aim_y = 0.5 * config.layer.width;
     let aim_z = rows.first().map_or(0.0, |r| r.position.z);
     let zone = |fraction: Real| -> (usize, Real) {
         let threshold = fraction * config.rock.mean_size;
-        let mut radii: Vec<Real> = (0..world.bodies.len())
-            .filter(|&i| i != index && world.bodies[i].is_dynamic())
-            .filter(|&i| (world.bodies[i].position - start_positions[i]).norm() > threshold)
+        let mut radii: Vec<Real> = (0..world.bodies().len())
+            .filter(|&i| i != index && world.bodies()[i].is_dynamic())
+            .filter(|&i| (world.bodies()[i].position - start_positions[i]).norm() > threshold)
             .map(|i| {
                 let p = start_positions[i];
                 ((p.y - aim_y).powi(2) + (p.z - aim_z).powi(2)).sqrt()
@@ -479,7 +481,7 @@ pub fn penetrate_with(
         outcome,
         dt,
         steps,
-        rocks: world.bodies.len() - 1,
+        rocks: world.bodies().len() - 1,
         projectile_mass: body.mass,
         residual_speed: body.velocity.norm(),
         residual_axial_velocity: body.velocity.dot(&e0),
@@ -515,7 +517,7 @@ pub fn penetrate_with(
         snapshots,
         wall_time: start.elapsed(),
         asleep_fraction: counters.sleeping_body_steps as Real
-            / (steps as Real * (world.bodies.len() - 1) as Real),
+            / (steps as Real * (world.bodies().len() - 1) as Real),
         counters,
         rows,
     })
@@ -525,7 +527,7 @@ fn snapshot(world: &World, time: Real, tip: Point) -> Snapshot {
     Snapshot {
         time,
         tip,
-        poses: (0..world.bodies.len()).map(|i| world.pose(i)).collect(),
+        poses: (0..world.bodies().len()).map(|i| world.pose(i)).collect(),
     }
 }
 

@@ -145,14 +145,14 @@ pub fn draw_sections(
     if snapshots.is_empty() {
         return Err(SectionError::Input("no snapshots".into()));
     }
-    if start_positions.len() != world.bodies.len()
+    if start_positions.len() != world.bodies().len()
         || snapshots
             .iter()
-            .any(|s| s.poses.len() != world.bodies.len())
+            .any(|s| s.poses.len() != world.bodies().len())
     {
         return Err(SectionError::Input(format!(
             "{} bodies, {} start positions, snapshots of {:?} poses",
-            world.bodies.len(),
+            world.bodies().len(),
             start_positions.len(),
             snapshots.iter().map(|s| s.poses.len()).collect::<Vec<_>>()
         )));

@@ -311,7 +311,7 @@ pub fn draw_run_sections(
         mean_size: config.rock.mean_size,
         // Twice the threshold of the disturbed zone: a rock at the threshold is mid-scale.
         displacement_scale: 2.0 * config.impact.disturbed_threshold,
-        projectile: world.bodies.len() - 1,
+        projectile: world.bodies().len() - 1,
         title,
     };
     draw_sections(path, world, &p.start_positions, &p.snapshots, &picture)?;

@@ -105,7 +105,7 @@ impl Impact {
 
 fn kinetic_energy(sim: &Simulation) -> Real {
     sim.world
-        .bodies
+        .bodies()
         .iter()
         .map(|b| b.translational_kinetic_energy() + b.rotational_kinetic_energy())
         .sum()
@@ -113,7 +113,7 @@ fn kinetic_energy(sim: &Simulation) -> Real {
 
 fn active_contacts(sim: &Simulation) -> usize {
     sim.world
-        .contacts
+        .contacts()
         .states()
         .iter()
         .filter(|s| s.is_active())
@@ -130,7 +130,7 @@ fn energy_error(steps_per_contact: Real) -> Result<(Real, Real, usize), SuiteErr
     };
     let initial = impact.run_initial_energy()?;
     let sim = impact.run()?;
-    let body = &sim.world.bodies[0];
+    let body = &sim.world.bodies()[0];
     let radius = SEMI_AXES.iter().cloned().fold(0.0, Real::max);
     let j_min = body.inertia.0.min();
     // Two equal bodies: m* = m/2; the eccentric lever arm adds R²/J per body.
@@ -169,9 +169,9 @@ fn restitution(
     };
     let sim = impact.run()?;
     let after = if wall {
-        -sim.world.bodies[0].velocity.x
+        -sim.world.bodies()[0].velocity.x
     } else {
-        sim.world.bodies[1].velocity.x - sim.world.bodies[0].velocity.x
+        sim.world.bodies()[1].velocity.x - sim.world.bodies()[0].velocity.x
     };
     let before = if wall { SPEED } else { 2.0 * SPEED };
     Ok((

@@ -119,7 +119,7 @@ struct BedRun {
 
 fn projectile_index(sim: &Simulation) -> Result<usize, SuiteError> {
     sim.world
-        .names
+        .names()
         .iter()
         .position(|n| n == "projectile")
         .ok_or_else(|| fail("no body named 'projectile'".into()))
@@ -127,7 +127,7 @@ fn projectile_index(sim: &Simulation) -> Result<usize, SuiteError> {
 
 /// Highest point of the bed (every body but the projectile) in the world's current state (m).
 fn world_bed_top(sim: &Simulation, projectile: usize) -> Real {
-    (0..sim.world.bodies.len())
+    (0..sim.world.bodies().len())
         .filter(|&i| i != projectile)
         .map(|i| {
             let pose = sim.world.pose(i);
@@ -158,11 +158,11 @@ fn run_bed(
 ) -> Result<BedRun, SuiteError> {
     let projectile = projectile_index(&sim)?;
     let steps = steps.min(sim.steps);
-    let p = &sim.world.bodies[projectile];
+    let p = &sim.world.bodies()[projectile];
     let (z0, v0) = (p.position.z, p.velocity.norm());
     let ke0 = p.translational_kinetic_energy();
     let bed_top = world_bed_top(&sim, projectile);
-    let particles = sim.world.bodies.len();
+    let particles = sim.world.bodies().len();
     let every = sim.output_every;
     ctx.progress().stage(label, steps);
     let progress = ctx.progress();
@@ -177,21 +177,26 @@ fn run_bed(
     let mut crossings = 0u64;
     let mut monitor = crossings::CrossingMonitor::new(&sim.world);
     let mut sample = |sim: &Simulation, history: &mut History| {
-        let b = &sim.world.bodies[projectile];
-        let fz = sim.world.loads.forces.get(projectile).map_or(0.0, |f| f.z);
+        let b = &sim.world.bodies()[projectile];
+        let fz = sim
+            .world
+            .loads()
+            .forces
+            .get(projectile)
+            .map_or(0.0, |f| f.z);
         let contacts = sim
             .world
-            .contacts
+            .contacts()
             .keys()
             .iter()
-            .zip(sim.world.contacts.states())
+            .zip(sim.world.contacts().states())
             .filter(|(k, s)| {
                 s.geometry.kind == ContactKind::Overlap
                     && matches!(k, polydem::world::ContactKey::Body { a, b }
                         if *a as usize == projectile || *b as usize == projectile)
             })
             .count() as Real;
-        let values = [sim.world.time, b.position.z, b.velocity.z, fz];
+        let values = [sim.world.time(), b.position.z, b.velocity.z, fz];
         non_finite += values.iter().filter(|v| !v.is_finite()).count() as u64;
         history.t.push(values[0]);
         history.z.push(values[1]);
@@ -209,7 +214,7 @@ fn run_bed(
                 run_error = Some(format!("step {n}: {e}"));
                 break;
             }
-            for s in sim.world.contacts.states() {
+            for s in sim.world.contacts().states() {
                 if s.geometry.kind == ContactKind::Overlap {
                     max_depth = max_depth.max(s.geometry.depth);
                 }
@@ -233,7 +238,7 @@ fn run_bed(
     }
     non_finite += sim
         .world
-        .bodies
+        .bodies()
         .iter()
         .filter(|b| {
             !(b.position.coords.iter().all(|v| v.is_finite())

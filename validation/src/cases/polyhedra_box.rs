@@ -76,23 +76,23 @@ fn process_cpu_seconds() -> Real {
 
 fn monitor(sim: &Simulation) -> Monitor {
     let world = &sim.world;
-    let n = world.bodies.len() as Real;
+    let n = world.bodies().len() as Real;
     let mut mean_z = 0.0;
     let mut min_z = Real::INFINITY;
     let mut kinetic = 0.0;
-    for b in &world.bodies {
+    for b in world.bodies() {
         mean_z += b.position.z / n;
         min_z = min_z.min(b.position.z);
         kinetic += b.translational_kinetic_energy();
     }
     let contacts = world
-        .contacts
+        .contacts()
         .states()
         .iter()
         .filter(|s| s.is_active())
         .count();
     Monitor {
-        time: world.time,
+        time: world.time(),
         mean_z,
         min_z,
         kinetic_energy: kinetic,
@@ -138,7 +138,7 @@ fn run_polydem(scene: &Path, ctx: &mut CaseContext) -> Result<(CodeRun, Simulati
         CodeRun {
             monitors,
             steps: summary.steps,
-            bodies: sim.world.bodies.len(),
+            bodies: sim.world.bodies().len(),
             wall_s,
             cpu_s,
             provenance: "this run".into(),
@@ -390,7 +390,7 @@ impl Case for PolyhedraBox {
         );
         let nan = sim
             .world
-            .bodies
+            .bodies()
             .iter()
             .filter(|b| !(b.position.coords.iter().all(|c| c.is_finite())))
             .count();

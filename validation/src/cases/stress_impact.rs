@@ -127,7 +127,7 @@ fn scene(p: &Params, time_step: (&str, Real), wall_only: bool) -> SceneText {
 
 fn projectile(sim: &Simulation) -> usize {
     sim.world
-        .names
+        .names()
         .iter()
         .position(|n| n == "projectile")
         .unwrap_or(0)
@@ -149,9 +149,9 @@ fn impact_run(mut sim: Simulation, steps: u64, samples: u64) -> ImpactRun {
     let (mut speed, mut height) = (Vec::new(), Vec::new());
     let mut max_vz = Real::NEG_INFINITY;
     let run = run_monitored(&mut sim, steps, (steps / samples).max(1), |s| {
-        let b = &s.world.bodies[i];
-        speed.push((s.world.time * 1e3, b.velocity.norm()));
-        height.push((s.world.time * 1e3, b.position.z));
+        let b = &s.world.bodies()[i];
+        speed.push((s.world.time() * 1e3, b.velocity.norm()));
+        height.push((s.world.time() * 1e3, b.position.z));
         max_vz = max_vz.max(b.velocity.z);
     });
     ImpactRun {
@@ -159,7 +159,7 @@ fn impact_run(mut sim: Simulation, steps: u64, samples: u64) -> ImpactRun {
         dt: sim.params.dt,
         speed,
         height,
-        final_velocity: sim.world.bodies[i].velocity,
+        final_velocity: sim.world.bodies()[i].velocity,
         max_vz,
     }
 }

@@ -157,13 +157,13 @@ fn long_run(
     // relative to the largest body size (bodies of every shape then get at least that band).
     let lightest = sim
         .world
-        .bodies
+        .bodies()
         .iter()
         .filter(|b| b.is_dynamic())
         .map(|b| b.mass)
         .fold(Real::INFINITY, Real::min);
-    let size = (0..sim.world.bodies.len())
-        .filter(|&i| sim.world.bodies[i].is_dynamic())
+    let size = (0..sim.world.bodies().len())
+        .filter(|&i| sim.world.bodies()[i].is_dynamic())
         .map(|i| sim.world.length_scale(i))
         .fold(0.0, Real::max);
     sim.params.tolerances.wall_depth = polydem::contact::WallDepth::Smoothed {
@@ -171,8 +171,8 @@ fn long_run(
     };
     // The same rule for polyhedron pairs (`polydem::contact::pair_smoothing`), whose band is relative to the
     // smaller body of the pair: relative to the smallest body size, every pair gets at least that band.
-    let smallest = (0..sim.world.bodies.len())
-        .filter(|&i| sim.world.bodies[i].is_dynamic())
+    let smallest = (0..sim.world.bodies().len())
+        .filter(|&i| sim.world.bodies()[i].is_dynamic())
         .map(|i| sim.world.length_scale(i))
         .fold(Real::INFINITY, Real::min);
     sim.params.tolerances.pair_smoothing = polydem::contact::PairSmoothing::Smoothed {
@@ -208,13 +208,13 @@ fn long_run(
         let err = sim.world.energy().balance / e0;
         worst = worst.max(err.abs());
         if n % every == 0 {
-            history.push((sim.world.time, err));
+            history.push((sim.world.time(), err));
             ctx.progress().inc(every);
         }
     }
     let outside = sim
         .world
-        .bodies
+        .bodies()
         .iter()
         .filter(|b| b.is_dynamic())
         .filter(|b| (0..3).any(|a| !(b.position[a] > 0.0 && b.position[a] < extent[a])))
@@ -226,7 +226,7 @@ fn long_run(
         outside,
         counters,
         max_overlap,
-        bodies: sim.world.bodies.iter().filter(|b| b.is_dynamic()).count(),
+        bodies: sim.world.bodies().iter().filter(|b| b.is_dynamic()).count(),
         dt: sim.params.dt,
         contact_time: sim.time_step.contact_time,
         e0,

@@ -74,12 +74,12 @@ struct OracleStats {
 fn compare_with_oracle(sim: &Simulation, stats: &mut OracleStats) {
     let w = &sim.world;
     // Before the first step the store holds no geometry yet.
-    if w.step_index == 0 {
+    if w.step_index() == 0 {
         return;
     }
     let band = ContactTolerances::default().touching;
-    for i in 0..w.bodies.len() {
-        for j in i + 1..w.bodies.len() {
+    for i in 0..w.bodies().len() {
+        for j in i + 1..w.bodies().len() {
             let (Shape::Polyhedron(a), Shape::Polyhedron(b)) = (w.shape(i), w.shape(j)) else {
                 continue;
             };
@@ -91,7 +91,10 @@ fn compare_with_oracle(sim: &Simulation, stats: &mut OracleStats) {
             };
             // The store holds exactly the candidates of the last evaluation; a pair outside it was judged
             // apart by the broad phase: separated.
-            let engine_kind = w.contacts.get(&key).map(|s| (s.geometry.kind, s.geometry));
+            let engine_kind = w
+                .contacts()
+                .get(&key)
+                .map(|s| (s.geometry.kind, s.geometry));
             let kind = engine_kind.map_or(ContactKind::Separated, |k| k.0);
             stats.pairs += 1;
             let ambiguous = signed_gap(&oracle).abs() <= 2.0 * band * size;
@@ -153,15 +156,15 @@ fn run_scene(name: &str, mut sim: Simulation, steps: u64, oracle_every: u64) -> 
             compare_with_oracle(s, &mut oracle);
         }
         if n.is_multiple_of(every) {
-            if let Some(e0) = s.world.ledger.initial_total {
-                history.push((s.world.time, s.world.energy().balance / e0));
+            if let Some(e0) = s.world.ledger().initial_total {
+                history.push((s.world.time(), s.world.energy().balance / e0));
             }
         }
         n += 1;
     });
     ShapeRun {
         name: name.into(),
-        bodies: sim.world.bodies.len(),
+        bodies: sim.world.bodies().len(),
         dt,
         steps: run.steps,
         step_error: run.step_error,
@@ -393,20 +396,20 @@ impl Case for StressShapes {
         // cube's speed, relative to the cube size (one size here).
         let light = sim
             .world
-            .bodies
+            .bodies()
             .iter()
             .map(|b| b.mass)
             .fold(Real::INFINITY, Real::min);
         let heavy_speed = sim
             .world
-            .bodies
+            .bodies()
             .iter()
             .map(|b| b.velocity.norm())
             .fold(0.0, Real::max);
         let band = heavy_speed * (light / p.normal_stiffness).sqrt() / sim.world.length_scale(0);
         sim.params.tolerances.wall_depth = polydem::contact::WallDepth::Smoothed { band };
         sim.params.tolerances.pair_smoothing = PairSmoothing::Smoothed { band };
-        let masses: Vec<Real> = sim.world.bodies.iter().map(|b| b.mass).collect();
+        let masses: Vec<Real> = sim.world.bodies().iter().map(|b| b.mass).collect();
         let ratio = masses.iter().cloned().fold(0.0, Real::max)
             / masses.iter().cloned().fold(Real::INFINITY, Real::min);
         let mass_run = run_scene("mass_ratio", sim, p.steps, p.oracle_every);

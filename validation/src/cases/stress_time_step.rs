@@ -123,8 +123,12 @@ fn build(s: &Setting, seed: u64) -> Result<(Simulation, Real), SuiteError> {
             .fold(Real::INFINITY, Real::min),
         _ => 0.0,
     };
-    sim.world.bodies[0].position.z -= min_z;
-    let e_scale = sim.world.bodies[0].mass * GRAVITY * sim.world.length_scale(0);
+    let mut position = sim.world.body(0).position;
+    position.z -= min_z;
+    sim.world
+        .set_body_position(0, position)
+        .map_err(|e| SuiteError::case(CASE, e.to_string()))?;
+    let e_scale = sim.world.bodies()[0].mass * GRAVITY * sim.world.length_scale(0);
     Ok((sim, e_scale))
 }
 
@@ -178,7 +182,7 @@ impl Case for StressTimeStep {
         for (k, s) in p.settings.iter().enumerate() {
             let (base, e_scale) = build(s, p.seed)?;
             let theory = base.time_step.stability_limit;
-            let mass = base.world.bodies[0].mass;
+            let mass = base.world.bodies()[0].mass;
             let k_n = s.stiffness;
             let is = |dt: Real| trial(&base, e_scale, dt, p.steps, p.error_limit);
             let (mut lo, mut hi) = (0.05 * theory, 50.0 * theory);

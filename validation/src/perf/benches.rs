@@ -338,7 +338,7 @@ fn steps(
 
 /// Contacts that carry a force: the work of the step figures.
 fn loaded_contacts(sim: &Simulation) -> u64 {
-    let states = sim.world.contacts.states();
+    let states = sim.world.contacts().states();
     states.iter().filter(|s| s.force_on_b.norm() > 0.0).count() as u64
 }
 
@@ -445,7 +445,7 @@ fn io(inputs: &Inputs, regions: &mut Regions) -> Result<(), String> {
         let sim = loaded
             .expect("measured")
             .map_err(|e| format!("{relative}: {e}"))?;
-        regions.set_work(sim.world.bodies.len() as u64);
+        regions.set_work(sim.world.bodies().len() as u64);
     }
     let sim = settled_box(inputs)?;
     let out = inputs.prepared.join("io");
@@ -481,6 +481,6 @@ fn io(inputs: &Inputs, regions: &mut Regions) -> Result<(), String> {
         .expect("measured")
         .map_err(|e| format!("{}: {e}", path.display()))?;
     regions.figures.last_mut().expect("just measured").1 =
-        payload.simulation.world.bodies.len() as u64;
+        payload.simulation.world.bodies().len() as u64;
     Ok(())
 }

@@ -19,19 +19,19 @@ pub struct CrossingMonitor {
 impl CrossingMonitor {
     pub fn new(world: &World) -> Self {
         Self {
-            poses: (0..world.bodies.len()).map(|i| world.pose(i)).collect(),
+            poses: (0..world.bodies().len()).map(|i| world.pose(i)).collect(),
         }
     }
 
     /// Crossings since the previous observation (or since [`CrossingMonitor::new`]).
     pub fn observe(&mut self, world: &World) -> u64 {
-        let now: Vec<Pose> = (0..world.bodies.len()).map(|i| world.pose(i)).collect();
+        let now: Vec<Pose> = (0..world.bodies().len()).map(|i| world.pose(i)).collect();
         let n = now.len().min(self.poses.len());
         let centre = |p: &Pose| Point::from(p.translation.vector);
         let travel = (0..n)
             .map(|i| (centre(&now[i]) - centre(&self.poses[i])).norm())
             .fold(0.0, Real::max);
-        let r_max = world.radii.iter().copied().fold(0.0, Real::max);
+        let r_max = world.radii().iter().copied().fold(0.0, Real::max);
         // A pair can cross only if its centres came within r_max + travel of each other, so the cells
         // of the current centres, 2 (r_max + travel) wide, hold every candidate in the 27 around a body.
         let cell = 2.0 * (r_max + travel);
@@ -50,11 +50,11 @@ impl CrossingMonitor {
         // A pair counts once, whichever centre went through the other (as the engine's monitor).
         let mut crossed: HashSet<(usize, usize)> = HashSet::new();
         for i in 0..n {
-            if !world.bodies[i].is_dynamic() {
+            if !world.bodies()[i].is_dynamic() {
                 continue;
             }
             let (x0, x1) = (centre(&self.poses[i]), centre(&now[i]));
-            for wall in &world.walls {
+            for wall in world.walls() {
                 if wall.signed_distance(&x0) >= 0.0 && wall.signed_distance(&x1) < 0.0 {
                     count += 1;
                 }
@@ -72,7 +72,7 @@ impl CrossingMonitor {
                             }
                             let r0 = self.poses[j].inverse_transform_point(&x0);
                             let r1 = now[j].inverse_transform_point(&x1);
-                            if r0.coords.norm().min(r1.coords.norm()) > world.radii[j] + travel {
+                            if r0.coords.norm().min(r1.coords.norm()) > world.radii()[j] + travel {
                                 continue;
                             }
                             if segment_enters(world.shape(j), &r0, &r1) {
@@ -149,15 +149,21 @@ normal = [0.0, 0.0, 1.0]
     fn crossing_monitor_finds_a_centre_moved_through_a_body_and_a_wall() {
         let mut sim = parse_scene(SCENE, Path::new("crossings_test.toml")).expect("scene");
         let mut monitor = CrossingMonitor::new(&sim.world);
-        sim.world.bodies[0].position = Point::new(-0.006, 0.0, 0.0);
+        sim.world
+            .set_body_position(0, Point::new(-0.006, 0.0, 0.0))
+            .expect("body 0");
         assert_eq!(
             monitor.observe(&sim.world),
             0,
             "move that stays clear of the cube"
         );
-        sim.world.bodies[0].position = Point::new(0.006, 0.0, 0.0);
+        sim.world
+            .set_body_position(0, Point::new(0.006, 0.0, 0.0))
+            .expect("body 0");
         assert_eq!(monitor.observe(&sim.world), 1, "centre through the cube");
-        sim.world.bodies[0].position = Point::new(0.006, 0.0, -0.012);
+        sim.world
+            .set_body_position(0, Point::new(0.006, 0.0, -0.012))
+            .expect("body 0");
         assert_eq!(monitor.observe(&sim.world), 1, "centre through the floor");
     }
 }

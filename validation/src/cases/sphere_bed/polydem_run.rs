@@ -46,13 +46,13 @@ pub(super) fn run_polydem(
     sim.params.energy_ledger = false;
     let projectile = sim
         .world
-        .names
+        .names()
         .iter()
         .position(|n| n == "projectile")
         .ok_or_else(|| fail(format!("{}: no body named 'projectile'", path.display())))?;
-    let z0 = sim.world.bodies[projectile].position.z;
-    let v0 = sim.world.bodies[projectile].velocity.norm();
-    let particles = sim.world.bodies.len();
+    let z0 = sim.world.bodies()[projectile].position.z;
+    let v0 = sim.world.bodies()[projectile].velocity.norm();
+    let particles = sim.world.bodies().len();
     let mut history = History::default();
     let steps = sim.steps;
     let stage = if threads == 1 {
@@ -158,16 +158,16 @@ impl RunObserver for ProjectileSamples<'_> {
     }
 
     fn observe(&mut self, s: &Simulation, _: u64) -> std::io::Result<()> {
-        let b = &s.world.bodies[self.projectile];
+        let b = &s.world.bodies()[self.projectile];
         // No loads before the first step: the projectile starts out of contact.
         let fz = s
             .world
-            .loads
+            .loads()
             .forces
             .get(self.projectile)
             .map_or(0.0, |f| f.z);
         let h = &mut *self.history;
-        h.t.push(s.world.time);
+        h.t.push(s.world.time());
         h.z.push(b.position.z);
         h.vz.push(b.velocity.z);
         h.fz.push(fz);
