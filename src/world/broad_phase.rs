@@ -4,8 +4,8 @@
 //! invalidate the list). Two bodies are a candidate pair when their spheres, each inflated by half the skin,
 //! overlap: `|x_i − x_j| < r_i + r_j + skin`. The list stays valid — it contains every pair that can touch —
 //! until some body has moved more than `skin / 2` from where it was at the last rebuild, so the grid is rebuilt
-//! only then ([`BroadPhase::needs_rebuild`]). The step uses the sharper test of the two largest moves
-//! ([`BroadPhase::pairs_may_be_stale`]: valid while d₁ + d₂ < skin), which lets one fast body travel nearly
+//! only then (`BroadPhase::needs_rebuild`). The step uses the sharper test of the two largest moves
+//! (`BroadPhase::pairs_may_be_stale`: valid while d₁ + d₂ < skin), which lets one fast body travel nearly
 //! the whole skin.
 //!
 //! The grid's cell size is the median inflated diameter, so a typical body covers one to eight cells; a body
@@ -147,19 +147,19 @@ impl BroadPhase {
     }
 
     /// The body centres at the last build (empty before the first).
-    pub fn centres_at_build(&self) -> &[Point] {
+    pub(crate) fn centres_at_build(&self) -> &[Point] {
         &self.centres_at_build
     }
 
     /// (skin / 2)²: a body whose centre is this far (squared) from where it was at the last build makes
     /// [`needs_rebuild`](Self::needs_rebuild) true.
-    pub fn rebuild_limit_sq(&self) -> Real {
+    pub(crate) fn rebuild_limit_sq(&self) -> Real {
         0.25 * self.skin * self.skin
     }
 
     /// Whether the pair list may have become incomplete: the body count changed, or some body moved more than
     /// half the skin since the last rebuild.
-    pub fn needs_rebuild(&self, centres: &[Point]) -> bool {
+    pub(crate) fn needs_rebuild(&self, centres: &[Point]) -> bool {
         if centres.len() != self.centres_at_build.len() || self.rebuilds == 0 {
             return true;
         }
@@ -179,7 +179,7 @@ impl BroadPhase {
     /// the skin, which implies it; this test lets one fast body (a projectile among resting rocks) travel
     /// nearly the whole skin between builds, so the grid is rebuilt about half as often. `centres` must hold
     /// one centre per body of the last build.
-    pub fn pairs_may_be_stale(&self, centres: &[Point], walls: &[Wall]) -> bool {
+    pub(crate) fn pairs_may_be_stale(&self, centres: &[Point], walls: &[Wall]) -> bool {
         if centres.len() != self.centres_at_build.len()
             || walls.len() != self.walls_at_build.len()
             || self.rebuilds == 0
@@ -213,7 +213,7 @@ impl BroadPhase {
     }
 
     /// Whether a wall was added or removed, or moved half the skin, since the last build with walls.
-    pub fn walls_moved(&self, walls: &[Wall]) -> bool {
+    pub(crate) fn walls_moved(&self, walls: &[Wall]) -> bool {
         if walls.len() != self.walls_at_build.len() {
             return true;
         }
@@ -242,7 +242,7 @@ impl BroadPhase {
 
     /// [`BroadPhase::rebuild_with_walls`] within the stage timed by `clock` (the parallel pair search is
     /// not serial time).
-    pub fn rebuild_with_walls_timed(
+    pub(crate) fn rebuild_with_walls_timed(
         &mut self,
         centres: &[Point],
         radii: &[Real],
@@ -283,7 +283,7 @@ impl BroadPhase {
         self.generation = fresh_generation();
     }
 
-    /// Rebuilds the pair list if [`needs_rebuild`](Self::needs_rebuild); returns whether it did.
+    /// Rebuilds the pair list if `needs_rebuild`; returns whether it did.
     pub fn update(&mut self, centres: &[Point], radii: &[Real]) -> bool {
         if self.needs_rebuild(centres) {
             self.rebuild(centres, radii);
@@ -513,7 +513,7 @@ fn spheres_within(c1: Point, r1: Real, c2: Point, r2: Real, skin: Real) -> bool 
 
 /// The body–wall candidates: `(body, wall)` for every body whose signed distance from the wall's plane is
 /// below its radius plus `skin`, sorted by body then wall. O(bodies × walls) — the handful of walls of a box.
-pub fn brute_force_wall_pairs(
+pub(crate) fn brute_force_wall_pairs(
     centres: &[Point],
     radii: &[Real],
     walls: &[Wall],

@@ -27,7 +27,7 @@
 //! plain sorted data that serialises and compares bit for bit.
 //!
 //! # Pairs of a body
-//! [`ContactStore::body_adjacency`] lists, for every body, the store entries it takes part in, in key order
+//! `ContactStore::body_adjacency` lists, for every body, the store entries it takes part in, in key order
 //! (compressed rows: [`BodyAdjacency`]). The step sums the forces on each body over its row — the same
 //! additions in the same order as a scatter over the candidates, so the same bits — with the bodies in
 //! parallel. The rows are derived from the keys only: built on first use after a sync that changed the
@@ -243,7 +243,12 @@ impl ContactStore {
     /// [`sync`](Self::sync) with a tag that identifies the content of `candidates` (nonzero, and a list
     /// with another content never gets the same tag; 0: unknown): when the last sync had the same tag, the
     /// keys are the candidates already and the comparison of the two lists is skipped.
-    pub fn sync_tagged(&mut self, candidates: &[ContactKey], tag: u64, step: u64) -> SyncCounts {
+    pub(crate) fn sync_tagged(
+        &mut self,
+        candidates: &[ContactKey],
+        tag: u64,
+        step: u64,
+    ) -> SyncCounts {
         debug_assert!(candidates.windows(2).all(|w| w[0] < w[1]));
         self.last_touched = step;
         if tag != 0 && tag == self.synced_tag {
@@ -301,13 +306,13 @@ impl ContactStore {
     }
 
     /// The states, mutable, in key order.
-    pub fn states_mut(&mut self) -> &mut [ContactState] {
+    pub(crate) fn states_mut(&mut self) -> &mut [ContactState] {
         &mut self.states
     }
 
     /// For every one of `bodies` bodies, the entries it takes part in, in key order (built here if the keys
     /// changed since the last call; see the module docs).
-    pub fn body_adjacency(&mut self, bodies: usize) -> &BodyAdjacency {
+    pub(crate) fn body_adjacency(&mut self, bodies: usize) -> &BodyAdjacency {
         if !self.adjacency.valid || self.adjacency.bodies != bodies {
             self.adjacency.build(&self.keys, bodies);
         }

@@ -193,7 +193,7 @@ impl ContactWork {
     /// The terms of an overlapping contact whose last evaluation applied no force to book (a new
     /// contact): `relative_velocity` is v_B − v_A at the contact point with the half-step velocities.
     #[inline(always)]
-    pub fn of_new_contact(
+    pub(crate) fn of_new_contact(
         response: &ContactResponse,
         relative_velocity: &Vector,
         dt: Real,
@@ -215,7 +215,7 @@ impl ContactWork {
     /// corrected by the difference between the work the last spring force did with the integrator's
     /// lever arms, ½ Δt f_s^n·v_prev, and the work the law's increment assumed, −½ k_t^n u_prev·v_t Δt.
     #[inline(always)]
-    pub fn of_evaluation(
+    pub(crate) fn of_evaluation(
         previous: &LastForces,
         previous_velocity: &Vector,
         normal: &Vector,
@@ -251,7 +251,7 @@ impl ContactWork {
     /// that evaluation acted for the first half kick, with `relative_velocity` at the last contact point
     /// and the last lever arms; the spring is released ([`release_spring`], the law's k_t at zero
     /// overlap; `tangential` is the tangential slot of the pair's model).
-    pub fn of_release(
+    pub(crate) fn of_release(
         tangential: &TangentialLaw,
         previous: &LastForces,
         relative_velocity: &Vector,

@@ -32,7 +32,7 @@
 //! in item order.
 //!
 //! Small scenes run serially: below [`Parallelism::min_candidates`] candidates (narrow phase, laws, force
-//! sums) or [`Parallelism::min_bodies`] units of integration work ([`integration_work`]: a body with
+//! sums) or [`Parallelism::min_bodies`] units of integration work (`integration_work`: a body with
 //! unequal principal moments counts [`ANISOTROPIC_WEIGHT`]) the fork/join overhead of rayon exceeds the
 //! work.
 //!
@@ -64,14 +64,14 @@ pub const CHUNKS_PER_THREAD: usize = 32;
 /// also holds the force sums (figures: `docs/tuning.md`).
 pub const DEFAULT_MIN_CANDIDATES: usize = 4096;
 
-/// Default [`Parallelism::min_bodies`]: 8192 units of integration work ([`integration_work`]), a small
+/// Default [`Parallelism::min_bodies`]: 8192 units of integration work (`integration_work`), a small
 /// margin above the break-even count of a sphere's kick and drift (figures: `docs/tuning.md`): 10⁴ spheres
 /// integrate in parallel, a few thousand bodies at rest stay serial. Tumbling polyhedra cost several
 /// times more ([`ANISOTROPIC_WEIGHT`]): 2048 of them are enough.
 pub const DEFAULT_MIN_BODIES: usize = 8192;
 
 /// Weight of a dynamic body with unequal principal moments in the integration's work
-/// ([`integration_work`]): its rotation splitting (three sub-rotations per drift) costs about this many
+/// (`integration_work`): its rotation splitting (three sub-rotations per drift) costs about this many
 /// sphere kicks and drifts (the ratio of the two measured with `examples/perf_threads.rs`: `docs/tuning.md`).
 pub const ANISOTROPIC_WEIGHT: usize = 4;
 
@@ -82,7 +82,7 @@ pub const ANISOTROPIC_WEIGHT: usize = 4;
 pub struct Parallelism {
     /// Narrow phase and laws run in parallel from this many candidates on.
     pub min_candidates: usize,
-    /// The integration runs in parallel from this much work on ([`integration_work`]: bodies, a body with
+    /// The integration runs in parallel from this much work on (`integration_work`: bodies, a body with
     /// unequal principal moments counting [`ANISOTROPIC_WEIGHT`]).
     pub min_bodies: usize,
 }
@@ -104,12 +104,12 @@ pub struct Worker {
     /// Counters of the queries of this chunk.
     pub query: QueryCounters,
     /// Items of this chunk that the caller marked for a serial pass after the region, in item order
-    /// (cleared by [`for_each_chunked`]). Chunks are contiguous ranges of items in chunk order, so the
+    /// (cleared by `for_each_chunked`). Chunks are contiguous ranges of items in chunk order, so the
     /// lists of the workers taken in order are the marked items in item order, for any number of chunks:
     /// a serial pass over them sees the same items in the same order as one over all items that skips the
     /// unmarked ones.
     pub picked: Vec<u32>,
-    /// Items of this chunk counted by the caller (cleared by [`for_each_chunked`]).
+    /// Items of this chunk counted by the caller (cleared by `for_each_chunked`).
     pub tally: u64,
 }
 
@@ -136,7 +136,7 @@ fn on_pool(parallel: bool, n: usize) -> bool {
 /// struck region's expensive pairs are contiguous in candidate order). Rayon's default adaptive split
 /// stops at a few large runs of chunks unless they are stolen, and a run taken by one thread could not be
 /// shared any more.
-pub fn for_each_chunked<S, O, E, F>(
+pub(crate) fn for_each_chunked<S, O, E, F>(
     parallel: bool,
     states: &mut [S],
     out: &mut [O],
@@ -188,7 +188,7 @@ where
 }
 
 /// Calls `f(i, &mut items[i])` for every item, in parallel when `parallel` (chunks of items, each a job:
-/// see [`for_each_chunked`]; `f` must not depend on the order).
+/// see `for_each_chunked`; `f` must not depend on the order).
 pub fn for_each_item<T, F>(parallel: bool, items: &mut [T], f: F)
 where
     T: Send,
@@ -216,7 +216,11 @@ where
 /// Calls `f(i, &mut items[i])` for every item, in parallel when `parallel`, and returns the first item (in
 /// item order) for which `f` returned an error, with that error. Every item is visited whatever fails, so
 /// the items end in the same state for any number of threads.
-pub fn for_each_item_checked<T, E, F>(parallel: bool, items: &mut [T], f: F) -> Option<(usize, E)>
+pub(crate) fn for_each_item_checked<T, E, F>(
+    parallel: bool,
+    items: &mut [T],
+    f: F,
+) -> Option<(usize, E)>
 where
     T: Send,
     E: Send,
@@ -254,7 +258,7 @@ where
 /// Calls `f(i, &mut a[i], &mut b[i], &mut c[i])` for every item, in parallel when `parallel`, and returns
 /// the first item (in item order) for which `f` returned an error, with that error. Every item is visited
 /// whatever fails, so the items end in the same state for any number of threads.
-pub fn for_each_item3_checked<A, B, C, E, F>(
+pub(crate) fn for_each_item3_checked<A, B, C, E, F>(
     parallel: bool,
     a: &mut [A],
     b: &mut [B],
@@ -306,7 +310,7 @@ where
 
 /// Calls `f(i, &mut a[i], &mut b[i], &mut c[i], &mut d[i])` for every item, in parallel when `parallel`
 /// (the chunks and jobs of [`for_each_item3`]; `f` must not depend on the order).
-pub fn for_each_item4<A, B, C, D, F>(
+pub(crate) fn for_each_item4<A, B, C, D, F>(
     parallel: bool,
     a: &mut [A],
     b: &mut [B],
@@ -356,8 +360,13 @@ pub fn for_each_item4<A, B, C, D, F>(
 
 /// Calls `f(i, &mut a[i], &mut b[i], &mut c[i])` for every item, in parallel when `parallel` (chunks of
 /// items, each a job; `f` must not depend on the order).
-pub fn for_each_item3<A, B, C, F>(parallel: bool, a: &mut [A], b: &mut [B], c: &mut [C], f: F)
-where
+pub(crate) fn for_each_item3<A, B, C, F>(
+    parallel: bool,
+    a: &mut [A],
+    b: &mut [B],
+    c: &mut [C],
+    f: F,
+) where
     A: Send,
     B: Send,
     C: Send,
@@ -382,7 +391,7 @@ where
 
 /// Calls `f(i, &mut a[i], &mut b[i])` for every item, in parallel when `parallel` (chunks of items, each a
 /// job; `f` must not depend on the order).
-pub fn for_each_item_pair<A, B, F>(parallel: bool, a: &mut [A], b: &mut [B], f: F)
+pub(crate) fn for_each_item_pair<A, B, F>(parallel: bool, a: &mut [A], b: &mut [B], f: F)
 where
     A: Send,
     B: Send,
@@ -411,6 +420,6 @@ where
 /// The integration's work in units of a sphere's kick and drift, compared with
 /// [`Parallelism::min_bodies`]: `bodies` plus [`ANISOTROPIC_WEIGHT`] − 1 more per dynamic body with unequal
 /// principal moments.
-pub fn integration_work(bodies: usize, anisotropic: usize) -> usize {
+pub(crate) fn integration_work(bodies: usize, anisotropic: usize) -> usize {
     bodies + (ANISOTROPIC_WEIGHT - 1) * anisotropic
 }

@@ -219,13 +219,13 @@ impl Drop for ChunkTimer {
 
 /// Starts a serial section whose end is not in the same closure (see [`serial_end`]).
 #[inline]
-pub fn serial_start() -> Option<(u64, Instant)> {
+pub(crate) fn serial_start() -> Option<(u64, Instant)> {
     enabled().then(|| (thread_cpu_ns(), Instant::now()))
 }
 
 /// Ends a serial section started by [`serial_start`] (nothing if the profile was off then).
 #[inline]
-pub fn serial_end(section: Section, start: Option<(u64, Instant)>) {
+pub(crate) fn serial_end(section: Section, start: Option<(u64, Instant)>) {
     let Some((c0, t0)) = start else {
         return;
     };

@@ -79,13 +79,13 @@ impl StageClock {
 
     /// Starts a serial section of the profile whose end is not in the same closure.
     #[inline]
-    pub fn serial_start(&self) -> Option<(u64, Instant)> {
+    pub(crate) fn serial_start(&self) -> Option<(u64, Instant)> {
         region_profile::serial_start()
     }
 
     /// Ends a serial section started by [`StageClock::serial_start`].
     #[inline]
-    pub fn serial_end(&self, section: Section, start: Option<(u64, Instant)>) {
+    pub(crate) fn serial_end(&self, section: Section, start: Option<(u64, Instant)>) {
         region_profile::serial_end(section, start)
     }
 

@@ -609,7 +609,7 @@ impl SphereSim {
     /// Puts the bodies, walls, loads, ledger, time and step index back into `world`, and nothing else: its
     /// contact store and broad phase stay as they were (for an output that reads bodies and loads only;
     /// [`Self::write_back`] is the whole state).
-    pub fn write_back_bodies(&self, world: &mut World) {
+    pub(crate) fn write_back_bodies(&self, world: &mut World) {
         for (i, body) in world.bodies.iter_mut().enumerate() {
             body.position = self.kin[i].position;
             body.velocity = self.kin[i].velocity;

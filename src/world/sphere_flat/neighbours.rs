@@ -425,7 +425,7 @@ impl NeighbourList {
     }
 
     /// Whether body `i` is a large body (listed with the wider skin; see the module docs).
-    pub fn is_large(&self, i: usize) -> bool {
+    pub(crate) fn is_large(&self, i: usize) -> bool {
         self.large_flags.get(i).copied().unwrap_or(false)
     }
 
