@@ -61,7 +61,9 @@ pub struct EpaScratch {
     /// Plane offset of each face, +∞ once the face is removed: the closest-face scan reads only this.
     live_offsets: Vec<Real>,
     horizon: Vec<(u32, u8)>,
-    new_faces: Vec<u32>,
+    /// The fan of the current iteration: (face, its vertex `v[0]`, its vertex `v[1]`), kept beside the
+    /// index so that the fan linking scans this list alone.
+    new_faces: Vec<(u32, u32, u32)>,
     max_verts: usize,
     max_faces: usize,
 }
@@ -362,18 +364,14 @@ pub fn epa<A: SupportMap + ?Sized, B: SupportMap + ?Sized>(
             scratch.faces[nf as usize].adj_edge[0] = k;
             scratch.faces[g as usize].adj[k as usize] = nf;
             scratch.faces[g as usize].adj_edge[k as usize] = 0;
-            scratch.new_faces.push(nf);
+            scratch.new_faces.push((nf, p, q));
         }
         // Link the fan: face j's edge 1 (q_j → w) meets face i's edge 2 (w → p_i) where p_i = q_j. The
         // horizon must be one simple loop: every q matches exactly one p.
-        let m = scratch.new_faces.len();
-        for j in 0..m {
-            let fj = scratch.new_faces[j];
-            let qj = scratch.faces[fj as usize].v[1];
+        for &(fj, _, qj) in scratch.new_faces.iter() {
             let mut found = u32::MAX;
-            for i in 0..m {
-                let fi = scratch.new_faces[i];
-                if scratch.faces[fi as usize].v[0] == qj {
+            for &(fi, pi, _) in scratch.new_faces.iter() {
+                if pi == qj {
                     if found != u32::MAX {
                         return degenerate(iterations, Degeneracy::BrokenHorizon);
                     }
