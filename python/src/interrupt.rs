@@ -23,20 +23,25 @@ pub const CHECK_INTERVAL: Duration = Duration::from_millis(100);
 pub struct SignalCheck {
     last: Instant,
     raised: Option<PyErr>,
+    /// Python runs signal handlers on its main thread only, so a call from another thread never takes
+    /// the GIL for them.
+    on_main_thread: bool,
 }
 
 impl SignalCheck {
-    pub fn new() -> Self {
+    /// A check for a call made by the current thread (`py` held by it).
+    pub fn new(py: Python<'_>) -> Self {
         Self {
             last: Instant::now(),
             raised: None,
+            on_main_thread: is_main_thread(py),
         }
     }
 
     /// Runs the signal handlers if [`CHECK_INTERVAL`] has passed since they last ran; whether one has
     /// raised (now or before).
     pub fn poll(&mut self) -> bool {
-        if self.raised.is_none() && self.last.elapsed() >= CHECK_INTERVAL {
+        if self.on_main_thread && self.raised.is_none() && self.last.elapsed() >= CHECK_INTERVAL {
             self.raised = Python::attach(|py| py.check_signals().err());
             self.last = Instant::now();
         }
@@ -49,10 +54,22 @@ impl SignalCheck {
     }
 }
 
+/// Whether the calling thread is Python's main thread (when `threading` cannot tell, it is taken to be,
+/// so that the handlers are still run).
+fn is_main_thread(py: Python<'_>) -> bool {
+    let answer = || -> PyResult<bool> {
+        let threading = py.import("threading")?;
+        let main = threading.call_method0("main_thread")?;
+        let current = threading.call_method0("current_thread")?;
+        Ok(main.is(&current))
+    };
+    answer().unwrap_or(true)
+}
+
 /// A check for the rockfill experiment, which asks it before each step, and the [`SignalCheck`] that
 /// answers it (to take the exception from after the run).
-pub fn stop_check() -> (StopCheck, Arc<Mutex<SignalCheck>>) {
-    let signals = Arc::new(Mutex::new(SignalCheck::new()));
+pub fn stop_check(py: Python<'_>) -> (StopCheck, Arc<Mutex<SignalCheck>>) {
+    let signals = Arc::new(Mutex::new(SignalCheck::new(py)));
     let shared = Arc::clone(&signals);
     let stop = StopCheck::new(move || shared.lock().is_ok_and(|mut s| s.poll()));
     (stop, signals)

@@ -173,7 +173,7 @@ fn run_stoppable(
     title: &str,
     progress: Option<Py<PyAny>>,
 ) -> PyResult<ExperimentResult> {
-    let (stop, signals) = interrupt::stop_check();
+    let (stop, signals) = interrupt::stop_check(py);
     let result = py.detach(|| {
         let mut report_progress = |stage: &str, text: String| {
             let Some(callback) = &progress else { return };

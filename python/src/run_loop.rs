@@ -78,7 +78,7 @@ pub fn run<'py>(owner: &Bound<'py, PySimulation>, request: RunRequest<'py>) -> P
         request.callback_every
     };
     let mut next_callback = start.saturating_add(request.callback_every);
-    let mut signals = SignalCheck::new();
+    let mut signals = SignalCheck::new(py);
     loop {
         let done = owner.borrow().sim.world.step_index();
         if done >= request.last {

@@ -179,7 +179,7 @@ impl PySimulation {
     #[pyo3(signature = (n = 1))]
     fn step(&mut self, py: Python<'_>, n: u64) -> PyResult<()> {
         let sim = &mut self.sim;
-        let mut signals = SignalCheck::new();
+        let mut signals = SignalCheck::new(py);
         let result = py.detach(|| advance(sim, n, &mut signals));
         if let Some(interrupt) = signals.take_raised() {
             return Err(interrupt);
