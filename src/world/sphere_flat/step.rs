@@ -24,7 +24,7 @@ use std::time::Instant;
 
 use crate::math::{Point, Real};
 
-use super::super::step::guard::{self, TimeStepCheck};
+use super::super::step::{guard, TimeStepCheck};
 use super::super::step::{StepError, StepReport};
 use super::super::ContactKey;
 use super::blocks::Blocks;

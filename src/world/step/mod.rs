@@ -37,12 +37,14 @@
 //! `checks` (8), `ledger` (9); `loads` runs 3–6 in order. A world of free spheres takes `sphere` for 1–2
 //! and 7–8 and `sphere_kernel` inside 4–5: the same stages, the same bits. The parameters, report, error,
 //! counters and scratch buffers are leaf files the stages share (`params`, `report`, `counters`,
-//! `scratch`), and each stage is timed by a [`super::timing::StageClock`].
+//! `scratch`, and the time-step check's choices and findings, `findings`), and each stage is timed by a
+//! [`super::timing::StageClock`].
 
 mod accumulate;
 mod broad;
 mod checks;
 mod counters;
+mod findings;
 pub(crate) mod guard;
 mod integrate;
 mod laws;
@@ -56,7 +58,7 @@ pub(super) mod sphere;
 mod sphere_kernel;
 
 pub use counters::StepCounters;
-pub use guard::{TimeStepCheck, TimeStepFinding};
+pub use findings::{TimeStepCheck, TimeStepFinding};
 pub use params::{StepParams, DEFAULT_OVERLAP_WARNING_FRACTION};
 pub use report::{OverlapWarning, StepError, StepReport};
 pub use scratch::StepScratch;

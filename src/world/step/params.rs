@@ -9,7 +9,7 @@ use super::super::skips::Skips;
 use super::super::sleep_state::SleepParams;
 #[cfg(doc)]
 use super::super::world::World;
-use super::guard::TimeStepCheck;
+use super::findings::TimeStepCheck;
 #[cfg(doc)]
 use super::StepReport;
 

@@ -6,7 +6,7 @@ use crate::math::Real;
 use super::super::contact_store::ContactKey;
 use super::super::world::World;
 use super::counters::StepCounters;
-use super::guard::TimeStepFinding;
+use super::findings::TimeStepFinding;
 
 /// A contact deeper than the warning fraction of the particle size.
 #[derive(Clone, Copy, Debug, PartialEq)]
