@@ -9,10 +9,37 @@
 
 use std::path::Path;
 
-pub use super::limits::RunLimits;
 use super::projectile::ProjectileParams;
 use polydem::law::{ContactModel, DampingLaw, LawError, NormalLaw, TangentialLaw};
 use polydem::math::Real;
+
+/// The default [`RunLimits::max_rocks`]: 200 000 rocks, five times the paper's layer at its smallest size
+/// (about 37 000 rocks at 100 mm), about [`super::limits::BYTES_PER_ROCK`] × 200 000 = 2.4 GB.
+pub const DEFAULT_MAX_ROCKS: usize = 200_000;
+
+/// The default [`RunLimits::max_steps`] of each stage: 10^7 steps. The paper's runs take about 3·10^5
+/// packing steps and 5 000 penetration steps at 100 mm; the penetration keeps one monitor row per step
+/// (10^7 rows are 1.4 GB).
+pub const DEFAULT_MAX_STEPS: u64 = 10_000_000;
+
+/// The size limits of a run; the experiment file's optional `[limits]` section (absent: the defaults).
+#[derive(Clone, Copy, Debug, PartialEq, serde::Deserialize, serde::Serialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct RunLimits {
+    /// The most rocks generation may make (the seed count of eq. 28).
+    pub max_rocks: usize,
+    /// The most steps of the packing (all its stages) and of the penetration run, each.
+    pub max_steps: u64,
+}
+
+impl Default for RunLimits {
+    fn default() -> Self {
+        Self {
+            max_rocks: DEFAULT_MAX_ROCKS,
+            max_steps: DEFAULT_MAX_STEPS,
+        }
+    }
+}
 
 /// Why a configuration was refused.
 #[derive(Debug, thiserror::Error)]

@@ -9,13 +9,13 @@ use super::bed::{
 use super::collapse::{collapse, CollapseParams};
 use super::config::ExperimentConfig;
 use super::generation::{generate, GenerationError, GenerationParams, Sample};
-use super::limits::{check_penetration_steps, check_rock_count, LimitError};
+use super::limits::{check_rock_count, LimitError};
 use super::packing::{
     empty_world, load_bed, loose_world, pack_with_stop, save_bed, PackingError, PackingReport,
 };
 use super::penetration::{
-    add_projectile, penetrate_with, MonitorRow, PenetrationError, PenetrationOptions,
-    PenetrationReport,
+    add_projectile, check_penetration_steps, penetrate_with, MonitorRow, PenetrationError,
+    PenetrationOptions, PenetrationReport,
 };
 use super::projectile::{Projectile, ProjectileError};
 use super::seeds::{Region, SeedError};

@@ -39,6 +39,7 @@ pub mod spatial_order;
 pub mod statistics;
 pub mod stop;
 pub mod study;
+pub mod summary;
 pub mod voronoi;
 
 pub use generation::{generate, GenerationError, GenerationParams, Sample};

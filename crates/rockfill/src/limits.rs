@@ -6,44 +6,19 @@
 //! A run beyond a limit is refused with what it would need and how to raise the limit: the experiment
 //! file's `[limits]` section or `--max-rocks` / `--max-steps` on the command line. The limits bound the
 //! work, they do not change it: a run within them is the same run.
+//!
+//! The penetration's step check, which counts its monitor rows, is
+//! [`super::penetration::check_penetration_steps`], built on [`within`].
 
 use super::config::ExperimentConfig;
+pub use super::config::{RunLimits, DEFAULT_MAX_ROCKS, DEFAULT_MAX_STEPS};
 use super::generation::{size_law_and_cell_radius, GenerationParams};
-use super::penetration::MonitorRow;
 use polydem::math::Real;
-
-/// The default [`RunLimits::max_rocks`]: 200 000 rocks, five times the paper's layer at its smallest size
-/// (about 37 000 rocks at 100 mm), about [`BYTES_PER_ROCK`] × 200 000 = 2.4 GB.
-pub const DEFAULT_MAX_ROCKS: usize = 200_000;
-
-/// The default [`RunLimits::max_steps`] of each stage: 10^7 steps. The paper's runs take about 3·10^5
-/// packing steps and 5 000 penetration steps at 100 mm; the penetration keeps one monitor row per step
-/// (10^7 rows are 1.4 GB).
-pub const DEFAULT_MAX_STEPS: u64 = 10_000_000;
 
 /// Memory per rock of generating and packing a bed (bytes), the estimate of the refusal message: the peak
 /// resident set of `polydem rockfill --size 100` (quick layer, 8 626 rocks) was 94 MB after 100 s of
 /// deposition, 11 kB per rock, rounded up for the contacts of the packed bed.
 pub const BYTES_PER_ROCK: u64 = 12_000;
-
-/// The size limits of a run; the experiment file's optional `[limits]` section (absent: the defaults).
-#[derive(Clone, Copy, Debug, PartialEq, serde::Deserialize, serde::Serialize)]
-#[serde(deny_unknown_fields, default)]
-pub struct RunLimits {
-    /// The most rocks generation may make (the seed count of eq. 28).
-    pub max_rocks: usize,
-    /// The most steps of the packing (all its stages) and of the penetration run, each.
-    pub max_steps: u64,
-}
-
-impl Default for RunLimits {
-    fn default() -> Self {
-        Self {
-            max_rocks: DEFAULT_MAX_ROCKS,
-            max_steps: DEFAULT_MAX_STEPS,
-        }
-    }
-}
 
 /// A run beyond its limits.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -91,32 +66,6 @@ pub fn check_rock_count(params: &GenerationParams, limit: usize) -> Result<(), L
     })
 }
 
-/// The penetration's steps at `dt` (at most `impact.max_time` / Δt), refused above the limit.
-/// `dt_bound` says whether `dt` is the run's Δt or only the upper bound known before generation.
-pub fn check_penetration_steps(
-    config: &ExperimentConfig,
-    dt: Real,
-    dt_bound: bool,
-) -> Result<(), LimitError> {
-    let imp = &config.impact;
-    let steps = imp.max_time / dt;
-    let rows_gb = steps * std::mem::size_of::<MonitorRow>() as Real / 1e9;
-    let rule = if dt_bound {
-        "known before generation: Δt ≤"
-    } else {
-        "Δt = min(the rocks' Δt,"
-    };
-    let reason = format!(
-        "impact.max_time = {:?} s over Δt, {rule} impact.travel_per_step {:?} × rock.mean_size {:?} m / impact.speed {:?} m/s{}; one monitor row per step, {rows_gb:.3e} GB",
-        imp.max_time,
-        imp.travel_per_step,
-        config.rock.mean_size,
-        imp.speed,
-        if dt_bound { "" } else { ")" }
-    );
-    within(config, "penetration", steps, dt, reason)
-}
-
 /// The packing's steps at `dt`: at most `max_deposition_time`, the wall's travel from the generation height
 /// to the layer at `compaction_speed`, `hold_time` and `restore_time`, over Δt; refused above the limit.
 pub fn check_packing_steps(config: &ExperimentConfig, dt: Real) -> Result<(), LimitError> {
@@ -131,7 +80,7 @@ pub fn check_packing_steps(config: &ExperimentConfig, dt: Real) -> Result<(), Li
     within(config, "packing", time / dt, dt, reason)
 }
 
-fn within(
+pub(crate) fn within(
     config: &ExperimentConfig,
     stage: &'static str,
     steps: Real,

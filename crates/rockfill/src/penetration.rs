@@ -22,7 +22,7 @@
 use std::time::{Duration, Instant};
 
 use super::config::ExperimentConfig;
-use super::limits::{check_penetration_steps, LimitError};
+use super::limits::{within, LimitError};
 use super::packing::{rock_time_step, top_wall_height, PackingError, KEPT_WALLS, STEEL};
 use super::projectile::Projectile;
 use super::stop::{self, StopCheck};
@@ -535,4 +535,30 @@ fn snapshot(world: &World, time: Real, tip: Point) -> Snapshot {
 /// x = `input_from_body.translation.x` of the projectile's input frame, whose base is at x = 0.
 fn axis_offset(projectile: &Projectile) -> Real {
     projectile.input_from_body.translation.vector.x
+}
+
+/// The penetration's steps at `dt` (at most `impact.max_time` / Δt), refused above the limit.
+/// `dt_bound` says whether `dt` is the run's Δt or only the upper bound known before generation.
+pub fn check_penetration_steps(
+    config: &ExperimentConfig,
+    dt: Real,
+    dt_bound: bool,
+) -> Result<(), LimitError> {
+    let imp = &config.impact;
+    let steps = imp.max_time / dt;
+    let rows_gb = steps * std::mem::size_of::<MonitorRow>() as Real / 1e9;
+    let rule = if dt_bound {
+        "known before generation: Δt ≤"
+    } else {
+        "Δt = min(the rocks' Δt,"
+    };
+    let reason = format!(
+        "impact.max_time = {:?} s over Δt, {rule} impact.travel_per_step {:?} × rock.mean_size {:?} m / impact.speed {:?} m/s{}; one monitor row per step, {rows_gb:.3e} GB",
+        imp.max_time,
+        imp.travel_per_step,
+        config.rock.mean_size,
+        imp.speed,
+        if dt_bound { "" } else { ")" }
+    );
+    within(config, "penetration", steps, dt, reason)
 }

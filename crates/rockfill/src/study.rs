@@ -286,7 +286,7 @@ pub fn run_one_with_stop(
         let path = dir.join("packing_trace.csv");
         super::packing::write_packing_trace(&path, &p.trace).map_err(io_error(&path))?;
     }
-    let text = super::cli::summary(config, &result);
+    let text = super::summary::summary(config, &result);
     let path = dir.join("summary.txt");
     std::fs::write(&path, &text).map_err(io_error(&path))?;
     draw_run_sections(config, &result, &dir.join("section.svg"), title)?;
