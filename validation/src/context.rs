@@ -6,7 +6,7 @@
 use std::fmt::Write as _;
 use std::path::PathBuf;
 
-use crate::case::{format_value, Check, Target};
+use crate::check::{format_value, Check, Target};
 use crate::error::SuiteError;
 use crate::plot::Plot;
 use crate::progress::Progress;

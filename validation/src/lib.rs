@@ -9,6 +9,7 @@
 
 pub mod case;
 pub mod cases;
+pub mod check;
 pub mod context;
 pub mod error;
 pub mod gate;
