@@ -15,7 +15,6 @@ use pyo3::prelude::*;
 
 use crate::errors::run_error;
 use crate::interrupt::{Interruptible, SignalCheck};
-use crate::simulation::PySimulation;
 
 /// What a `run` call asked for.
 pub struct RunRequest<'py> {
@@ -58,19 +57,29 @@ impl RunObserver for Stretch<'_, '_> {
     }
 }
 
+/// The Python object that owns the simulation a run steps (`polydem.Simulation`): a trait, so that the
+/// loop is written without the class that calls it.
+pub trait OwnsSimulation: pyo3::PyClass<Frozen = pyo3::pyclass::boolean_struct::False> {
+    fn simulation(&self) -> &Simulation;
+    fn simulation_mut(&mut self) -> &mut Simulation;
+}
+
 /// Runs the simulation `owner` to `request.last`. It is borrowed mutably for one stretch at a time, so
 /// callbacks between stretches see the simulation object as usual.
-pub fn run<'py>(owner: &Bound<'py, PySimulation>, request: RunRequest<'py>) -> PyResult<()> {
+pub fn run<'py, O: OwnsSimulation>(
+    owner: &Bound<'py, O>,
+    request: RunRequest<'py>,
+) -> PyResult<()> {
     let py = owner.py();
     let mut outputs = match &request.out {
         None => None,
         Some((dir, plan)) => {
             let mut this = owner.borrow_mut();
-            let sim = &mut this.sim;
+            let sim = this.simulation_mut();
             Some(open_for(sim, dir, plan, request.last)?)
         }
     };
-    let start = owner.borrow().sim.world.step_index();
+    let start = owner.borrow().simulation().world.step_index();
     let progress_every = ((request.last.saturating_sub(start)) / 100).max(scene::PROGRESS_STEPS);
     let chunk = if request.progress.is_some() {
         request.callback_every.min(progress_every)
@@ -80,7 +89,7 @@ pub fn run<'py>(owner: &Bound<'py, PySimulation>, request: RunRequest<'py>) -> P
     let mut next_callback = start.saturating_add(request.callback_every);
     let mut signals = SignalCheck::new(py);
     loop {
-        let done = owner.borrow().sim.world.step_index();
+        let done = owner.borrow().simulation().world.step_index();
         if done >= request.last {
             break;
         }
@@ -90,7 +99,7 @@ pub fn run<'py>(owner: &Bound<'py, PySimulation>, request: RunRequest<'py>) -> P
             .min(next_callback);
         {
             let mut this = owner.borrow_mut();
-            let sim = &mut this.sim;
+            let sim = this.simulation_mut();
             let skip = (done != start).then_some(done);
             let result = py.detach(|| stretch(sim, end, outputs.as_mut(), skip, &mut signals));
             if let Some(interrupt) = signals.take_raised() {

@@ -14,7 +14,7 @@ use pyo3::types::{PyBytes, PyDict, PyType};
 
 use crate::errors::{checkpoint_error, run_error, scene_error};
 use crate::interrupt::{Interruptible, SignalCheck};
-use crate::run_loop::{self, RunRequest, Unobserved};
+use crate::run_loop::{self, OwnsSimulation, RunRequest, Unobserved};
 use crate::world_arrays;
 
 /// A scene read and validated by the engine (materials, laws, shapes, bodies, walls, time step). Build a
@@ -122,6 +122,15 @@ fn interval_steps(every: Real, dt: Real) -> PyResult<u64> {
 #[pyclass(name = "Simulation", module = "polydem")]
 pub struct PySimulation {
     pub(crate) sim: Simulation,
+}
+
+impl OwnsSimulation for PySimulation {
+    fn simulation(&self) -> &Simulation {
+        &self.sim
+    }
+    fn simulation_mut(&mut self) -> &mut Simulation {
+        &mut self.sim
+    }
 }
 
 impl PySimulation {
