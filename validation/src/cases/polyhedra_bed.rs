@@ -308,6 +308,22 @@ fn scene_density(template: &str, name: &str) -> Result<Real, SuiteError> {
         .ok_or_else(|| fail(format!("scene template: no density of material '{name}'")))
 }
 
+/// The case's tolerances and references, read once.
+struct Gates {
+    volume_tol: Real,
+    ledger_tol: Real,
+    mean_diameter: Real,
+    box_side: Real,
+}
+
+/// What the variants add to the closing section.
+#[derive(Default)]
+struct Closing {
+    summary_rows: Vec<Vec<String>>,
+    speed_rows: Vec<Vec<String>>,
+    paragraphs: Vec<String>,
+}
+
 impl Case for PolyhedraBed {
     fn name(&self) -> &'static str {
         NAME
@@ -324,270 +340,352 @@ impl Case for PolyhedraBed {
         ctx: &mut CaseContext,
     ) -> Result<(), SuiteError> {
         let p: Params = data.params(NAME, profile)?;
-        let volume_tol = data.tolerance(NAME, "volume_rel")?.value;
-        let ledger_tol = data.tolerance(NAME, "ledger_rel")?.value;
-        let mean_diameter = data.reference(NAME, "mean_bed_diameter")?.value;
-        let box_side = data.reference(NAME, "box_side")?.value;
+        let gates = Gates {
+            volume_tol: data.tolerance(NAME, "volume_rel")?.value,
+            ledger_tol: data.tolerance(NAME, "ledger_rel")?.value,
+            mean_diameter: data.reference(NAME, "mean_bed_diameter")?.value,
+            box_side: data.reference(NAME, "box_side")?.value,
+        };
         let root = workspace_root();
         let spheres = generate::read_spheres(&root.join(SPHERE_FILE)).map_err(fail)?;
-        let state_header: Vec<String> = std::fs::read_to_string(root.join(STATE_FILE))
-            .map_err(SuiteError::io(root.join(STATE_FILE)))?
-            .lines()
-            .take_while(|l| l.starts_with('#'))
-            .map(|l| l.trim_start_matches('#').trim().to_owned())
-            .collect();
-        ctx.text(&format!(
-            "Every sphere of the settled sphere bed (`{SPHERE_FILE}`, 3000 spheres, radius 1.6–2.4 mm) is \
-             replaced by a random convex polyhedron of the same volume: the convex hull of {}–{} seeded \
-             random points on a sphere (dart throwing, no two closer than {} of their mean spacing, so no \
-             sliver), its centroid at the sphere's centre, scaled to (4/3)πr³; the points are isotropic, \
-             so the orientation is random. The polyhedra stick out of the spheres they replace (circumradius \
-             1.13–1.43 times the equal-volume radius) and overlapped their neighbours and the walls; they \
-             were not shrunk. The overlaps were removed by moving the centroids (the bed's centres \
-             stretched vertically by 1.2, then Gauss–Seidel sweeps separating each overlapping pair along \
-             the EPA normal), and the bed settled again under gravity with its own Hertz–Mindlin law in \
-             polydem, velocities dropped at the end (`validation/examples/generate_polyhedra_bed.rs`, \
-             `validation/src/cases/polyhedra_bed/generate.rs`). The settled state is `{STATE_FILE}`; its \
-             provenance:\n\n{}\n\n\
-             Both beds are then struck by the same steel sphere with the same laws, time step and sampling \
-             (the scene files `scenes/sphere_bed_*.toml`; the polyhedral scene is that file with the \
-             `[[body_file]]` of spheres replaced, written by the example's `scene` command). The projectile \
-             starts 0.5 mm above the highest point of its bed in both; depth is z0 − z from that start. \
-             The Hertz–Mindlin law of a polyhedron in polydem (`src/law/pair.rs`) is the sphere law with \
-             the Minkowski overlap δ_M as δ and, as R, the radius of the sphere of equal volume — here the \
-             radius of the sphere each polyhedron replaced — so a contact of two polyhedra has the \
-             stiffness of the two spheres they replaced at the same overlap, whatever the features in \
-             contact (vertex, edge or face): the shape changes where and along which normal the contacts \
-             act, not the law. The linear spring–dashpot law of variant c has one k_n and one dashpot per \
-             pair whatever the shape (f = k_n δ_M + c_n δ̇_M), as LIGGGHTS' `hooke/stiffness` has for \
-             spheres.",
-            generate::MIN_POINTS,
-            generate::MAX_POINTS,
-            generate::MIN_SPACING,
-            state_header
-                .iter()
-                .map(|l| format!("- {l}"))
-                .collect::<Vec<_>>()
-                .join("\n"),
-        ));
-        let mut summary_rows = Vec::new();
-        let mut speed_rows = Vec::new();
-        let mut paragraphs = Vec::new();
+        intro(ctx, &root)?;
+        let mut out = Closing::default();
         for variant in &p.variants {
-            let v = &variant.name;
-            let template_path = template_scene(v).map_err(fail)?;
-            let template = std::fs::read_to_string(root.join(template_path))
-                .map_err(SuiteError::io(root.join(template_path)))?;
-            let (text, bodies) = scene_for_variant(&root, v).map_err(fail)?;
+            run_variant(ctx, &p, variant, &gates, &spheres, &mut out)?;
+        }
+        closing(ctx, &out)
+    }
+}
 
-            // The generated bed: volumes and initial overlaps.
-            let placed = generate::place(&bodies).map_err(fail)?;
-            let volume_error = bodies
-                .iter()
-                .zip(&placed)
-                .map(|(b, pl)| {
-                    let sphere = 4.0 / 3.0 * std::f64::consts::PI * b.radius.powi(3);
-                    (pl.poly.mass_properties().volume / sphere - 1.0).abs()
-                })
-                .fold(0.0, Real::max);
-            let bed_density = scene_density(&template, "bed")?;
-            let law = bounds::BedLaw::from_scene(&template).map_err(fail)?;
-            let r_min = spheres
-                .iter()
-                .map(|s| s.radius)
-                .fold(Real::INFINITY, Real::min);
-            let bed_mass: Real = spheres
-                .iter()
-                .map(|s| bed_density * 4.0 / 3.0 * std::f64::consts::PI * s.radius.powi(3))
-                .sum();
-            // The bed's whole weight on one contact of the two smallest grains: no static contact carries more.
-            let static_bound = law.static_overlap(bed_mass * 9.81, 0.5 * r_min);
-            let t_gen = Instant::now();
-            let initial = initial_overlap(&bodies, box_side)?;
-            let t_gen = t_gen.elapsed().as_secs_f64();
+/// How the polyhedral bed was made, with the provenance of its settled state.
+fn intro(ctx: &mut CaseContext, root: &Path) -> Result<(), SuiteError> {
+    let state_header: Vec<String> = std::fs::read_to_string(root.join(STATE_FILE))
+        .map_err(SuiteError::io(root.join(STATE_FILE)))?
+        .lines()
+        .take_while(|l| l.starts_with('#'))
+        .map(|l| l.trim_start_matches('#').trim().to_owned())
+        .collect();
+    ctx.text(&format!(
+        "Every sphere of the settled sphere bed (`{SPHERE_FILE}`, 3000 spheres, radius 1.6–2.4 mm) is \
+         replaced by a random convex polyhedron of the same volume: the convex hull of {}–{} seeded \
+         random points on a sphere (dart throwing, no two closer than {} of their mean spacing, so no \
+         sliver), its centroid at the sphere's centre, scaled to (4/3)πr³; the points are isotropic, \
+         so the orientation is random. The polyhedra stick out of the spheres they replace (circumradius \
+         1.13–1.43 times the equal-volume radius) and overlapped their neighbours and the walls; they \
+         were not shrunk. The overlaps were removed by moving the centroids (the bed's centres \
+         stretched vertically by 1.2, then Gauss–Seidel sweeps separating each overlapping pair along \
+         the EPA normal), and the bed settled again under gravity with its own Hertz–Mindlin law in \
+         polydem, velocities dropped at the end (`validation/examples/generate_polyhedra_bed.rs`, \
+         `validation/src/cases/polyhedra_bed/generate.rs`). The settled state is `{STATE_FILE}`; its \
+         provenance:\n\n{}\n\n\
+         Both beds are then struck by the same steel sphere with the same laws, time step and sampling \
+         (the scene files `scenes/sphere_bed_*.toml`; the polyhedral scene is that file with the \
+         `[[body_file]]` of spheres replaced, written by the example's `scene` command). The projectile \
+         starts 0.5 mm above the highest point of its bed in both; depth is z0 − z from that start. \
+         The Hertz–Mindlin law of a polyhedron in polydem (`src/law/pair.rs`) is the sphere law with \
+         the Minkowski overlap δ_M as δ and, as R, the radius of the sphere of equal volume — here the \
+         radius of the sphere each polyhedron replaced — so a contact of two polyhedra has the \
+         stiffness of the two spheres they replaced at the same overlap, whatever the features in \
+         contact (vertex, edge or face): the shape changes where and along which normal the contacts \
+         act, not the law. The linear spring–dashpot law of variant c has one k_n and one dashpot per \
+         pair whatever the shape (f = k_n δ_M + c_n δ̇_M), as LIGGGHTS' `hooke/stiffness` has for \
+         spheres.",
+        generate::MIN_POINTS,
+        generate::MAX_POINTS,
+        generate::MIN_SPACING,
+        state_header
+            .iter()
+            .map(|l| format!("- {l}"))
+            .collect::<Vec<_>>()
+            .join("\n"),
+    ));
+    Ok(())
+}
 
-            let sim_poly = parse_scene(&text, Path::new(&format!("polyhedra_bed_{v}.toml")))
-                .map_err(|e| fail(e.to_string()))?;
-            let sim_sphere =
-                load_scene(&root.join(template_path)).map_err(|e| fail(e.to_string()))?;
-            let steps = variant.steps.unwrap_or(u64::MAX).min(sim_poly.steps);
-            let spheres_run = run_bed(
-                sim_sphere,
-                steps,
-                p.tunnelling_every,
-                &format!("{v} spheres"),
-                ctx,
-            )?;
-            let poly_run = run_bed(
-                sim_poly,
-                steps,
-                p.tunnelling_every,
-                &format!("{v} polyhedra"),
-                ctx,
-            )?;
-            let overlap_bound = law.energy_overlap(poly_run.ke0, 0.5 * r_min);
-            let t_end = *poly_run.history.t.last().unwrap_or(&0.0);
+/// Both beds of one variant run, compared, checked and plotted.
+fn run_variant(
+    ctx: &mut CaseContext,
+    p: &Params,
+    variant: &Variant,
+    gates: &Gates,
+    spheres: &[polydem::scene::body_file::SphereRow],
+    out: &mut Closing,
+) -> Result<(), SuiteError> {
+    let root = workspace_root();
+    let v = &variant.name;
+    let template_path = template_scene(v).map_err(fail)?;
+    let template = std::fs::read_to_string(root.join(template_path))
+        .map_err(SuiteError::io(root.join(template_path)))?;
+    let (text, bodies) = scene_for_variant(&root, v).map_err(fail)?;
 
-            ctx.section(&format!("{v} (t ≤ {:.4} ms)", t_end * 1e3));
-            let (ms, mp) = (
-                metrics(&format!("{v} spheres"), &spheres_run)?,
-                metrics(&format!("{v} polyhedra"), &poly_run)?,
-            );
-            // Both runs count the projectile's contacts at every sample.
-            let contacts = |m: &Metrics| m.mean_contacts.unwrap_or(Real::NAN);
-            let solid_fraction = |top: Real| {
-                spheres
-                    .iter()
-                    .map(|s| 4.0 / 3.0 * std::f64::consts::PI * s.radius.powi(3))
-                    .sum::<Real>()
-                    / (box_side * box_side * top)
-            };
-            ctx.text(&format!(
-                "Scene `{template_path}` and its polyhedral version; {steps} steps (t ≤ {:.4} ms) of the \
-                 scene's {}. Both beds hold the same 3000 grain volumes; the sphere bed's top is at {:.2} mm \
-                 (solid fraction below the top {:.3}), the polyhedral bed's at {:.2} mm ({:.3}).",
-                t_end * 1e3,
-                spheres_run.steps.max(steps),
-                spheres_run.bed_top * 1e3,
-                solid_fraction(spheres_run.bed_top),
-                poly_run.bed_top * 1e3,
-                solid_fraction(poly_run.bed_top),
-            ));
-            let row = |heading: String, a: Real, b: Real| {
-                vec![
-                    heading,
-                    CaseContext::fmt(a),
-                    CaseContext::fmt(b),
-                    CaseContext::fmt(b / a),
-                ]
-            };
-            let mut rows: Vec<Vec<String>> = QUANTITIES
-                .iter()
-                .map(|q| row(q.heading(), q.of(&ms), q.of(&mp)))
-                .collect();
-            rows.push(row(
-                "mean projectile contacts after first contact [-]".into(),
-                contacts(&ms),
-                contacts(&mp),
-            ));
-            ctx.table(
-                Some(&format!("{v}_table")),
-                &["quantity", "spheres", "polyhedra", "polyhedra / spheres"],
-                &rows,
-            )?;
-            let checks_rows = [("spheres", &spheres_run), ("polyhedra", &poly_run)]
-                .iter()
-                .map(|(bed, r)| {
-                    vec![
-                        (*bed).to_owned(),
-                        CaseContext::fmt(r.ledger_error),
-                        CaseContext::fmt(r.max_depth / mean_diameter),
-                        format!("{}", r.crossings),
-                        format!("{}", r.non_finite),
-                    ]
-                })
-                .collect::<Vec<_>>();
-            ctx.text(&format!(
-                "Checks on both runs (the rows below gate the polyhedral one): the energy ledger's largest \
-                 |balance| over the samples relative to the projectile's initial kinetic energy \
-                 ({:.4e} J); the largest Minkowski overlap of any contact at the end of any step; body \
-                 centres that went through another body or a wall (the definition of \
-                 `polydem::world::tunnelling`, candidates from a grid: `polyhedra_bed/crossings.rs`; observed \
-                 every {} steps); non-finite sampled values.",
-                poly_run.ke0, p.tunnelling_every
-            ));
-            ctx.table(
-                None,
-                &[
-                    "bed",
-                    "ledger |balance| / KE0",
-                    "max overlap [mean diameters]",
-                    "crossings",
-                    "non-finite values",
-                ],
-                &checks_rows,
-            )?;
-            ctx.check(
-                &format!("{v}_volume_rel_error"),
-                volume_error,
-                Target::at_most(volume_tol),
-                "1 (max over the 3000 polyhedra of |V / ((4/3)πr³) − 1|)",
-            );
-            ctx.check(
-                &format!("{v}_initial_max_overlap"),
-                initial / mean_diameter,
-                Target::at_most(static_bound / mean_diameter),
-                &format!("mean bed diameters (exact SAT oracle and walls, settled bed; bound: {} overlap of the bed's whole weight on one contact of the two smallest grains)", law.describe()),
-            );
-            ctx.check(
-                &format!("{v}_non_finite_values"),
-                poly_run.non_finite as Real,
-                Target::equal(0.0),
-                "count",
-            );
-            ctx.check(
-                &format!("{v}_ledger_error"),
-                poly_run.ledger_error,
-                Target::at_most(ledger_tol),
-                "1 (max |balance| / projectile's initial kinetic energy)",
-            );
-            ctx.check(
-                &format!("{v}_max_overlap"),
-                poly_run.max_depth / mean_diameter,
-                Target::at_most(overlap_bound / mean_diameter),
-                &format!("mean bed diameters (bound: one {} contact of the softest pair holding the projectile's whole kinetic energy)", law.describe()),
-            );
-            ctx.check(
-                &format!("{v}_tunnelling_crossings"),
-                poly_run.crossings as Real,
-                Target::equal(0.0),
-                "count",
-            );
+    // The generated bed: volumes and initial overlaps.
+    let placed = generate::place(&bodies).map_err(fail)?;
+    let volume_error = bodies
+        .iter()
+        .zip(&placed)
+        .map(|(b, pl)| {
+            let sphere = 4.0 / 3.0 * std::f64::consts::PI * b.radius.powi(3);
+            (pl.poly.mass_properties().volume / sphere - 1.0).abs()
+        })
+        .fold(0.0, Real::max);
+    let bed_density = scene_density(&template, "bed")?;
+    let law = bounds::BedLaw::from_scene(&template).map_err(fail)?;
+    let r_min = spheres
+        .iter()
+        .map(|s| s.radius)
+        .fold(Real::INFINITY, Real::min);
+    let bed_mass: Real = spheres
+        .iter()
+        .map(|s| bed_density * 4.0 / 3.0 * std::f64::consts::PI * s.radius.powi(3))
+        .sum();
+    // The bed's whole weight on one contact of the two smallest grains: no static contact carries more.
+    let static_bound = law.static_overlap(bed_mass * 9.81, 0.5 * r_min);
+    let initial = initial_overlap(&bodies, gates.box_side)?;
 
-            // Plots: spheres and polyhedra overlaid.
-            let series = |run: &BedRun, label: &str, f: &dyn Fn(&BedRun, usize) -> Real| Series {
-                label: label.into(),
-                style: SeriesStyle::Line,
-                points: (0..run.history.t.len())
-                    .map(|i| (run.history.t[i] * 1e3, f(run, i)))
-                    .collect(),
-            };
-            for (quantity, y_label, pick) in [
-                (
-                    "depth",
-                    "depth z0 − z (mm)",
-                    &(|r: &BedRun, i: usize| (r.z0 - r.history.z[i]) * 1e3)
-                        as &dyn Fn(&BedRun, usize) -> Real,
-                ),
-                (
-                    "velocity",
-                    "vertical velocity (m/s)",
-                    &|r: &BedRun, i: usize| r.history.vz[i],
-                ),
-                (
-                    "force",
-                    "vertical contact force (N)",
-                    &|r: &BedRun, i: usize| r.history.fz[i],
-                ),
-            ] {
-                ctx.plot(&Plot {
-                    name: format!("{v}_{quantity}"),
-                    title: format!("{v}: projectile {quantity}, spheres vs polyhedra"),
-                    x_label: "t (ms)".into(),
-                    y_label: y_label.into(),
-                    x_log: false,
-                    y_log: false,
-                    series: vec![
-                        series(&spheres_run, "sphere bed", pick),
-                        series(&poly_run, "polyhedral bed (equal volumes)", pick),
-                    ],
-                    caption: format!(
-                        "Projectile {quantity} against time in the sphere bed and in the same bed of \
-                         polyhedra of equal volume (polydem, same law and step)."
-                    ),
-                })?;
-            }
-            paragraphs.push(format!(
+    let sim_poly = parse_scene(&text, Path::new(&format!("polyhedra_bed_{v}.toml")))
+        .map_err(|e| fail(e.to_string()))?;
+    let sim_sphere = load_scene(&root.join(template_path)).map_err(|e| fail(e.to_string()))?;
+    let steps = variant.steps.unwrap_or(u64::MAX).min(sim_poly.steps);
+    let spheres_run = run_bed(
+        sim_sphere,
+        steps,
+        p.tunnelling_every,
+        &format!("{v} spheres"),
+        ctx,
+    )?;
+    let poly_run = run_bed(
+        sim_poly,
+        steps,
+        p.tunnelling_every,
+        &format!("{v} polyhedra"),
+        ctx,
+    )?;
+    let overlap_bound = law.energy_overlap(poly_run.ke0, 0.5 * r_min);
+    let t_end = *poly_run.history.t.last().unwrap_or(&0.0);
+
+    ctx.section(&format!("{v} (t ≤ {:.4} ms)", t_end * 1e3));
+    let (ms, mp) = (
+        metrics(&format!("{v} spheres"), &spheres_run)?,
+        metrics(&format!("{v} polyhedra"), &poly_run)?,
+    );
+    // Both runs count the projectile's contacts at every sample.
+    let contacts = |m: &Metrics| m.mean_contacts.unwrap_or(Real::NAN);
+    let solid_fraction = |top: Real| {
+        spheres
+            .iter()
+            .map(|s| 4.0 / 3.0 * std::f64::consts::PI * s.radius.powi(3))
+            .sum::<Real>()
+            / (gates.box_side * gates.box_side * top)
+    };
+    ctx.text(&format!(
+        "Scene `{template_path}` and its polyhedral version; {steps} steps (t ≤ {:.4} ms) of the \
+         scene's {}. Both beds hold the same 3000 grain volumes; the sphere bed's top is at {:.2} mm \
+         (solid fraction below the top {:.3}), the polyhedral bed's at {:.2} mm ({:.3}).",
+        t_end * 1e3,
+        spheres_run.steps.max(steps),
+        spheres_run.bed_top * 1e3,
+        solid_fraction(spheres_run.bed_top),
+        poly_run.bed_top * 1e3,
+        solid_fraction(poly_run.bed_top),
+    ));
+    let row = |heading: String, a: Real, b: Real| {
+        vec![
+            heading,
+            CaseContext::fmt(a),
+            CaseContext::fmt(b),
+            CaseContext::fmt(b / a),
+        ]
+    };
+    let mut rows: Vec<Vec<String>> = QUANTITIES
+        .iter()
+        .map(|q| row(q.heading(), q.of(&ms), q.of(&mp)))
+        .collect();
+    rows.push(row(
+        "mean projectile contacts after first contact [-]".into(),
+        contacts(&ms),
+        contacts(&mp),
+    ));
+    ctx.table(
+        Some(&format!("{v}_table")),
+        &["quantity", "spheres", "polyhedra", "polyhedra / spheres"],
+        &rows,
+    )?;
+    let checks_rows = [("spheres", &spheres_run), ("polyhedra", &poly_run)]
+        .iter()
+        .map(|(bed, r)| {
+            vec![
+                (*bed).to_owned(),
+                CaseContext::fmt(r.ledger_error),
+                CaseContext::fmt(r.max_depth / gates.mean_diameter),
+                format!("{}", r.crossings),
+                format!("{}", r.non_finite),
+            ]
+        })
+        .collect::<Vec<_>>();
+    ctx.text(&format!(
+        "Checks on both runs (the rows below gate the polyhedral one): the energy ledger's largest \
+         |balance| over the samples relative to the projectile's initial kinetic energy \
+         ({:.4e} J); the largest Minkowski overlap of any contact at the end of any step; body \
+         centres that went through another body or a wall (the definition of \
+         `polydem::world::tunnelling`, candidates from a grid: `polyhedra_bed/crossings.rs`; observed \
+         every {} steps); non-finite sampled values.",
+        poly_run.ke0, p.tunnelling_every
+    ));
+    ctx.table(
+        None,
+        &[
+            "bed",
+            "ledger |balance| / KE0",
+            "max overlap [mean diameters]",
+            "crossings",
+            "non-finite values",
+        ],
+        &checks_rows,
+    )?;
+    let initial_bound = (initial, static_bound);
+    check_variant(
+        ctx,
+        v,
+        gates,
+        &law,
+        volume_error,
+        initial_bound,
+        &poly_run,
+        overlap_bound,
+    );
+    plot_variant(ctx, v, &spheres_run, &poly_run)?;
+    out.paragraphs.push(paragraph(v, t_end, &ms, &mp));
+    out.summary_rows.push(vec![
+        v.clone(),
+        format!("{:.3}", ms.final_depth * 1e3),
+        format!("{:.3}", mp.final_depth * 1e3),
+        format!("{:.3}", ms.peak_force),
+        format!("{:.3}", mp.peak_force),
+        format!("{:.3}", ms.final_vz),
+        format!("{:.3}", mp.final_vz),
+        format!("{:.3}", relative_difference(ms.impulse, mp.impulse)),
+    ]);
+    for (bed, r) in [("spheres", &spheres_run), ("polyhedra", &poly_run)] {
+        out.speed_rows.push(vec![
+            v.clone(),
+            bed.to_owned(),
+            format!("{}", r.steps),
+            format!("{:.2}", r.wall_time_s),
+            format!(
+                "{:.3e}",
+                r.particles as Real * r.steps as Real / r.wall_time_s
+            ),
+        ]);
+    }
+    Ok(())
+}
+
+/// The gated rows of a variant (the polyhedral run's).
+#[allow(clippy::too_many_arguments)]
+fn check_variant(
+    ctx: &mut CaseContext,
+    v: &str,
+    gates: &Gates,
+    law: &bounds::BedLaw,
+    volume_error: Real,
+    (initial, static_bound): (Real, Real),
+    poly_run: &BedRun,
+    overlap_bound: Real,
+) {
+    ctx.check(
+        &format!("{v}_volume_rel_error"),
+        volume_error,
+        Target::at_most(gates.volume_tol),
+        "1 (max over the 3000 polyhedra of |V / ((4/3)πr³) − 1|)",
+    );
+    ctx.check(
+        &format!("{v}_initial_max_overlap"),
+        initial / gates.mean_diameter,
+        Target::at_most(static_bound / gates.mean_diameter),
+        &format!("mean bed diameters (exact SAT oracle and walls, settled bed; bound: {} overlap of the bed's whole weight on one contact of the two smallest grains)", law.describe()),
+    );
+    ctx.check(
+        &format!("{v}_non_finite_values"),
+        poly_run.non_finite as Real,
+        Target::equal(0.0),
+        "count",
+    );
+    ctx.check(
+        &format!("{v}_ledger_error"),
+        poly_run.ledger_error,
+        Target::at_most(gates.ledger_tol),
+        "1 (max |balance| / projectile's initial kinetic energy)",
+    );
+    ctx.check(
+        &format!("{v}_max_overlap"),
+        poly_run.max_depth / gates.mean_diameter,
+        Target::at_most(overlap_bound / gates.mean_diameter),
+        &format!("mean bed diameters (bound: one {} contact of the softest pair holding the projectile's whole kinetic energy)", law.describe()),
+    );
+    ctx.check(
+        &format!("{v}_tunnelling_crossings"),
+        poly_run.crossings as Real,
+        Target::equal(0.0),
+        "count",
+    );
+}
+
+/// The projectile's depth, velocity and force against time, spheres and polyhedra overlaid.
+fn plot_variant(
+    ctx: &mut CaseContext,
+    v: &str,
+    spheres_run: &BedRun,
+    poly_run: &BedRun,
+) -> Result<(), SuiteError> {
+    let series = |run: &BedRun, label: &str, f: &dyn Fn(&BedRun, usize) -> Real| Series {
+        label: label.into(),
+        style: SeriesStyle::Line,
+        points: (0..run.history.t.len())
+            .map(|i| (run.history.t[i] * 1e3, f(run, i)))
+            .collect(),
+    };
+    for (quantity, y_label, pick) in [
+        (
+            "depth",
+            "depth z0 − z (mm)",
+            &(|r: &BedRun, i: usize| (r.z0 - r.history.z[i]) * 1e3)
+                as &dyn Fn(&BedRun, usize) -> Real,
+        ),
+        (
+            "velocity",
+            "vertical velocity (m/s)",
+            &|r: &BedRun, i: usize| r.history.vz[i],
+        ),
+        (
+            "force",
+            "vertical contact force (N)",
+            &|r: &BedRun, i: usize| r.history.fz[i],
+        ),
+    ] {
+        ctx.plot(&Plot {
+            name: format!("{v}_{quantity}"),
+            title: format!("{v}: projectile {quantity}, spheres vs polyhedra"),
+            x_label: "t (ms)".into(),
+            y_label: y_label.into(),
+            x_log: false,
+            y_log: false,
+            series: vec![
+                series(spheres_run, "sphere bed", pick),
+                series(poly_run, "polyhedral bed (equal volumes)", pick),
+            ],
+            caption: format!(
+                "Projectile {quantity} against time in the sphere bed and in the same bed of \
+                 polyhedra of equal volume (polydem, same law and step)."
+            ),
+        })?;
+    }
+    Ok(())
+}
+
+/// What the shape did in a variant, in words.
+fn paragraph(v: &str, t_end: Real, ms: &Metrics, mp: &Metrics) -> String {
+    let contacts = |m: &Metrics| m.mean_contacts.unwrap_or(Real::NAN);
+    format!(
                 "**{v}** (first {:.2} ms): in the polyhedral bed the projectile reaches a depth of {:.2} mm \
                  against {:.2} mm in the sphere bed ({:+.0} %); its peak contact force is {:.3} N against \
                  {:.3} N ({:+.0} %), at {:.3} ms against {:.3} ms; the vertical contact impulse is {:.4} N s \
@@ -623,65 +721,44 @@ impl Case for PolyhedraBed {
                 },
                 mp.final_vz,
                 ms.final_vz,
-                contacts(&mp),
-                contacts(&ms),
-            ));
-            summary_rows.push(vec![
-                v.clone(),
-                format!("{:.3}", ms.final_depth * 1e3),
-                format!("{:.3}", mp.final_depth * 1e3),
-                format!("{:.3}", ms.peak_force),
-                format!("{:.3}", mp.peak_force),
-                format!("{:.3}", ms.final_vz),
-                format!("{:.3}", mp.final_vz),
-                format!("{:.3}", relative_difference(ms.impulse, mp.impulse)),
-            ]);
-            for (bed, r) in [("spheres", &spheres_run), ("polyhedra", &poly_run)] {
-                speed_rows.push(vec![
-                    v.clone(),
-                    bed.to_owned(),
-                    format!("{}", r.steps),
-                    format!("{:.2}", r.wall_time_s),
-                    format!(
-                        "{:.3e}",
-                        r.particles as Real * r.steps as Real / r.wall_time_s
-                    ),
-                ]);
-            }
-            let _ = t_gen;
-        }
-        ctx.section("What the shape does");
-        ctx.text(&paragraphs.join("\n\n"));
-        ctx.table(
-            Some("summary"),
-            &[
-                "variant",
-                "final depth spheres [mm]",
-                "polyhedra [mm]",
-                "peak force spheres [N]",
-                "polyhedra [N]",
-                "final v_z spheres [m/s]",
-                "polyhedra [m/s]",
-                "impulse, relative difference",
-            ],
-            &summary_rows,
-        )?;
-        ctx.section("Cost (one thread, with the monitors)");
-        ctx.text(
-            "Wall time of the stepping loop including this case's monitors (overlap scan every step, \
-             tunnelling monitor), so not a speed figure of the engine; the machine is shared.",
-        );
-        ctx.table(
-            Some("cost"),
-            &[
-                "variant",
-                "bed",
-                "steps",
-                "wall time [s]",
-                "particle-steps/s",
-            ],
-            &speed_rows,
-        )?;
-        Ok(())
-    }
+                contacts(mp),
+                contacts(ms),
+            )
+}
+
+/// The summary of every variant and the cost table.
+fn closing(ctx: &mut CaseContext, out: &Closing) -> Result<(), SuiteError> {
+    ctx.section("What the shape does");
+    ctx.text(&out.paragraphs.join("\n\n"));
+    ctx.table(
+        Some("summary"),
+        &[
+            "variant",
+            "final depth spheres [mm]",
+            "polyhedra [mm]",
+            "peak force spheres [N]",
+            "polyhedra [N]",
+            "final v_z spheres [m/s]",
+            "polyhedra [m/s]",
+            "impulse, relative difference",
+        ],
+        &out.summary_rows,
+    )?;
+    ctx.section("Cost (one thread, with the monitors)");
+    ctx.text(
+        "Wall time of the stepping loop including this case's monitors (overlap scan every step, \
+         tunnelling monitor), so not a speed figure of the engine; the machine is shared.",
+    );
+    ctx.table(
+        Some("cost"),
+        &[
+            "variant",
+            "bed",
+            "steps",
+            "wall time [s]",
+            "particle-steps/s",
+        ],
+        &out.speed_rows,
+    )?;
+    Ok(())
 }
