@@ -110,6 +110,37 @@ fn wall_impact(
     Ok((run, m_star))
 }
 
+/// The case's parameters, references and tolerances.
+struct Inputs<'a> {
+    data: &'a CaseData,
+    p: Params,
+    hertz_tol: Real,
+    e_tol: Real,
+    sliding_tol: Real,
+    margin: Real,
+    /// The wall's stiffness over the sphere's (its Young modulus factor).
+    factor: Real,
+}
+
+impl Inputs<'_> {
+    fn r(&self, key: &str) -> Result<Real, SuiteError> {
+        self.data.reference("chung_ooi", key).map(|q| q.value)
+    }
+
+    fn material(&self, name: &'static str, prefix: &str) -> Result<Material, SuiteError> {
+        Ok(Material {
+            name,
+            young: self.r(&format!("{prefix}_young"))?,
+            poisson: self.r(&format!("{prefix}_poisson"))?,
+            density: self.r(&format!("{prefix}_density"))?,
+        })
+    }
+}
+
+fn chung_ooi_error(msg: String) -> SuiteError {
+    SuiteError::case("chung_ooi", msg)
+}
+
 impl Case for ChungOoi {
     fn name(&self) -> &'static str {
         "chung_ooi"
@@ -125,333 +156,361 @@ impl Case for ChungOoi {
         profile: Profile,
         ctx: &mut CaseContext,
     ) -> Result<(), SuiteError> {
-        let p: Params = data.params(self.name(), profile)?;
-        let r = |key: &str| data.reference("chung_ooi", key).map(|q| q.value);
-        let hertz_tol = data.tolerance(self.name(), "hertz_rel")?.value;
-        let e_tol = data.tolerance(self.name(), "restitution_rel")?.value;
-        let sliding_tol = data.tolerance(self.name(), "sliding_rel")?.value;
-        let margin = data.tolerance(self.name(), "sliding_margin")?.value;
-        let fail = |msg: String| SuiteError::case("chung_ooi", msg);
-        let material = |name: &'static str, prefix: &str| -> Result<Material, SuiteError> {
-            Ok(Material {
-                name,
-                young: r(&format!("{prefix}_young"))?,
-                poisson: r(&format!("{prefix}_poisson"))?,
-                density: r(&format!("{prefix}_density"))?,
-            })
+        let name = self.name();
+        let inp = Inputs {
+            data,
+            p: data.params(name, profile)?,
+            hertz_tol: data.tolerance(name, "hertz_rel")?.value,
+            e_tol: data.tolerance(name, "restitution_rel")?.value,
+            sliding_tol: data.tolerance(name, "sliding_rel")?.value,
+            margin: data.tolerance(name, "sliding_margin")?.value,
+            factor: data.reference(name, "wall_stiffness_factor")?.value,
         };
-        let factor = r("wall_stiffness_factor")?;
         ctx.progress().stage(
             "impacts",
-            (4 + 2 * p.restitutions.len() + p.angles_deg.len()) as u64,
+            (4 + 2 * inp.p.restitutions.len() + inp.p.angles_deg.len()) as u64,
         );
+        hertz_impacts(ctx, &inp)?;
+        restitution_impacts(ctx, &inp)?;
+        oblique_impacts(ctx, &inp)
+    }
+}
 
-        // Tests 1 and 2: Hertz theory.
-        let mut hertz_rows = Vec::new();
-        let mut hertz_check = |ctx: &mut CaseContext,
-                               test: &str,
-                               m: &Material,
-                               run: &Impact,
-                               theory: (Real, Real, Real)|
-         -> Result<(), SuiteError> {
-            let tag = format!("{test}_{}", m.name);
-            for (quantity, unit, measured, expected) in [
-                ("peak_force", "N", run.peak_force, theory.0),
-                ("peak_overlap", "m", run.peak_overlap, theory.1),
-                ("contact_duration", "s", run.duration, theory.2),
-            ] {
-                let error = (measured - expected).abs() / expected;
-                ctx.check(
-                    &format!("{tag}_{quantity}_rel_error"),
-                    error,
-                    Target::at_most(hertz_tol),
-                    "1",
-                );
-                hertz_rows.push(vec![
-                    test.to_string(),
-                    m.name.to_string(),
-                    format!("{quantity} ({unit})"),
-                    CaseContext::fmt(measured),
-                    CaseContext::fmt(expected),
-                    CaseContext::fmt(error),
-                ]);
-            }
-            Ok(())
-        };
-        for m in [
-            material("glass", "t1_glass")?,
-            material("limestone", "t1_limestone")?,
+/// Tests 1 and 2: elastic normal impacts, sphere on sphere and sphere on wall, against Hertz theory.
+fn hertz_impacts(ctx: &mut CaseContext, inp: &Inputs) -> Result<(), SuiteError> {
+    // Tests 1 and 2: Hertz theory.
+    let mut hertz_rows = Vec::new();
+    let mut hertz_check = |ctx: &mut CaseContext,
+                           test: &str,
+                           m: &Material,
+                           run: &Impact,
+                           theory: (Real, Real, Real)|
+     -> Result<(), SuiteError> {
+        let tag = format!("{test}_{}", m.name);
+        for (quantity, unit, measured, expected) in [
+            ("peak_force", "N", run.peak_force, theory.0),
+            ("peak_overlap", "m", run.peak_overlap, theory.1),
+            ("contact_duration", "s", run.duration, theory.2),
         ] {
-            let (radius, speed) = (r("t1_radius")?, r("t1_speed")?);
-            let pair = SpherePair {
-                material_a: elastic(&m).map_err(fail)?,
-                material_b: elastic(&m).map_err(fail)?,
-                radius_a: radius,
-                radius_b: Some(radius),
-                restitution: 1.0,
-                friction: 0.0,
-            };
-            let model = hertz_mindlin(&pair).map_err(|e| fail(e.to_string()))?;
-            let a = sphere(&m, radius, Point::origin(), Vector::new(0.0, 0.0, speed));
-            let b = sphere(
-                &m,
-                radius,
-                Point::new(0.0, 0.0, 2.0 * radius * (1.0 + 1e-4)),
-                Vector::new(0.0, 0.0, -speed),
-            );
-            let m_star = 0.5 * a.mass;
-            let approach = 2.0 * speed;
-            let dt = model.normal.elastic_contact_time(m_star, approach) / p.steps_per_contact;
-            let run = impact(
-                &model,
-                a,
-                b,
-                m_star,
-                dt,
-                (50.0 * p.steps_per_contact) as usize,
-                |a, b| sphere_sphere(radius, radius, a, b),
-            );
-            let e_star = effective_young_modulus(&pair.material_a, &pair.material_b);
-            let theory = hertz_theory(e_star, effective(radius, Some(radius)), m_star, approach);
-            hertz_check(ctx, "test1", &m, &run, theory)?;
-            ctx.progress().inc(1);
-        }
-        for m in [
-            material("aluminium_alloy", "t2_al")?,
-            material("magnesium_alloy", "t2_mg")?,
-        ] {
-            let (radius, speed) = (r("t2_radius")?, r("t2_speed")?);
-            let wall = wall_material(&m, factor);
-            let (run, m_star) =
-                wall_impact(&m, &wall, radius, speed, 0.0, 1.0, 0.0, p.steps_per_contact)
-                    .map_err(fail)?;
-            let e_star = effective_young_modulus(
-                &elastic(&wall).map_err(fail)?,
-                &elastic(&m).map_err(fail)?,
-            );
-            let theory = hertz_theory(e_star, radius, m_star, speed);
-            hertz_check(ctx, "test2", &m, &run, theory)?;
-            ctx.progress().inc(1);
-        }
-
-        // Test 3: restitution.
-        let (radius, speed) = (r("t34_radius")?, r("t34_speed")?);
-        let mut e_rows = Vec::new();
-        let mut e_series = Vec::new();
-        for m in [
-            material("aluminium_oxide", "t34_alox")?,
-            material("cast_iron", "t3_iron")?,
-        ] {
-            let wall = wall_material(&m, factor);
-            let mut worst: Real = 0.0;
-            let mut points = Vec::new();
-            for &e in &p.restitutions {
-                let (run, _) =
-                    wall_impact(&m, &wall, radius, speed, 0.0, e, 0.0, p.steps_per_contact)
-                        .map_err(fail)?;
-                let measured = run.b.velocity.z / speed;
-                let error = (measured / e - 1.0).abs();
-                worst = worst.max(error);
-                e_rows.push(vec![
-                    m.name.to_string(),
-                    format!("{e}"),
-                    format!("{measured:.6}"),
-                    CaseContext::fmt(error),
-                ]);
-                points.push((e, measured));
-                ctx.progress().inc(1);
-            }
+            let error = (measured - expected).abs() / expected;
             ctx.check(
-                &format!("test3_{}_restitution_rel_error_max", m.name),
-                worst,
-                Target::at_most(e_tol),
+                &format!("{tag}_{quantity}_rel_error"),
+                error,
+                Target::at_most(inp.hertz_tol),
                 "1",
             );
-            e_series.push(Series {
-                label: m.name.to_string(),
-                style: SeriesStyle::Points,
-                points,
-            });
-        }
-
-        // Test 4: oblique impacts.
-        let m = material("aluminium_oxide", "t34_alox")?;
-        let wall = wall_material(&m, factor);
-        let (mu, e) = (r("t4_friction")?, r("t4_restitution")?);
-        let threshold = 3.5 * mu * (1.0 + e);
-        let mut oblique_rows = Vec::new();
-        let (mut et_ours, mut et_theory, mut w_ours, mut w_theory) =
-            (Vec::new(), Vec::new(), Vec::new(), Vec::new());
-        let (mut worst_vt, mut worst_spin, mut checked): (Real, Real, usize) = (0.0, 0.0, 0);
-        for &angle in &p.angles_deg {
-            let theta = angle.to_radians();
-            let (v_n, v_t) = (speed * theta.cos(), speed * theta.sin());
-            let (run, _) = wall_impact(&m, &wall, radius, v_n, v_t, e, mu, p.steps_per_contact)
-                .map_err(fail)?;
-            let (vt_after, spin) = (run.b.velocity.x, run.b.angular_velocity().y);
-            let sliding = theta.tan() >= threshold;
-            let (vt_rigid, spin_rigid) = if sliding {
-                (
-                    v_t - mu * (1.0 + e) * v_n,
-                    2.5 * mu * (1.0 + e) * v_n / radius,
-                )
-            } else {
-                (5.0 / 7.0 * v_t, 5.0 / 7.0 * v_t / radius)
-            };
-            let checked_here = theta.tan() >= margin * threshold;
-            let (err_vt, err_spin) = (
-                (vt_after - vt_rigid).abs() / vt_rigid.abs(),
-                (spin - spin_rigid).abs() / spin_rigid.abs(),
-            );
-            if checked_here {
-                worst_vt = worst_vt.max(err_vt);
-                worst_spin = worst_spin.max(err_spin);
-                checked += 1;
-            }
-            oblique_rows.push(vec![
-                format!("{angle}"),
-                if sliding {
-                    "gross sliding"
-                } else {
-                    "rolling at exit (rigid)"
-                }
-                .into(),
-                if checked_here { "yes" } else { "no" }.into(),
-                format!("{:.5}", vt_after / v_t),
-                format!("{:.5}", vt_rigid / v_t),
-                format!("{spin:.3}"),
-                format!("{spin_rigid:.3}"),
+            hertz_rows.push(vec![
+                test.to_string(),
+                m.name.to_string(),
+                format!("{quantity} ({unit})"),
+                CaseContext::fmt(measured),
+                CaseContext::fmt(expected),
+                CaseContext::fmt(error),
             ]);
-            et_ours.push((angle, vt_after / v_t));
-            et_theory.push((angle, vt_rigid / v_t));
-            w_ours.push((angle, spin));
-            w_theory.push((angle, spin_rigid));
+        }
+        Ok(())
+    };
+    for m in [
+        inp.material("glass", "t1_glass")?,
+        inp.material("limestone", "t1_limestone")?,
+    ] {
+        let (radius, speed) = (inp.r("t1_radius")?, inp.r("t1_speed")?);
+        let pair = SpherePair {
+            material_a: elastic(&m).map_err(chung_ooi_error)?,
+            material_b: elastic(&m).map_err(chung_ooi_error)?,
+            radius_a: radius,
+            radius_b: Some(radius),
+            restitution: 1.0,
+            friction: 0.0,
+        };
+        let model = hertz_mindlin(&pair).map_err(|e| chung_ooi_error(e.to_string()))?;
+        let a = sphere(&m, radius, Point::origin(), Vector::new(0.0, 0.0, speed));
+        let b = sphere(
+            &m,
+            radius,
+            Point::new(0.0, 0.0, 2.0 * radius * (1.0 + 1e-4)),
+            Vector::new(0.0, 0.0, -speed),
+        );
+        let m_star = 0.5 * a.mass;
+        let approach = 2.0 * speed;
+        let dt = model.normal.elastic_contact_time(m_star, approach) / inp.p.steps_per_contact;
+        let run = impact(
+            &model,
+            a,
+            b,
+            m_star,
+            dt,
+            (50.0 * inp.p.steps_per_contact) as usize,
+            |a, b| sphere_sphere(radius, radius, a, b),
+        );
+        let e_star = effective_young_modulus(&pair.material_a, &pair.material_b);
+        let theory = hertz_theory(e_star, effective(radius, Some(radius)), m_star, approach);
+        hertz_check(ctx, "test1", &m, &run, theory)?;
+        ctx.progress().inc(1);
+    }
+    for m in [
+        inp.material("aluminium_alloy", "t2_al")?,
+        inp.material("magnesium_alloy", "t2_mg")?,
+    ] {
+        let (radius, speed) = (inp.r("t2_radius")?, inp.r("t2_speed")?);
+        let wall = wall_material(&m, inp.factor);
+        let (run, m_star) = wall_impact(
+            &m,
+            &wall,
+            radius,
+            speed,
+            0.0,
+            1.0,
+            0.0,
+            inp.p.steps_per_contact,
+        )
+        .map_err(chung_ooi_error)?;
+        let e_star = effective_young_modulus(
+            &elastic(&wall).map_err(chung_ooi_error)?,
+            &elastic(&m).map_err(chung_ooi_error)?,
+        );
+        let theory = hertz_theory(e_star, radius, m_star, speed);
+        hertz_check(ctx, "test2", &m, &run, theory)?;
+        ctx.progress().inc(1);
+    }
+
+    ctx.section("Tests 1–2: elastic normal impacts against Hertz theory");
+    ctx.text(&format!(
+        "dt = t_c/{} (t_c the elastic contact time of the law). Hertz theory (Johnson 1985 §11.4): \
+         δ_max = (15 m* v²/(16 E* √R*))^(2/5), F_max = (4/3) E* √R* δ_max^(3/2), t_c = 2.9432 δ_max/v.",
+        inp.p.steps_per_contact
+    ));
+    ctx.table(
+        Some("hertz"),
+        &[
+            "test",
+            "material",
+            "quantity",
+            "ours",
+            "Hertz",
+            "relative error",
+        ],
+        &hertz_rows,
+    )?;
+    Ok(())
+}
+
+/// Test 3: output against input restitution, sphere on wall.
+fn restitution_impacts(ctx: &mut CaseContext, inp: &Inputs) -> Result<(), SuiteError> {
+    // Test 3: restitution.
+    let (radius, speed) = (inp.r("t34_radius")?, inp.r("t34_speed")?);
+    let mut e_rows = Vec::new();
+    let mut e_series = Vec::new();
+    for m in [
+        inp.material("aluminium_oxide", "t34_alox")?,
+        inp.material("cast_iron", "t3_iron")?,
+    ] {
+        let wall = wall_material(&m, inp.factor);
+        let mut worst: Real = 0.0;
+        let mut points = Vec::new();
+        for &e in &inp.p.restitutions {
+            let (run, _) = wall_impact(
+                &m,
+                &wall,
+                radius,
+                speed,
+                0.0,
+                e,
+                0.0,
+                inp.p.steps_per_contact,
+            )
+            .map_err(chung_ooi_error)?;
+            let measured = run.b.velocity.z / speed;
+            let error = (measured / e - 1.0).abs();
+            worst = worst.max(error);
+            e_rows.push(vec![
+                m.name.to_string(),
+                format!("{e}"),
+                format!("{measured:.6}"),
+                CaseContext::fmt(error),
+            ]);
+            points.push((e, measured));
             ctx.progress().inc(1);
         }
-        if checked == 0 {
-            return Err(fail(format!(
-                "no incident angle of {:?} is in gross sliding (tan θ ≥ {margin} × {threshold:.4})",
-                p.angles_deg
-            )));
-        }
         ctx.check(
-            "test4_gross_sliding_tangential_velocity_rel_error_max",
-            worst_vt,
-            Target::at_most(sliding_tol),
+            &format!("test3_{}_restitution_rel_error_max", m.name),
+            worst,
+            Target::at_most(inp.e_tol),
             "1",
         );
-        ctx.check(
-            "test4_gross_sliding_spin_rel_error_max",
-            worst_spin,
-            Target::at_most(sliding_tol),
-            "1",
-        );
-
-        ctx.section("Tests 1–2: elastic normal impacts against Hertz theory");
-        ctx.text(&format!(
-            "dt = t_c/{} (t_c the elastic contact time of the law). Hertz theory (Johnson 1985 §11.4): \
-             δ_max = (15 m* v²/(16 E* √R*))^(2/5), F_max = (4/3) E* √R* δ_max^(3/2), t_c = 2.9432 δ_max/v.",
-            p.steps_per_contact
-        ));
-        ctx.table(
-            Some("hertz"),
-            &[
-                "test",
-                "material",
-                "quantity",
-                "ours",
-                "Hertz",
-                "relative error",
-            ],
-            &hertz_rows,
-        )?;
-        ctx.section("Test 3: output against input restitution");
-        ctx.table(
-            Some("restitution"),
-            &["material", "e input", "e output", "|e_out/e_in − 1|"],
-            &e_rows,
-        )?;
         e_series.push(Series {
-            label: "e_out = e_in".into(),
-            style: SeriesStyle::Line,
-            points: p.restitutions.iter().map(|&e| (e, e)).collect(),
+            label: m.name.to_string(),
+            style: SeriesStyle::Points,
+            points,
         });
-        ctx.plot(&Plot {
-            name: "test3_restitution".into(),
-            title: "Test 3: output against input restitution".into(),
-            x_label: "input e (1)".into(),
-            y_label: "output e (1)".into(),
-            x_log: false,
-            y_log: false,
-            series: e_series,
-            caption: format!("Sphere of radius {radius} m on a wall at {speed} m/s."),
-        })?;
-        ctx.section("Test 4: oblique impacts against the rigid-body solution");
-        ctx.text(&format!(
-            "Aluminium oxide sphere, resultant speed {speed} m/s, μ = {mu}, e = {e}. Rigid-body impulse solution \
-             with Coulomb friction: gross sliding for tan θ ≥ (7/2) μ (1 + e) = {threshold:.4} (θ ≥ {:.1}°): \
-             v_t'/v_t = 1 − μ (1 + e)/tan θ, ω' R = (5/2) μ (1 + e) v_n; below, the sphere leaves rolling, \
-             v_t' = ω' R = (5/7) v_t. The rolling branch ignores tangential compliance (Maw et al. 1976; the Mindlin \
-             spring stores tangential energy and returns part of it), so it is plotted, not checked; the gross \
-             sliding branch is checked for tan θ ≥ {margin} × {threshold:.4} ({checked} angles).",
-            threshold.atan().to_degrees()
-        ));
-        ctx.table(
-            Some("oblique"),
-            &[
-                "θ (deg)",
-                "rigid-body regime",
-                "checked",
-                "v_t'/v_t ours",
-                "v_t'/v_t rigid",
-                "ω' ours (rad/s)",
-                "ω' rigid (rad/s)",
-            ],
-            &oblique_rows,
-        )?;
-        ctx.plot(&Plot {
-            name: "test4_tangential_restitution".into(),
-            title: "Test 4: tangential coefficient of restitution".into(),
-            x_label: "incident angle θ (deg)".into(),
-            y_label: "v_t'/v_t (1)".into(),
-            x_log: false,
-            y_log: false,
-            series: vec![
-                Series {
-                    label: "polydem (Hertz–Mindlin)".into(),
-                    style: SeriesStyle::Points,
-                    points: et_ours,
-                },
-                Series {
-                    label: "rigid-body solution".into(),
-                    style: SeriesStyle::Line,
-                    points: et_theory,
-                },
-            ],
-            caption: "Below the sliding threshold the Mindlin spring's compliance lowers v_t'/v_t under 5/7 (Maw et al.)."
-                .into(),
-        })?;
-        ctx.plot(&Plot {
-            name: "test4_spin".into(),
-            title: "Test 4: rebound angular velocity".into(),
-            x_label: "incident angle θ (deg)".into(),
-            y_label: "ω' (rad/s)".into(),
-            x_log: false,
-            y_log: false,
-            series: vec![
-                Series {
-                    label: "polydem (Hertz–Mindlin)".into(),
-                    style: SeriesStyle::Points,
-                    points: w_ours,
-                },
-                Series {
-                    label: "rigid-body solution".into(),
-                    style: SeriesStyle::Line,
-                    points: w_theory,
-                },
-            ],
-            caption: "Spin about the axis n × t (the rolling sense).".into(),
-        })?;
-        Ok(())
     }
+
+    ctx.section("Test 3: output against input restitution");
+    ctx.table(
+        Some("restitution"),
+        &["material", "e input", "e output", "|e_out/e_in − 1|"],
+        &e_rows,
+    )?;
+    e_series.push(Series {
+        label: "e_out = e_in".into(),
+        style: SeriesStyle::Line,
+        points: inp.p.restitutions.iter().map(|&e| (e, e)).collect(),
+    });
+    ctx.plot(&Plot {
+        name: "test3_restitution".into(),
+        title: "Test 3: output against input restitution".into(),
+        x_label: "input e (1)".into(),
+        y_label: "output e (1)".into(),
+        x_log: false,
+        y_log: false,
+        series: e_series,
+        caption: format!("Sphere of radius {radius} m on a wall at {speed} m/s."),
+    })?;
+    Ok(())
+}
+
+/// Test 4: oblique impacts against the rigid-body solution with Coulomb friction.
+fn oblique_impacts(ctx: &mut CaseContext, inp: &Inputs) -> Result<(), SuiteError> {
+    let margin = inp.margin;
+    let (radius, speed) = (inp.r("t34_radius")?, inp.r("t34_speed")?);
+    // Test 4: oblique impacts.
+    let m = inp.material("aluminium_oxide", "t34_alox")?;
+    let wall = wall_material(&m, inp.factor);
+    let (mu, e) = (inp.r("t4_friction")?, inp.r("t4_restitution")?);
+    let threshold = 3.5 * mu * (1.0 + e);
+    let mut oblique_rows = Vec::new();
+    let (mut et_ours, mut et_theory, mut w_ours, mut w_theory) =
+        (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+    let (mut worst_vt, mut worst_spin, mut checked): (Real, Real, usize) = (0.0, 0.0, 0);
+    for &angle in &inp.p.angles_deg {
+        let theta = angle.to_radians();
+        let (v_n, v_t) = (speed * theta.cos(), speed * theta.sin());
+        let (run, _) = wall_impact(&m, &wall, radius, v_n, v_t, e, mu, inp.p.steps_per_contact)
+            .map_err(chung_ooi_error)?;
+        let (vt_after, spin) = (run.b.velocity.x, run.b.angular_velocity().y);
+        let sliding = theta.tan() >= threshold;
+        let (vt_rigid, spin_rigid) = if sliding {
+            (
+                v_t - mu * (1.0 + e) * v_n,
+                2.5 * mu * (1.0 + e) * v_n / radius,
+            )
+        } else {
+            (5.0 / 7.0 * v_t, 5.0 / 7.0 * v_t / radius)
+        };
+        let checked_here = theta.tan() >= margin * threshold;
+        let (err_vt, err_spin) = (
+            (vt_after - vt_rigid).abs() / vt_rigid.abs(),
+            (spin - spin_rigid).abs() / spin_rigid.abs(),
+        );
+        if checked_here {
+            worst_vt = worst_vt.max(err_vt);
+            worst_spin = worst_spin.max(err_spin);
+            checked += 1;
+        }
+        oblique_rows.push(vec![
+            format!("{angle}"),
+            if sliding {
+                "gross sliding"
+            } else {
+                "rolling at exit (rigid)"
+            }
+            .into(),
+            if checked_here { "yes" } else { "no" }.into(),
+            format!("{:.5}", vt_after / v_t),
+            format!("{:.5}", vt_rigid / v_t),
+            format!("{spin:.3}"),
+            format!("{spin_rigid:.3}"),
+        ]);
+        et_ours.push((angle, vt_after / v_t));
+        et_theory.push((angle, vt_rigid / v_t));
+        w_ours.push((angle, spin));
+        w_theory.push((angle, spin_rigid));
+        ctx.progress().inc(1);
+    }
+    if checked == 0 {
+        return Err(chung_ooi_error(format!(
+            "no incident angle of {:?} is in gross sliding (tan θ ≥ {margin} × {threshold:.4})",
+            inp.p.angles_deg
+        )));
+    }
+    ctx.check(
+        "test4_gross_sliding_tangential_velocity_rel_error_max",
+        worst_vt,
+        Target::at_most(inp.sliding_tol),
+        "1",
+    );
+    ctx.check(
+        "test4_gross_sliding_spin_rel_error_max",
+        worst_spin,
+        Target::at_most(inp.sliding_tol),
+        "1",
+    );
+
+    ctx.section("Test 4: oblique impacts against the rigid-body solution");
+    ctx.text(&format!(
+        "Aluminium oxide sphere, resultant speed {speed} m/s, μ = {mu}, e = {e}. Rigid-body impulse solution \
+         with Coulomb friction: gross sliding for tan θ ≥ (7/2) μ (1 + e) = {threshold:.4} (θ ≥ {:.1}°): \
+         v_t'/v_t = 1 − μ (1 + e)/tan θ, ω' R = (5/2) μ (1 + e) v_n; below, the sphere leaves rolling, \
+         v_t' = ω' R = (5/7) v_t. The rolling branch ignores tangential compliance (Maw et al. 1976; the Mindlin \
+         spring stores tangential energy and returns part of it), so it is plotted, not checked; the gross \
+         sliding branch is checked for tan θ ≥ {margin} × {threshold:.4} ({checked} angles).",
+        threshold.atan().to_degrees()
+    ));
+    ctx.table(
+        Some("oblique"),
+        &[
+            "θ (deg)",
+            "rigid-body regime",
+            "checked",
+            "v_t'/v_t ours",
+            "v_t'/v_t rigid",
+            "ω' ours (rad/s)",
+            "ω' rigid (rad/s)",
+        ],
+        &oblique_rows,
+    )?;
+    ctx.plot(&Plot {
+        name: "test4_tangential_restitution".into(),
+        title: "Test 4: tangential coefficient of restitution".into(),
+        x_label: "incident angle θ (deg)".into(),
+        y_label: "v_t'/v_t (1)".into(),
+        x_log: false,
+        y_log: false,
+        series: vec![
+            Series {
+                label: "polydem (Hertz–Mindlin)".into(),
+                style: SeriesStyle::Points,
+                points: et_ours,
+            },
+            Series {
+                label: "rigid-body solution".into(),
+                style: SeriesStyle::Line,
+                points: et_theory,
+            },
+        ],
+        caption: "Below the sliding threshold the Mindlin spring's compliance lowers v_t'/v_t under 5/7 (Maw et al.)."
+            .into(),
+    })?;
+    ctx.plot(&Plot {
+        name: "test4_spin".into(),
+        title: "Test 4: rebound angular velocity".into(),
+        x_label: "incident angle θ (deg)".into(),
+        y_label: "ω' (rad/s)".into(),
+        x_log: false,
+        y_log: false,
+        series: vec![
+            Series {
+                label: "polydem (Hertz–Mindlin)".into(),
+                style: SeriesStyle::Points,
+                points: w_ours,
+            },
+            Series {
+                label: "rigid-body solution".into(),
+                style: SeriesStyle::Line,
+                points: w_theory,
+            },
+        ],
+        caption: "Spin about the axis n × t (the rolling sense).".into(),
+    })?;
+    Ok(())
 }
