@@ -108,9 +108,7 @@ pub(super) fn kick_and_drift(
 }
 
 /// Stages 7–8: the second half kick, then the checks of the same body, in one pass; the first non-finite
-/// body in body order is reported, for any number of threads. When stage 6 left the per-body sums to this
-/// pass ([`StepScratch::deferred_gather`]), body i's sums over its pairs in candidate order (the same
-/// additions as stage 6's gather) come first.
+/// body in body order is reported, for any number of threads (see [`kick_each_body`]).
 pub(super) fn kick_and_check(
     params: &StepParams,
     integrator: &Integrator,
@@ -118,8 +116,36 @@ pub(super) fn kick_and_check(
     scratch: &mut StepScratch,
     counters: &mut StepCounters,
 ) -> Result<(), StepError> {
-    let dt = params.dt;
-    let skip = params.skips;
+    let (dt, skip) = (params.dt, params.skips);
+    // The pass borrows the world mutably; the sleep flags it reads are lent out of it meanwhile.
+    let asleep = std::mem::take(&mut world.sleep);
+    let result = kick_each_body(
+        params,
+        world,
+        scratch,
+        counters,
+        |i, body, force, torque| {
+            if !(asleep.is_asleep(i) || (skip.non_dynamic_pairs && is_at_rest_fixed(body))) {
+                integrator.second_half_kick(body, force, torque, dt);
+            }
+            non_finite_quantity(body, force, torque)
+        },
+    );
+    world.sleep = asleep;
+    result
+}
+
+/// The pass of stages 7–8 that every layout of the general step shares: `kick` on each body with its
+/// loads, the first non-finite quantity it reports (in body order, for any number of threads) the error.
+/// When stage 6 left the per-body sums to this pass ([`StepScratch::deferred_gather`]), body i's sums
+/// over its pairs in candidate order (the same additions as stage 6's gather) come first.
+pub(super) fn kick_each_body(
+    params: &StepParams,
+    world: &mut World,
+    scratch: &mut StepScratch,
+    counters: &mut StepCounters,
+    kick: impl Fn(usize, &mut RigidBody, &Vector, &Vector) -> Option<&'static str> + Sync,
+) -> Result<(), StepError> {
     let mut clock = StageClock::start();
     let parallel_bodies = integration_work(world.bodies.len(), scratch.inputs.summary.anisotropic)
         >= params.parallel.min_bodies;
@@ -128,7 +154,7 @@ pub(super) fn kick_and_check(
         let adjacency = clock.serial(Section::SerialStore, || {
             world.contacts.body_adjacency(n_bodies)
         });
-        let (evaluated, asleep) = (&scratch.evaluated, &world.sleep);
+        let evaluated = &scratch.evaluated;
         let loads = &mut world.loads;
         clock.region(Section::KickChecks, true, || {
             for_each_item3_checked(
@@ -138,22 +164,15 @@ pub(super) fn kick_and_check(
                 &mut loads.torques,
                 |i, body, force, torque| {
                     sum_body_loads(adjacency, evaluated, i, force, torque);
-                    if !(asleep.is_asleep(i) || (skip.non_dynamic_pairs && is_at_rest_fixed(body)))
-                    {
-                        integrator.second_half_kick(body, force, torque, dt);
-                    }
-                    non_finite_quantity(body, force, torque)
+                    kick(i, body, force, torque)
                 },
             )
         })
     } else {
-        let (loads, asleep) = (&world.loads, &world.sleep);
+        let loads = &world.loads;
         clock.region(Section::KickChecks, parallel_bodies, || {
             for_each_item_checked(parallel_bodies, &mut world.bodies, |i, body| {
-                if !(asleep.is_asleep(i) || (skip.non_dynamic_pairs && is_at_rest_fixed(body))) {
-                    integrator.second_half_kick(body, &loads.forces[i], &loads.torques[i], dt);
-                }
-                non_finite_quantity(body, &loads.forces[i], &loads.torques[i])
+                kick(i, body, &loads.forces[i], &loads.torques[i])
             })
         })
     };

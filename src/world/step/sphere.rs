@@ -25,15 +25,13 @@ use crate::math::{Real, Vector};
 use crate::shape::Shape;
 
 use super::super::body_inputs;
-use super::super::parallel::{
-    for_each_item3, for_each_item3_checked, for_each_item_checked, integration_work,
-};
+use super::super::parallel::{for_each_item3, integration_work};
 use super::super::region_profile::Section;
 use super::super::timing::{Stage, StageClock};
 use super::super::world::World;
-use super::accumulate::sum_body_loads;
 use super::checks::non_finite_quantity;
 use super::counters::StepCounters;
+use super::integrate::kick_each_body;
 use super::ledger::StepPowers;
 use super::loads;
 use super::params::StepParams;
@@ -203,39 +201,11 @@ fn kick_all(
     counters: &mut StepCounters,
 ) -> Result<(), StepError> {
     let dt = params.dt;
-    let mut clock = StageClock::start();
-    let parallel_bodies = integration_work(world.bodies.len(), scratch.inputs.summary.anisotropic)
-        >= params.parallel.min_bodies;
-    let non_finite = if std::mem::take(&mut scratch.deferred_gather) {
-        let n_bodies = world.bodies.len();
-        let adjacency = clock.serial(Section::SerialStore, || {
-            world.contacts.body_adjacency(n_bodies)
-        });
-        let evaluated = &scratch.evaluated;
-        let loads = &mut world.loads;
-        clock.region(Section::KickChecks, true, || {
-            for_each_item3_checked(
-                true,
-                &mut world.bodies,
-                &mut loads.forces,
-                &mut loads.torques,
-                |i, body, force, torque| {
-                    sum_body_loads(adjacency, evaluated, i, force, torque);
-                    kick_and_check(body, force, torque, translation, dt)
-                },
-            )
-        })
-    } else {
-        let loads = &world.loads;
-        clock.region(Section::KickChecks, parallel_bodies, || {
-            for_each_item_checked(parallel_bodies, &mut world.bodies, |i, body| {
-                kick_and_check(body, &loads.forces[i], &loads.torques[i], translation, dt)
-            })
-        })
-    };
-    counters.add(Stage::Integrate, clock.stop());
-    match non_finite {
-        Some(found) => Err(StepError::non_finite(world, found)),
-        None => Ok(()),
-    }
+    kick_each_body(
+        params,
+        world,
+        scratch,
+        counters,
+        |_, body, force, torque| kick_and_check(body, force, torque, translation, dt),
+    )
 }
