@@ -286,164 +286,195 @@ impl Case for PolyhedraBox {
         let scene = root.join("reference/polyhedra_box/scene.toml");
 
         let (ours, sim) = run_polydem(&scene, ctx)?;
-        let mut yade_note = String::new();
-        let yade = match p.rerun_yade {
-            true => {
-                let dir =
-                    std::env::temp_dir().join(format!("polydem-yade-box-{}", std::process::id()));
-                std::fs::create_dir_all(&dir)
-                    .map_err(|e| fail(format!("cannot create {}: {e}", dir.display())))?;
-                match rerun_yade(&root, &dir)? {
-                    Some(csv) => {
-                        let mut run = read_yade(&csv)?;
-                        run.provenance = "this run".into();
-                        run
-                    }
-                    None => {
-                        yade_note = "YADE is not installed here: the YADE figures are the recorded run, not this run. ".into();
-                        recorded_yade(&root)?
-                    }
-                }
-            }
-            false => recorded_yade(&root)?,
-        };
+        let (yade, yade_note) = yade_run(&p, &root)?;
         if yade.bodies != ours.bodies || yade.steps != ours.steps {
             return Err(fail(format!(
                 "YADE run has {} bodies and {} steps, polydem {} and {}: not the same scene",
                 yade.bodies, yade.steps, ours.bodies, ours.steps
             )));
         }
-
-        ctx.section("Cost per step");
-        let per_step = |r: &CodeRun, s: Real| s / r.steps as Real;
-        let particle_steps = |r: &CodeRun, s: Real| (r.bodies as Real * r.steps as Real) / s;
-        let rows: Vec<Vec<String>> = [("polydem", &ours), ("YADE 2023.02a -j1", &yade)]
-            .iter()
-            .map(|(name, r)| {
-                vec![
-                    name.to_string(),
-                    r.provenance.clone(),
-                    format!("{}", r.steps),
-                    CaseContext::fmt(r.cpu_s),
-                    CaseContext::fmt(r.wall_s),
-                    CaseContext::fmt(per_step(r, r.cpu_s) * 1e6),
-                    CaseContext::fmt(particle_steps(r, r.cpu_s)),
-                ]
-            })
-            .collect();
-        ctx.table(
-            Some("timing"),
-            &[
-                "code",
-                "figures from",
-                "steps",
-                "CPU time (s)",
-                "wall time (s)",
-                "CPU µs per step",
-                "particle-steps per CPU second",
-            ],
-            &rows,
-        )?;
-        let speedup = yade.cpu_s / ours.cpu_s;
-        let wall_speedup = yade.wall_s / ours.wall_s;
-        let contact_steps_ours: Real = ours.monitors.iter().map(|m| m.contacts).sum::<Real>()
-            / ours.monitors.len() as Real
-            * ours.steps as Real;
-        let contact_steps_yade: Real = yade.monitors.iter().map(|m| m.contacts).sum::<Real>()
-            / yade.monitors.len() as Real
-            * yade.steps as Real;
-        ctx.text(&format!(
-            "{yade_note}YADE / polydem CPU time per step: **{speedup:.1}×** (wall time: {wall_speedup:.1}×; \
-             target ≥ {speedup_target}× from the issue). Mean number of contacts over the run (sampled at the \
-             output interval): polydem {:.0}, YADE {:.0}; CPU µs per contact-step: polydem {:.3}, YADE {:.3}.",
-            contact_steps_ours / ours.steps as Real,
-            contact_steps_yade / yade.steps as Real,
-            ours.cpu_s / contact_steps_ours.max(1.0) * 1e6,
-            yade.cpu_s / contact_steps_yade.max(1.0) * 1e6,
-        ));
-        ctx.check(
-            "yade_over_polydem_cpu_time",
-            speedup,
-            Target::at_least(speedup_target),
-            "1",
-        );
-
-        ctx.section("Energy ledger of the polydem run");
-        let e = sim.world.energy();
-        let scale = e.mechanical().abs().max(e.translational_kinetic);
-        let balance = e.balance.abs() / scale;
-        ctx.text(&format!(
-            "Elastic normal law (e = 1) with Coulomb friction μ = 0.5: the only dissipation is friction work \
-             ({} J). Balance E(t) + dissipated − E(0) = {} J, {} of the mechanical energy {} J. Polyhedra \
-             landing flat on a wall carry the known first-order error of the deepest-vertex wall contact \
-             (the single_contact_energy case).",
-            CaseContext::fmt(e.dissipated_friction),
-            CaseContext::fmt(e.balance),
-            CaseContext::fmt(balance),
-            CaseContext::fmt(e.mechanical()),
-        ));
-        ctx.check(
-            "energy_balance_rel",
-            balance,
-            Target::at_most(balance_tol),
-            "1",
-        );
-        let nan = sim
-            .world
-            .bodies()
-            .iter()
-            .filter(|b| !(b.position.coords.iter().all(|c| c.is_finite())))
-            .count();
-        ctx.check(
-            "non_finite_bodies",
-            nan as Real,
-            Target::equal(0.0),
-            "bodies",
-        );
-
-        ctx.section("Trajectories (not gated: the two laws differ)");
-        let plots: [MonitorPlot; 4] = [
-            (
-                "mean_height",
-                "Mean height of the centres of mass",
-                "mean z (m)",
-                |m| m.mean_z,
-            ),
-            ("lowest_centre", "Lowest centre of mass", "min z (m)", |m| {
-                m.min_z
-            }),
-            (
-                "kinetic_energy",
-                "Translational kinetic energy",
-                "energy (J)",
-                |m| m.kinetic_energy,
-            ),
-            (
-                "contacts",
-                "Contacts (overlapping pairs incl. walls)",
-                "contacts",
-                |m| m.contacts,
-            ),
-        ];
-        for (name, title, y_label, value) in plots {
-            ctx.plot(&Plot {
-                name: name.into(),
-                title: title.into(),
-                x_label: "t (s)".into(),
-                y_label: y_label.into(),
-                x_log: false,
-                y_log: false,
-                series: vec![
-                    curve("polydem", &ours.monitors, value),
-                    curve("YADE (volumetric law)", &yade.monitors, value),
-                ],
-                caption: format!(
-                    "Sampled every {} s. YADE: {}.",
-                    CaseContext::fmt(sim.params.dt * sim.output_every as Real),
-                    yade.provenance
-                ),
-            })?;
-        }
-        Ok(())
+        cost_per_step(ctx, &ours, &yade, &yade_note, speedup_target)?;
+        energy_ledger(ctx, &sim, balance_tol);
+        trajectories(ctx, &sim, &ours, &yade)
     }
+}
+
+/// YADE's run of the scene: this run's where YADE is installed and `rerun_yade` asks for it, else the
+/// recorded one; with the note the page gives when a re-run was asked for and could not be made.
+fn yade_run(p: &Params, root: &Path) -> Result<(CodeRun, String), SuiteError> {
+    let mut yade_note = String::new();
+    let yade = match p.rerun_yade {
+        true => {
+            let dir = std::env::temp_dir().join(format!("polydem-yade-box-{}", std::process::id()));
+            std::fs::create_dir_all(&dir)
+                .map_err(|e| fail(format!("cannot create {}: {e}", dir.display())))?;
+            match rerun_yade(root, &dir)? {
+                Some(csv) => {
+                    let mut run = read_yade(&csv)?;
+                    run.provenance = "this run".into();
+                    run
+                }
+                None => {
+                    yade_note = "YADE is not installed here: the YADE figures are the recorded run, not this run. ".into();
+                    recorded_yade(root)?
+                }
+            }
+        }
+        false => recorded_yade(root)?,
+    };
+    Ok((yade, yade_note))
+}
+
+/// The cost of a step in both codes, and the gated ratio of their CPU times.
+fn cost_per_step(
+    ctx: &mut CaseContext,
+    ours: &CodeRun,
+    yade: &CodeRun,
+    yade_note: &str,
+    speedup_target: Real,
+) -> Result<(), SuiteError> {
+    ctx.section("Cost per step");
+    let per_step = |r: &CodeRun, s: Real| s / r.steps as Real;
+    let particle_steps = |r: &CodeRun, s: Real| (r.bodies as Real * r.steps as Real) / s;
+    let rows: Vec<Vec<String>> = [("polydem", ours), ("YADE 2023.02a -j1", yade)]
+        .iter()
+        .map(|(name, r)| {
+            vec![
+                name.to_string(),
+                r.provenance.clone(),
+                format!("{}", r.steps),
+                CaseContext::fmt(r.cpu_s),
+                CaseContext::fmt(r.wall_s),
+                CaseContext::fmt(per_step(r, r.cpu_s) * 1e6),
+                CaseContext::fmt(particle_steps(r, r.cpu_s)),
+            ]
+        })
+        .collect();
+    ctx.table(
+        Some("timing"),
+        &[
+            "code",
+            "figures from",
+            "steps",
+            "CPU time (s)",
+            "wall time (s)",
+            "CPU µs per step",
+            "particle-steps per CPU second",
+        ],
+        &rows,
+    )?;
+    let speedup = yade.cpu_s / ours.cpu_s;
+    let wall_speedup = yade.wall_s / ours.wall_s;
+    let contact_steps_ours: Real = ours.monitors.iter().map(|m| m.contacts).sum::<Real>()
+        / ours.monitors.len() as Real
+        * ours.steps as Real;
+    let contact_steps_yade: Real = yade.monitors.iter().map(|m| m.contacts).sum::<Real>()
+        / yade.monitors.len() as Real
+        * yade.steps as Real;
+    ctx.text(&format!(
+        "{yade_note}YADE / polydem CPU time per step: **{speedup:.1}×** (wall time: {wall_speedup:.1}×; \
+         target ≥ {speedup_target}× from the issue). Mean number of contacts over the run (sampled at the \
+         output interval): polydem {:.0}, YADE {:.0}; CPU µs per contact-step: polydem {:.3}, YADE {:.3}.",
+        contact_steps_ours / ours.steps as Real,
+        contact_steps_yade / yade.steps as Real,
+        ours.cpu_s / contact_steps_ours.max(1.0) * 1e6,
+        yade.cpu_s / contact_steps_yade.max(1.0) * 1e6,
+    ));
+    ctx.check(
+        "yade_over_polydem_cpu_time",
+        speedup,
+        Target::at_least(speedup_target),
+        "1",
+    );
+
+    Ok(())
+}
+
+/// The energy ledger of the polydem run and its finite state, gated.
+fn energy_ledger(ctx: &mut CaseContext, sim: &Simulation, balance_tol: Real) {
+    ctx.section("Energy ledger of the polydem run");
+    let e = sim.world.energy();
+    let scale = e.mechanical().abs().max(e.translational_kinetic);
+    let balance = e.balance.abs() / scale;
+    ctx.text(&format!(
+        "Elastic normal law (e = 1) with Coulomb friction μ = 0.5: the only dissipation is friction work \
+         ({} J). Balance E(t) + dissipated − E(0) = {} J, {} of the mechanical energy {} J. Polyhedra \
+         landing flat on a wall carry the known first-order error of the deepest-vertex wall contact \
+         (the single_contact_energy case).",
+        CaseContext::fmt(e.dissipated_friction),
+        CaseContext::fmt(e.balance),
+        CaseContext::fmt(balance),
+        CaseContext::fmt(e.mechanical()),
+    ));
+    ctx.check(
+        "energy_balance_rel",
+        balance,
+        Target::at_most(balance_tol),
+        "1",
+    );
+    let nan = sim
+        .world
+        .bodies()
+        .iter()
+        .filter(|b| !(b.position.coords.iter().all(|c| c.is_finite())))
+        .count();
+    ctx.check(
+        "non_finite_bodies",
+        nan as Real,
+        Target::equal(0.0),
+        "bodies",
+    );
+}
+
+/// The monitors of both runs overlaid (not gated: the two laws differ).
+fn trajectories(
+    ctx: &mut CaseContext,
+    sim: &Simulation,
+    ours: &CodeRun,
+    yade: &CodeRun,
+) -> Result<(), SuiteError> {
+    ctx.section("Trajectories (not gated: the two laws differ)");
+    let plots: [MonitorPlot; 4] = [
+        (
+            "mean_height",
+            "Mean height of the centres of mass",
+            "mean z (m)",
+            |m| m.mean_z,
+        ),
+        ("lowest_centre", "Lowest centre of mass", "min z (m)", |m| {
+            m.min_z
+        }),
+        (
+            "kinetic_energy",
+            "Translational kinetic energy",
+            "energy (J)",
+            |m| m.kinetic_energy,
+        ),
+        (
+            "contacts",
+            "Contacts (overlapping pairs incl. walls)",
+            "contacts",
+            |m| m.contacts,
+        ),
+    ];
+    for (name, title, y_label, value) in plots {
+        ctx.plot(&Plot {
+            name: name.into(),
+            title: title.into(),
+            x_label: "t (s)".into(),
+            y_label: y_label.into(),
+            x_log: false,
+            y_log: false,
+            series: vec![
+                curve("polydem", &ours.monitors, value),
+                curve("YADE (volumetric law)", &yade.monitors, value),
+            ],
+            caption: format!(
+                "Sampled every {} s. YADE: {}.",
+                CaseContext::fmt(sim.params.dt * sim.output_every as Real),
+                yade.provenance
+            ),
+        })?;
+    }
+    Ok(())
 }
