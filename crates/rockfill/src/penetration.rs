@@ -396,7 +396,7 @@ pub fn penetrate_with(
         let body = &world.bodies()[index];
         let axis = body.orientation * projectile.axis_body;
         let tip = body.position + axis * (length - axis_offset(projectile));
-        let force = world.loads().forces[index];
+        let force = world.loads().forces()[index];
         let contacts = world
             .contacts()
             .keys()
