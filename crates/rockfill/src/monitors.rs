@@ -12,7 +12,7 @@
 //! `monitors.csv`.
 
 use std::io::{self, BufWriter, Write};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
 use polydem::io::output::Output;
@@ -157,7 +157,7 @@ impl MonitorSeries {
         self.rows
     }
 
-    fn write_file(&self, path: &PathBuf) -> io::Result<()> {
+    fn write_file(&self, path: &Path) -> io::Result<()> {
         let mut out = BufWriter::new(std::fs::File::create(path)?);
         writeln!(out, "{}", MonitorRow::CSV_HEADER)?;
         for row in &self.rows {
