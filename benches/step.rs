@@ -321,7 +321,7 @@ fn sleeping(c: &mut Criterion) {
         }
         eprintln!(
             "sleeping bench: {} of {} bodies asleep before the impact",
-            b.world.sleep().sleeping,
+            b.world.sleep().asleep_count(),
             b.world.bodies().len()
         );
         Scene {

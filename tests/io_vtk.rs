@@ -274,13 +274,13 @@ fn frames_parse_back_with_the_world_geometry_and_fields(encoding: VtkEncoding) {
             close(
                 &format!("body {i} contact force"),
                 &force[3 * cell..3 * cell + 3],
-                &world.loads().forces[i],
-                world.loads().forces[i].norm(),
+                &world.loads().forces()[i],
+                world.loads().forces()[i].norm(),
             );
             start = end;
             cell += 1;
         }
-        if world.loads().forces[i].norm() > 0.0 {
+        if world.loads().forces()[i].norm() > 0.0 {
             nonzero_forces += 1;
         }
         base += poly.vertices().len();
@@ -365,8 +365,8 @@ fn frames_parse_back_with_the_world_geometry_and_fields(encoding: VtkEncoding) {
         close(
             &format!("wall {k} force"),
             &wall_force[3 * k..3 * k + 3],
-            &world.loads().wall_forces[k],
-            world.loads().wall_forces[k].norm(),
+            &world.loads().wall_forces()[k],
+            world.loads().wall_forces()[k].norm(),
         );
         start = end;
     }

@@ -517,7 +517,7 @@ impl Pin {
         }
         let mut loads = Fnv1a::new();
         let l = &world.loads();
-        for v in l.forces.iter().chain(&l.torques).chain(&l.wall_forces) {
+        for v in l.forces().iter().chain(l.torques()).chain(l.wall_forces()) {
             loads.vector(v);
         }
 

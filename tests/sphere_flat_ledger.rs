@@ -71,17 +71,20 @@ fn flat(params: &polydem::world::StepParams, world: &World, steps: u64, threads:
 fn ledger_values(w: &World) -> [(&'static str, f64); 9] {
     let l = &w.ledger();
     [
-        ("initial_total", l.initial_total.unwrap_or(f64::NAN)),
-        ("dissipated_damping", l.dissipated_damping),
-        ("dissipated_friction", l.dissipated_friction),
-        ("dissipated_viscous", l.dissipated_viscous),
-        ("external_work", l.external_work),
-        ("tangential_stiffness_work", l.tangential_stiffness_work),
-        ("loads.damping_work", w.loads().damping_work),
-        ("loads.friction_dissipation", w.loads().friction_dissipation),
+        ("initial_total", l.initial_total().unwrap_or(f64::NAN)),
+        ("dissipated_damping", l.dissipated_damping()),
+        ("dissipated_friction", l.dissipated_friction()),
+        ("dissipated_viscous", l.dissipated_viscous()),
+        ("external_work", l.external_work()),
+        ("tangential_stiffness_work", l.tangential_stiffness_work()),
+        ("loads.damping_work", w.loads().damping_work()),
+        (
+            "loads.friction_dissipation",
+            w.loads().friction_dissipation(),
+        ),
         (
             "loads.tangential_stiffness_work",
-            w.loads().tangential_stiffness_work,
+            w.loads().tangential_stiffness_work(),
         ),
     ]
 }
@@ -106,14 +109,14 @@ fn assert_booked(file: &str, w: &World) {
     let l = &w.ledger();
     let mindlin = !file.contains("linear");
     assert!(
-        l.dissipated_damping > 0.0
-            && l.dissipated_friction > 0.0
-            && (l.tangential_stiffness_work != 0.0) == mindlin,
+        l.dissipated_damping() > 0.0
+            && l.dissipated_friction() > 0.0
+            && (l.tangential_stiffness_work() != 0.0) == mindlin,
         "{file}: damping {:e} J, friction {:e} J, stiffness work {:e} J booked: expected > 0, > 0, \
          nonzero for a Hertz–Mindlin scene only",
-        l.dissipated_damping,
-        l.dissipated_friction,
-        l.tangential_stiffness_work
+        l.dissipated_damping(),
+        l.dissipated_friction(),
+        l.tangential_stiffness_work()
     );
 }
 

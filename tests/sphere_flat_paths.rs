@@ -58,8 +58,8 @@ fn first_difference(a: &World, b: &World) -> Option<String> {
     let extra = |w: &World| {
         [
             w.time(),
-            w.ledger().external_work,
-            w.ledger().initial_total.unwrap_or(f64::NAN),
+            w.ledger().external_work(),
+            w.ledger().initial_total().unwrap_or(f64::NAN),
         ]
     };
     let (la, lb) = (

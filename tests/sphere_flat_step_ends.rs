@@ -46,8 +46,8 @@ fn accessors_show_every_step_end_as_the_general_step() {
                     b.angular_momentum,
                     flat.angular_momentum(i),
                 ),
-                ("force", world.loads().forces[i], flat.forces()[i]),
-                ("torque", world.loads().torques[i], flat.torques()[i]),
+                ("force", world.loads().forces()[i], flat.forces()[i]),
+                ("torque", world.loads().torques()[i], flat.torques()[i]),
             ];
             for (what, general, ours) in pairs {
                 let bits = |v: &polydem::math::Vector| v.map(Real::to_bits);

@@ -54,7 +54,7 @@ fn a_prescribed_wall_does_the_work_the_ledger_reports() {
     let steps = ((0.02 + t_c + 0.05) / params.dt) as usize;
     for _ in 0..steps {
         step(&params, &mut world, &mut scratch).expect("step");
-        max_wall_force = max_wall_force.max(-world.loads().wall_forces[0].z);
+        max_wall_force = max_wall_force.max(-world.loads().wall_forces()[0].z);
     }
     let v = world.bodies()[0].velocity.z;
     assert!(

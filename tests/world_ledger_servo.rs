@@ -69,7 +69,7 @@ fn servo_run(per_contact: Real, steps: usize) -> (Real, Real, usize) {
     let mut switches = 0;
     let mut last_moving = false;
     for _ in 0..steps {
-        let force = world.loads().wall_forces.get(1).map_or(0.0, |f| f.z);
+        let force = world.loads().wall_forces().get(1).map_or(0.0, |f| f.z);
         let moving = force < cap;
         switches += usize::from(moving != last_moving);
         last_moving = moving;

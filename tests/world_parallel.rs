@@ -71,7 +71,7 @@ fn one_two_and_four_threads_give_bit_identical_states() {
         serial_contacts > 1000,
         "the scene must be contact-rich to test anything: {serial_contacts} contact evaluations in {STEPS} steps"
     );
-    let wall_force = serial.loads().wall_forces[0].z;
+    let wall_force = serial.loads().wall_forces()[0].z;
     assert!(
         wall_force < 0.0,
         "the floor must be pushed down after {STEPS} steps: force on the floor {wall_force} N (z)"

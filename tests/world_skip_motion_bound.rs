@@ -465,11 +465,15 @@ fn assert_same_run(
             ("position", a.position.coords, b.position.coords),
             ("velocity", a.velocity, b.velocity),
             ("angular momentum", a.angular_momentum, b.angular_momentum),
-            ("contact force", on.loads().forces[i], off.loads().forces[i]),
+            (
+                "contact force",
+                on.loads().forces()[i],
+                off.loads().forces()[i],
+            ),
             (
                 "contact torque",
-                on.loads().torques[i],
-                off.loads().torques[i],
+                on.loads().torques()[i],
+                off.loads().torques()[i],
             ),
         ] {
             assert_eq!(
@@ -488,9 +492,9 @@ fn assert_same_run(
     }
     for (w, (x, y)) in on
         .loads()
-        .wall_forces
+        .wall_forces()
         .iter()
-        .zip(&off.loads().wall_forces)
+        .zip(off.loads().wall_forces())
         .enumerate()
     {
         assert_eq!(

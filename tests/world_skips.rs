@@ -202,9 +202,9 @@ fn bodies_without_angular_momentum_skip_the_rotation_exactly() {
         }),
     );
     assert!(
-        on.loads().wall_forces[0].z < 0.0,
+        on.loads().wall_forces()[0].z < 0.0,
         "the spheres must reach the floor: force on the floor {:?}",
-        on.loads().wall_forces[0]
+        on.loads().wall_forces()[0]
     );
     for (i, (a, b)) in on.bodies().iter().zip(off.bodies()).enumerate() {
         assert_eq!(a.angular_momentum, Vector::zeros(), "body {i} gained spin");
@@ -263,7 +263,10 @@ fn query_skips_and_verlet_skin_agree_with_full_queries_within_tolerance() {
         e_on.translational_kinetic + e_on.rotational_kinetic,
         e_off.translational_kinetic + e_off.rotational_kinetic,
     );
-    let floor = rel(on.loads().wall_forces[0].z, off.loads().wall_forces[0].z);
+    let floor = rel(
+        on.loads().wall_forces()[0].z,
+        off.loads().wall_forces()[0].z,
+    );
     eprintln!(
         "query skips on vs off after {STEPS} steps: max |Δx|/d = {:e}, max |Δv|/v0 = {:e}, kinetic energy {ke:e}, floor force {floor:e}; counters on {c_on:?} off {c_off:?}",
         dx / d,

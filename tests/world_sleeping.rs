@@ -94,11 +94,11 @@ fn strike(sleeping: bool, threads: usize) -> Outcome {
         for _ in 0..STEPS {
             let r = step(&b.params, &mut b.world, &mut scratch).expect("step");
             counters.merge(&r.counters);
-            max_sleeping = max_sleeping.max(b.world.sleep().sleeping);
-            if b.world.sleep().sleeping == b.world.bodies().len() - 1
+            max_sleeping = max_sleeping.max(b.world.sleep().asleep_count());
+            if b.world.sleep().asleep_count() == b.world.bodies().len() - 1
                 && floor_while_asleep.is_none()
             {
-                floor_while_asleep = Some((-b.world.loads().wall_forces[0].z, weight));
+                floor_while_asleep = Some((-b.world.loads().wall_forces()[0].z, weight));
             }
         }
         Outcome {
@@ -293,9 +293,9 @@ fn strike_column(sleeping: bool, steps: usize) -> ColumnRun {
             let disturbed = if sleeping {
                 !world.sleep().is_asleep(j)
             } else {
-                let net = world.loads().forces[j] + body.mass * world.gravity();
+                let net = world.loads().forces()[j] + body.mass * world.gravity();
                 net.norm() > sleep.rest_force * body.mass * g
-                    || world.loads().torques[j].norm() > sleep.rest_force * body.mass * g * RADIUS
+                    || world.loads().torques()[j].norm() > sleep.rest_force * body.mass * g * RADIUS
             };
             if disturbed && f.is_none() {
                 *f = Some(s);

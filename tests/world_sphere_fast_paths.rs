@@ -55,12 +55,12 @@ fn run_world(params: StepParams, mut world: World, steps: u64) -> World {
 fn ledger_bits(w: &World) -> Vec<u64> {
     let l = &w.ledger();
     [
-        l.dissipated_damping,
-        l.dissipated_friction,
-        l.dissipated_viscous,
-        l.external_work,
-        l.tangential_stiffness_work,
-        l.initial_total.unwrap_or(f64::NAN),
+        l.dissipated_damping(),
+        l.dissipated_friction(),
+        l.dissipated_viscous(),
+        l.external_work(),
+        l.tangential_stiffness_work(),
+        l.initial_total().unwrap_or(f64::NAN),
     ]
     .iter()
     .map(|x| x.to_bits())
@@ -101,31 +101,31 @@ fn the_ledger_switch_changes_only_the_ledger() {
     let (l_on, l_off) = (with.ledger(), without.ledger());
     // With the ledger the dissipation of this run is booked (so the comparison below can fail) ...
     assert!(
-        l_on.dissipated_damping > 0.0 && l_on.dissipated_friction > 0.0,
+        l_on.dissipated_damping() > 0.0 && l_on.dissipated_friction() > 0.0,
         "{SCENE}: with the ledger, damping {} J and friction {} J booked over {STEPS} steps (expected > 0)",
-        l_on.dissipated_damping,
-        l_on.dissipated_friction
+        l_on.dissipated_damping(),
+        l_on.dissipated_friction()
     );
     // ... and without it nothing per contact is, while the terms of the step itself are the same.
     assert_eq!(
         (
-            l_off.dissipated_damping,
-            l_off.dissipated_friction,
-            l_off.tangential_stiffness_work
+            l_off.dissipated_damping(),
+            l_off.dissipated_friction(),
+            l_off.tangential_stiffness_work()
         ),
         (0.0, 0.0, 0.0),
         "{SCENE}: without the ledger the per-contact terms must stay zero"
     );
     assert_eq!(
         (
-            l_off.external_work.to_bits(),
-            l_off.dissipated_viscous.to_bits(),
-            l_off.initial_total.map(f64::to_bits)
+            l_off.external_work().to_bits(),
+            l_off.dissipated_viscous().to_bits(),
+            l_off.initial_total().map(f64::to_bits)
         ),
         (
-            l_on.external_work.to_bits(),
-            l_on.dissipated_viscous.to_bits(),
-            l_on.initial_total.map(f64::to_bits)
+            l_on.external_work().to_bits(),
+            l_on.dissipated_viscous().to_bits(),
+            l_on.initial_total().map(f64::to_bits)
         ),
         "{SCENE}: the external and viscous work must not depend on the switch"
     );

@@ -149,7 +149,7 @@ impl PySimulation {
 
     fn current_loads(&self) -> PyResult<&Loads> {
         let loads = &self.sim.world.loads();
-        if loads.current && loads.forces.len() == self.sim.world.bodies().len() {
+        if loads.is_current() && loads.forces().len() == self.sim.world.bodies().len() {
             Ok(loads)
         } else {
             Err(PyRuntimeError::new_err(
@@ -351,14 +351,14 @@ impl PySimulation {
     /// new (N, 3) array (a copy). Raises `RuntimeError` before the first step, when none was evaluated.
     fn forces<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<Real>>> {
         let loads = self.current_loads()?;
-        self.rows(py, 3, |i| loads.forces[i].as_slice().to_vec())
+        self.rows(py, 3, |i| loads.forces()[i].as_slice().to_vec())
     }
 
     /// Contact torques about the centres of mass (N·m, world frame) from the last evaluation, a new
     /// (N, 3) array (a copy). Raises `RuntimeError` before the first step.
     fn torques<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<Real>>> {
         let loads = self.current_loads()?;
-        self.rows(py, 3, |i| loads.torques[i].as_slice().to_vec())
+        self.rows(py, 3, |i| loads.torques()[i].as_slice().to_vec())
     }
 
     /// The energy ledger now (J), as a dict: kinetic (translational, rotational), elastic and

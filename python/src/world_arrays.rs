@@ -61,8 +61,8 @@ pub fn walls<'py>(py: Python<'py>, world: &World) -> PyResult<Bound<'py, PyDict>
         .collect();
     let normals: Vec<Vector> = world.walls().iter().map(|w| w.normal_world()).collect();
     let velocities: Vec<Vector> = world.walls().iter().map(|w| w.velocity).collect();
-    let forces: Vec<Vector> = if world.loads().wall_forces.len() == world.walls().len() {
-        world.loads().wall_forces.clone()
+    let forces: Vec<Vector> = if world.loads().wall_forces().len() == world.walls().len() {
+        world.loads().wall_forces().to_vec()
     } else {
         vec![Vector::zeros(); world.walls().len()]
     };

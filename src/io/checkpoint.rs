@@ -377,16 +377,16 @@ fn check_consistency(sim: &Simulation) -> Result<(), String> {
     if let Some(&t) = sim.tracked.iter().find(|&&t| t >= n) {
         return Err(format!("tracked body {t} of {n}"));
     }
-    if w.loads().current
-        && (w.loads().forces.len() != n
-            || w.loads().torques.len() != n
-            || w.loads().wall_forces.len() != w.walls().len())
+    if w.loads().is_current()
+        && (w.loads().forces().len() != n
+            || w.loads().torques().len() != n
+            || w.loads().wall_forces().len() != w.walls().len())
     {
         return Err(format!(
             "loads for {} / {} bodies and {} walls, world has {n} bodies and {} walls",
-            w.loads().forces.len(),
-            w.loads().torques.len(),
-            w.loads().wall_forces.len(),
+            w.loads().forces().len(),
+            w.loads().torques().len(),
+            w.loads().wall_forces().len(),
             w.walls().len()
         ));
     }

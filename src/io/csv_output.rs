@@ -78,7 +78,7 @@ pub fn write_walls_rows(out: &mut impl Write, sim: &Simulation) -> io::Result<()
         let f = sim
             .world
             .loads()
-            .wall_forces
+            .wall_forces()
             .get(w)
             .copied()
             .unwrap_or_else(crate::math::Vector::zeros);

@@ -640,7 +640,7 @@ pub fn walls_vtu(out: &mut String, world: &World, format: VtkEncoding) -> PieceC
             s.vec(
                 &world
                     .loads()
-                    .wall_forces
+                    .wall_forces()
                     .get(k)
                     .copied()
                     .unwrap_or_else(Vector::zeros),
@@ -770,14 +770,14 @@ fn body_vectors() -> [(&'static str, fn(&World, usize) -> Vector); 4] {
         ("angular_velocity", |w, i| w.bodies()[i].angular_velocity()),
         ("contact_force", |w, i| {
             w.loads()
-                .forces
+                .forces()
                 .get(i)
                 .copied()
                 .unwrap_or_else(Vector::zeros)
         }),
         ("contact_torque", |w, i| {
             w.loads()
-                .torques
+                .torques()
                 .get(i)
                 .copied()
                 .unwrap_or_else(Vector::zeros)

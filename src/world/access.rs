@@ -327,10 +327,26 @@ impl World {
         self.loads.current = false;
     }
 
-    /// The loads for a caller that sets them by hand (a test of a damping model that reads them). The next
-    /// force evaluation of a step overwrites them.
-    pub fn loads_mut_unchecked(&mut self) -> &mut Loads {
-        &mut self.loads
+    /// Sets the contact force (N) and torque (N·m) of body `i` in the loads by hand, for a caller that
+    /// reads them outside the step (a test of a damping model). The per-body arrays grow to the body count
+    /// first (new entries zero); nothing else changes, and the next force evaluation of a step overwrites
+    /// them.
+    pub fn set_body_load_unchecked(
+        &mut self,
+        i: usize,
+        force: Vector,
+        torque: Vector,
+    ) -> Result<(), WorldError> {
+        self.check_body(i)?;
+        let n = self.bodies.len();
+        for column in [&mut self.loads.forces, &mut self.loads.torques] {
+            if column.len() < n {
+                column.resize(n, Vector::zeros());
+            }
+        }
+        self.loads.forces[i] = force;
+        self.loads.torques[i] = torque;
+        Ok(())
     }
 
     /// Restarts the energy ledger: the next step records the initial energy again.

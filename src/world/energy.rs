@@ -80,22 +80,57 @@ use crate::math::Vector;
 #[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct EnergyLedger {
     /// Mechanical energy at the first evaluation of the loads (J); `None` before it.
-    pub initial_total: Option<Real>,
+    pub(in crate::world) initial_total: Option<Real>,
     /// Work of the normal damping dissipated so far (J).
-    pub dissipated_damping: Real,
+    pub(in crate::world) dissipated_damping: Real,
     /// Work of friction dissipated so far (J).
-    pub dissipated_friction: Real,
+    pub(in crate::world) dissipated_friction: Real,
     /// Work of the global viscous damping dissipated so far (J).
-    pub dissipated_viscous: Real,
+    pub(in crate::world) dissipated_viscous: Real,
     /// Work done on the system by non-dynamic bodies and walls so far (J).
-    pub external_work: Real,
+    pub(in crate::world) external_work: Real,
     /// Kinetic energy removed when bodies fell asleep (J).
     #[serde(default)]
-    pub removed_by_sleeping: Real,
+    pub(in crate::world) removed_by_sleeping: Real,
     /// Work of the tangential stiffness change (Mindlin k_t ∝ δ^(1/2)) on the stored tangential energy
     /// (J, either sign; see [`crate::law::tangential`]): enters the balance like external work.
     #[serde(default)]
-    pub tangential_stiffness_work: Real,
+    pub(in crate::world) tangential_stiffness_work: Real,
+}
+
+impl EnergyLedger {
+    /// Mechanical energy at the first evaluation of the loads (J); `None` before it (or after
+    /// [`super::World::reset_ledger`]).
+    pub fn initial_total(&self) -> Option<Real> {
+        self.initial_total
+    }
+
+    /// Work of the normal damping and the tangential dashpot dissipated so far (J).
+    pub fn dissipated_damping(&self) -> Real {
+        self.dissipated_damping
+    }
+
+    /// Work of Coulomb friction dissipated so far (J).
+    pub fn dissipated_friction(&self) -> Real {
+        self.dissipated_friction
+    }
+
+    /// Work of the tangential stiffness change so far (J, either sign; enters the balance like external
+    /// work).
+    pub fn tangential_stiffness_work(&self) -> Real {
+        self.tangential_stiffness_work
+    }
+
+    /// Work of the global viscous damping dissipated so far (J).
+    pub fn dissipated_viscous(&self) -> Real {
+        self.dissipated_viscous
+    }
+
+    /// Work done on the system by non-dynamic bodies and walls so far, with the work booked by
+    /// [`super::World::record_external_work`] (J).
+    pub fn external_work(&self) -> Real {
+        self.external_work
+    }
 }
 
 /// Every term of the ledger at one instant (J).

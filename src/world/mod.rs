@@ -15,6 +15,7 @@ mod body_inputs;
 pub mod broad_phase;
 pub mod contact_store;
 pub mod energy;
+mod loads;
 mod material_presence;
 pub mod parallel;
 pub mod region_profile;

@@ -55,20 +55,20 @@ impl SleepParams {
 #[derive(Clone, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct SleepState {
     /// Whether each body is asleep.
-    pub asleep: Vec<bool>,
+    pub(in crate::world) asleep: Vec<bool>,
     /// Consecutive calm steps of each awake body.
-    pub calm_steps: Vec<u32>,
+    pub(in crate::world) calm_steps: Vec<u32>,
     /// Number of sleeping bodies.
-    pub sleeping: usize,
+    pub(in crate::world) sleeping: usize,
     /// Rest load of each sleeping body: net force F + m g (N) when it fell asleep.
-    pub rest_force: Vec<Vector>,
+    pub(in crate::world) rest_force: Vec<Vector>,
     /// Contact torque of each sleeping body when it fell asleep (N·m).
-    pub rest_torque: Vec<Vector>,
+    pub(in crate::world) rest_torque: Vec<Vector>,
     /// Departure of the net force (N) from the rest load that wakes each sleeping body (of the torque:
     /// this times its bounding radius).
-    pub wake_limit: Vec<Real>,
+    pub(in crate::world) wake_limit: Vec<Real>,
     /// Counts every change of the sleeping set (the frozen sums are rebuilt when it moves).
-    pub changes: u64,
+    pub(in crate::world) changes: u64,
 }
 
 impl SleepState {
@@ -79,6 +79,11 @@ impl SleepState {
         self.rest_force.resize(n, Vector::zeros());
         self.rest_torque.resize(n, Vector::zeros());
         self.wake_limit.resize(n, 0.0);
+    }
+
+    /// Number of sleeping bodies.
+    pub fn asleep_count(&self) -> usize {
+        self.sleeping
     }
 
     /// Whether body `i` is asleep (false for an index the state does not cover yet).

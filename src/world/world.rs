@@ -25,6 +25,7 @@ use super::material_presence::MaterialPresence;
 pub use super::material_presence::SetupStats;
 use super::sleep_state::SleepState;
 
+pub use super::loads::Loads;
 pub use super::wall::Wall;
 
 /// Why a body, wall or material could not be added.
@@ -156,32 +157,6 @@ impl MaterialTable {
     pub fn name(&self, id: u32) -> &str {
         &self.names[id as usize]
     }
-}
-
-/// Resultant force and torque on each body from the last contact evaluation, and the sums the energy
-/// ledger needs from it. The step evaluates forces once, at the new positions, and reuses them for the
-/// next step's first half kick.
-#[derive(Clone, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
-pub struct Loads {
-    /// Contact force on each body (N), world frame (gravity is added by the integrator).
-    pub forces: Vec<Vector>,
-    /// Contact torque about each body's centre of mass (N·m), world frame.
-    pub torques: Vec<Vector>,
-    /// Total contact force on each wall (N).
-    pub wall_forces: Vec<Vector>,
-    /// Σ of the elastic potentials (normal power law and tangential spring) of all contacts (J).
-    pub elastic_potential: Real,
-    /// Σ of the damping work dissipated during the step that produced these loads (J; see
-    /// [`super::energy`]).
-    pub damping_work: Real,
-    /// Σ of the friction work dissipated during the step that produced these loads (J).
-    pub friction_dissipation: Real,
-    /// Σ of the work of the tangential stiffness change during the step that produced these loads (J).
-    pub tangential_stiffness_work: Real,
-    /// Power (W) the non-dynamic bodies and the walls deliver to the system through contacts.
-    pub external_power: Real,
-    /// Whether these loads belong to the current state (false before the first evaluation).
-    pub current: bool,
 }
 
 /// Every body, wall, shape and material of a simulation, and the state kept between steps.

@@ -35,12 +35,12 @@ pub fn body_difference(a: &World, b: &World) -> Option<String> {
 /// `extra`.
 pub fn load_values(w: &World, extra: &[f64]) -> Vec<f64> {
     w.loads()
-        .forces
+        .forces()
         .iter()
-        .chain(&w.loads().torques)
-        .chain(&w.loads().wall_forces)
+        .chain(w.loads().torques())
+        .chain(w.loads().wall_forces())
         .flat_map(|v| v.iter().copied())
-        .chain([w.loads().elastic_potential, w.loads().external_power])
+        .chain([w.loads().elastic_potential(), w.loads().external_power()])
         .chain(extra.iter().copied())
         .collect()
 }

@@ -1,7 +1,7 @@
 //! `polydem rockfill`: the paper's experiment from the command line.
 //!
 //! ```text
-//! polydem rockfill [--config FILE | --full] [--size MM] [--seed N] [--bed DIR] [--out DIR]
+//! polydem rockfill [--config FILE | --full] [--size MM] [--seed N] [--bed DIR] [--out DIR] [--vtk-every N]
 //! polydem rockfill study [--config FILE | --full] --sizes 100,130,175,200,290 --seeds 1,2,3
 //!                        [--section-sizes K] [--reuse-beds] --out DIR
 //! polydem rockfill convergence [--config FILE | --full] [--dt-divisors 1,2,4] [--sections 1.0,1.5,2.0]
@@ -13,9 +13,10 @@
 //! or with `--full` the full-scale layer (`scenes/rockfill/paper.toml`). `--bed DIR` starts from a bed saved
 //! by an earlier run (its checkpoint `bed.pdck` when there is one, else its CSV files; see
 //! [`super::bed`]) instead of generating and packing. Writes into `--out` (default `out/rockfill`):
-//! `monitors.csv` (the projectile's time series, columns in [`super::penetration::MonitorRow::CSV_HEADER`]), the packed bed
+//! `monitors.csv` (the projectile's time series, columns in [`super::monitors::MonitorRow::CSV_HEADER`]), the packed bed
 //! (`bed.pdck`, `bed_info.json`, `bed_*.csv`, when generated), `section.svg` (the paper's Fig. 7 picture)
-//! and `summary.txt` (also printed).
+//! and `summary.txt` (also printed); with `--vtk-every N`, VTK frames of the penetration (`vtk/`, `*.pvd`),
+//! written by the engine's output as `polydem run` writes them.
 //!
 //! `study` runs the size study ([`super::study`]); `convergence` the time-step and rock-count sequences
 //! ([`super::convergence`]); `sensitivity` the one-at-a-time contact-parameter runs from one bed
@@ -27,8 +28,9 @@ use anyhow::{Context, Result};
 
 use super::config::ExperimentConfig;
 use super::convergence::{run_convergence, ConvergenceParams};
+use super::penetration::PenetrationFiles;
 use super::sensitivity::{run_sensitivity, sensitivity_table, SensitivityParams, Variation};
-use super::study::{run_one, run_study, StudyParams};
+use super::study::{run_one_with_files, run_study, StudyParams};
 use super::summary::summary;
 
 /// Options of `polydem rockfill`.
@@ -47,6 +49,10 @@ pub struct RockfillArgs {
     /// Output directory.
     #[arg(long, default_value = "out/rockfill")]
     pub out: PathBuf,
+    /// Write VTK frames of the penetration (OUT/vtk, with .pvd collections) at its start and at every
+    /// step index that is a multiple of N (zlib-compressed binary, as `polydem run`).
+    #[arg(long, value_name = "N")]
+    pub vtk_every: Option<u64>,
 }
 
 /// The sample: the file's mean rock size and seed, or these (for a run from a saved bed, the bed's: the
@@ -227,13 +233,15 @@ pub fn run(args: &RockfillArgs) -> Result<()> {
         config.rock.mean_size * 1e3,
         config.rock.seed
     );
-    let result = run_one(
-        &config,
-        &args.out,
-        args.bed.as_deref(),
-        &title,
-        &mut progress,
-    )?;
+    if args.vtk_every == Some(0) {
+        anyhow::bail!("--vtk-every 0: must be at least 1 step");
+    }
+    let files = PenetrationFiles {
+        vtk_every: args.vtk_every,
+        ..PenetrationFiles::monitors_in(&args.out)
+    };
+    let bed = args.bed.as_deref();
+    let result = run_one_with_files(&config, files, bed, &title, None, &mut progress)?;
     print!("{}", summary(&config, &result));
     Ok(())
 }

@@ -21,8 +21,8 @@ use plotters::prelude::*;
 
 use super::config::ExperimentConfig;
 use super::experiment::{run_experiment_with, BedSource};
-use super::penetration::PenetrationOptions;
-use super::study::{has_bed, run_one, write_monitors, StudyError};
+use super::penetration::{PenetrationFiles, PenetrationOptions};
+use super::study::{has_bed, run_one, StudyError};
 use polydem::math::Real;
 
 /// What to run.
@@ -201,6 +201,10 @@ pub fn run_convergence(
         for &k in &params.dt_divisors {
             let options = PenetrationOptions {
                 dt_divisor: k,
+                files: Some(PenetrationFiles {
+                    monitors: format!("monitors_dt_div{k}.csv"),
+                    ..PenetrationFiles::monitors_in(&params.out)
+                }),
                 ..PenetrationOptions::default()
             };
             let r = run_experiment_with(
@@ -215,7 +219,6 @@ pub fn run_convergence(
                 source,
             })?;
             let p = &r.penetration;
-            write_monitors(&params.out.join(format!("monitors_dt_div{k}.csv")), &p.rows)?;
             progress(format!(
                 "time step Δt/{k} = {:.3e} s: {} steps, {:.1} s, residual {:.2} m/s, deflection {:.3}° / {:.3}°",
                 p.dt,

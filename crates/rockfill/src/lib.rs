@@ -15,7 +15,8 @@
 //!   supported) that the packing starts from;
 //! - [`packing`]: the container, deposition under gravity, compaction by a moving top wall, hold, bed CSV;
 //! - [`bed`]: the packed bed as an engine checkpoint, so that penetration runs start from it;
-//! - [`penetration`]: the impact run and its monitors (velocity, resistance, deflection, disturbed zone);
+//! - [`monitors`]: the projectile's monitor series (`monitors.csv`) as an engine output;
+//! - [`penetration`]: the impact run (velocity, resistance, deflection, disturbed zone) and its files;
 //! - [`experiment`]: generation → packing (or a saved bed) → penetration;
 //! - [`stop`]: the check a front end answers to stop a packing or penetration run between two steps;
 //! - [`cli`]: the `polydem rockfill` subcommand.
@@ -29,6 +30,7 @@ pub mod experiment;
 pub mod generation;
 pub mod grading;
 pub mod limits;
+pub mod monitors;
 pub mod packing;
 pub mod penetration;
 pub mod projectile;

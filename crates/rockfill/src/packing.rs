@@ -566,7 +566,11 @@ pub fn pack_with_stop(
             kinetic_fraction: kinetic / lift_energy(world),
             bed_top: bed_top(world),
             top_wall: top_wall_height(world),
-            wall_force: world.loads().wall_forces.get(TOP_WALL).map_or(0.0, |f| f.z),
+            wall_force: world
+                .loads()
+                .wall_forces()
+                .get(TOP_WALL)
+                .map_or(0.0, |f| f.z),
         }
     };
     // 1. Deposition.
@@ -615,7 +619,11 @@ pub fn pack_with_stop(
         let mut stalled_since: Option<Real> = None;
         while top_wall_height(world) > target {
             // Servo: full speed on a loose bed, slowing to a stop as the wall force nears the cap.
-            let force = world.loads().wall_forces.get(TOP_WALL).map_or(0.0, |f| f.z);
+            let force = world
+                .loads()
+                .wall_forces()
+                .get(TOP_WALL)
+                .map_or(0.0, |f| f.z);
             let fraction = (1.0 - force / force_cap).clamp(0.0, 1.0);
             world.set_wall_velocity(
                 TOP_WALL,
@@ -657,8 +665,13 @@ pub fn pack_with_stop(
     // 4. Restore the true density (density scaling only): a geometric ramp of the density from s ρ to ρ over
     // the first half of `restore_time`, then the true density for the second half (see the module docs).
     if p.packing_density_scale.is_some() {
-        let wall_force =
-            |world: &World| world.loads().wall_forces.get(TOP_WALL).map_or(0.0, |f| f.z);
+        let wall_force = |world: &World| {
+            world
+                .loads()
+                .wall_forces()
+                .get(TOP_WALL)
+                .map_or(0.0, |f| f.z)
+        };
         let force0 = wall_force(world);
         let restore_time = p.restore_time.unwrap_or(0.0);
         let (t0, top0) = (world.time(), top_wall_height(world));
@@ -678,7 +691,7 @@ pub fn pack_with_stop(
                     config.rock.density * next
                 };
                 let changed = set_rock_density(world, density)?;
-                if world.ledger().initial_total.is_some() {
+                if world.ledger().initial_total().is_some() {
                     world.record_external_work(changed);
                 }
                 sigma = next;
@@ -764,7 +777,7 @@ pub fn apply_local_damping(world: &mut World, alpha: Real, dt: Real) -> Real {
             continue;
         }
         let loads = world.loads();
-        let (force, torque) = match (loads.forces.get(i), loads.torques.get(i)) {
+        let (force, torque) = match (loads.forces().get(i), loads.torques().get(i)) {
             (Some(f), Some(t)) => (*f, *t),
             _ => continue,
         };

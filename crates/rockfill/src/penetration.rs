@@ -7,11 +7,11 @@
 //! in the ledger is a contact loss. The time step is the packing one or smaller, so that the projectile
 //! travels at most `travel_per_step` of a mean rock size per step.
 //!
-//! # Monitors (one row per step, [`MonitorRow`])
-//! Position of the centre of mass and of the tip; velocity; the resultant contact force on the projectile
-//! (penetration resistance) and its component along the initial axis e₀ (negative = resisting); the
-//! deflection angles between the velocity and e₀ and between the current axis and e₀; the number of rocks
-//! touching it.
+//! # Monitors and files
+//! One [`MonitorRow`] per step ([`super::monitors`]). The run hands its state to its outputs through the
+//! engine's [`Output`] trait, like `polydem run`: the monitor series (`monitors.csv`, written when the run
+//! completes) and, when asked for, the engine's VTK frames of the bed and the projectile
+//! ([`PenetrationFiles`]).
 //!
 //! # Disturbed zone
 //! At the end, a rock is disturbed when its displacement since the start of the run exceeds
@@ -19,18 +19,27 @@
 //! of flight (the x axis through the aim point) within which 95 % of the disturbed rocks started, given in mean
 //! rock sizes (the paper reports an affected range of 6–7 sizes for the 100 mm sample, read off Fig. 7).
 
+use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
 use super::config::ExperimentConfig;
 use super::limits::{within, LimitError};
-use super::packing::{rock_time_step, top_wall_height, PackingError, KEPT_WALLS, STEEL};
+pub use super::monitors::MonitorRow;
+use super::monitors::{MonitorSeries, ProjectileGauge};
+use super::packing::{
+    rock_time_step, time_step_and_limit, top_wall_height, PackingError, KEPT_WALLS, STEEL,
+};
 use super::projectile::Projectile;
 use super::stop::{self, StopCheck};
 use polydem::dynamics::{Motion, RigidBody, ViscousDamping};
+use polydem::io::output::{Output, OutputSet, Schedule};
+use polydem::io::vtk::{VtkEncoding, VtkWriter};
+use polydem::io::vtk_frames::VtkFrames;
 use polydem::math::{Point, Pose, Real, Vector};
+use polydem::scene::{RunObserver, Simulation, TimeStepInfo};
 use polydem::shape::Shape;
 use polydem::world::{
-    sleeping, step, ContactKey, StepCounters, StepError, StepParams, StepScratch, World, WorldError,
+    sleeping, step, StepCounters, StepError, StepParams, StepScratch, World, WorldError,
 };
 
 /// Why a penetration run failed.
@@ -49,54 +58,9 @@ pub enum PenetrationError {
     /// [`PenetrationOptions::stop`] asked the run to stop (before a step: the world is at a step boundary).
     #[error("penetration interrupted after {steps} steps")]
     Interrupted { steps: u64 },
-}
-
-/// One row of the monitor time series.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct MonitorRow {
-    pub time: Real,
-    pub position: Point,
-    pub tip: Point,
-    pub velocity: Vector,
-    /// Resultant contact force on the projectile (N).
-    pub force: Vector,
-    /// Its component along e₀ (N).
-    pub axial_force: Real,
-    /// Angle between the velocity and e₀ (degrees).
-    pub velocity_deflection: Real,
-    /// Angle between the axis and e₀ (degrees).
-    pub axis_deflection: Real,
-    /// Rocks overlapping the projectile.
-    pub contacts: usize,
-}
-
-impl MonitorRow {
-    pub const CSV_HEADER: &'static str = "t,x,y,z,tip_x,tip_y,tip_z,vx,vy,vz,speed,fx,fy,fz,f_axial,velocity_deflection_deg,axis_deflection_deg,contacts";
-
-    pub fn csv_row(&self) -> String {
-        let (p, t, v, f) = (self.position, self.tip, self.velocity, self.force);
-        format!(
-            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
-            self.time,
-            p.x,
-            p.y,
-            p.z,
-            t.x,
-            t.y,
-            t.z,
-            v.x,
-            v.y,
-            v.z,
-            v.norm(),
-            f.x,
-            f.y,
-            f.z,
-            self.axial_force,
-            self.velocity_deflection,
-            self.axis_deflection,
-            self.contacts
-        )
-    }
+    /// An output file of the run could not be opened or written (the message names it).
+    #[error("penetration output: {0}")]
+    Output(#[from] std::io::Error),
 }
 
 /// Displacement thresholds (in mean sizes) at which the disturbed zone is also measured: the paper's
@@ -134,6 +98,35 @@ pub struct PenetrationOptions {
     /// Asked before each step (of the penetration, and of the packing when the run packs a bed) whether
     /// to stop there; `None` runs to the end.
     pub stop: Option<StopCheck>,
+    /// The files the run writes; `None` writes none (the report holds the monitor rows either way).
+    pub files: Option<PenetrationFiles>,
+}
+
+/// The files a penetration run writes, through the engine's [`Output`] implementations.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PenetrationFiles {
+    /// The directory they go into (created if missing).
+    pub dir: PathBuf,
+    /// File name of the monitor series in `dir` (`monitors.csv` for a run of the study).
+    pub monitors: String,
+    /// VTK frames of the bed and the projectile (`vtk/`, with `.pvd` collections) of the state the run
+    /// starts from and of every step whose index is a multiple of this (as `polydem run` schedules
+    /// them); `None`: no frames.
+    pub vtk_every: Option<u64>,
+    /// Encoding of the VTK frames.
+    pub vtk_encoding: VtkEncoding,
+}
+
+impl PenetrationFiles {
+    /// The monitor series `monitors.csv` in `dir`, no VTK frames.
+    pub fn monitors_in(dir: impl Into<PathBuf>) -> Self {
+        Self {
+            dir: dir.into(),
+            monitors: "monitors.csv".into(),
+            vtk_every: None,
+            vtk_encoding: VtkEncoding::default(),
+        }
+    }
 }
 
 impl Default for PenetrationOptions {
@@ -144,6 +137,7 @@ impl Default for PenetrationOptions {
             max_steps: None,
             start_offset: Vector::zeros(),
             stop: None,
+            files: None,
         }
     }
 }
@@ -309,11 +303,6 @@ pub fn add_projectile(
     Ok(world.add_body("projectile", shape, STEEL, body)? as usize)
 }
 
-fn angle_deg(a: &Vector, b: &Vector) -> Real {
-    let c = a.dot(b) / (a.norm() * b.norm());
-    c.clamp(-1.0, 1.0).acos().to_degrees()
-}
-
 /// Runs the impact on a world prepared by [`add_projectile`]. `progress` is called every 100 steps with the
 /// latest monitor row.
 pub fn penetrate(
@@ -343,17 +332,16 @@ pub fn penetration_time_step(
     Ok(dt_rocks.min(imp.travel_per_step * config.rock.mean_size / imp.speed))
 }
 
-/// [`penetrate`] with options (time-step divisor, pose snapshots).
+/// [`penetrate`] with options (time-step divisor, pose snapshots, files).
 pub fn penetrate_with(
     config: &ExperimentConfig,
     world: &mut World,
     projectile: &Projectile,
     index: usize,
     options: &PenetrationOptions,
-    mut progress: impl FnMut(&MonitorRow),
+    progress: impl FnMut(&MonitorRow),
 ) -> Result<PenetrationReport, PenetrationError> {
     let start = Instant::now();
-    let imp = &config.impact;
     let dt = penetration_time_step(config, world)? / options.dt_divisor;
     // A run stopped after `max_steps` (a benchmark's stretch) is bounded by that.
     if options
@@ -362,111 +350,252 @@ pub fn penetrate_with(
     {
         check_penetration_steps(config, dt, false)?;
     }
-    let mut params = StepParams::new(dt);
-    params.damping = ViscousDamping::None;
-    params.sleeping = config.sleeping.params(config.sleeping.penetration);
-    let mut scratch = StepScratch::default();
+    let (_, contact_time, stability_limit) =
+        time_step_and_limit(config, world, config.packing.steps_per_contact)?;
+    let time_step = TimeStepInfo {
+        dt,
+        derived: true,
+        contact_time,
+        stability_limit,
+    };
     let start_positions: Vec<Point> = world.bodies().iter().map(|b| b.position).collect();
-    let e0 = Vector::x();
     let kinetic0 = world.bodies()[index].translational_kinetic_energy()
         + world.bodies()[index].rotational_kinetic_energy();
     // The ledger restarts here: removing walls and adding the projectile changed the energy outside it.
     world.reset_ledger();
+    let gauge = ProjectileGauge {
+        index,
+        axis_body: projectile.axis_body,
+        tip_distance: projectile.params.length - axis_offset(projectile),
+        initial_axis: Vector::x(),
+        start_time: world.time(),
+    };
+    let outputs = open_outputs(options, world, gauge)?;
+    // The run is a `Simulation` (the state every output reads) for its duration; the world goes back
+    // to the caller whatever the outcome.
+    let placeholder = World::new(world.gravity(), world.materials().clone(), 0.0);
+    let world_in = std::mem::replace(world, placeholder);
+    let mut sim = penetration_simulation(config, world_in, projectile, index, time_step, options);
+    let run = run_impact(
+        config,
+        &mut sim,
+        (projectile, index),
+        options,
+        outputs,
+        progress,
+    );
+    *world = sim.world;
+    let run = run?;
+    Ok(report(
+        config,
+        world,
+        (projectile, index),
+        &start_positions,
+        kinetic0,
+        dt,
+        run,
+        start.elapsed(),
+    ))
+}
+
+/// The outputs of a run: the monitor series, driven step by step through the [`Output`] trait (the run
+/// reads its rows), and the other outputs of [`PenetrationFiles`] in an [`OutputSet`].
+struct RunOutputs {
+    monitors: MonitorSeries,
+    others: OutputSet<'static>,
+}
+
+fn open_outputs(
+    options: &PenetrationOptions,
+    world: &World,
+    gauge: ProjectileGauge,
+) -> Result<RunOutputs, PenetrationError> {
+    let start_step = world.step_index();
+    let files = options.files.as_ref();
+    let monitors = MonitorSeries::new(gauge, start_step, files.map(|f| f.dir.join(&f.monitors)));
+    let mut others = OutputSet::new();
+    if let Some(f) = files {
+        std::fs::create_dir_all(&f.dir).map_err(|e| in_dir(&f.dir, e))?;
+        if let Some(every) = f.vtk_every {
+            let writer =
+                VtkWriter::new(&f.dir, world, f.vtk_encoding).map_err(|e| in_dir(&f.dir, e))?;
+            let schedule = Schedule {
+                start_step,
+                last_step: u64::MAX,
+                every: Some(every),
+                at_start: true,
+                at_end: false,
+            };
+            others.push(VtkFrames::new(writer, schedule));
+        }
+    }
+    Ok(RunOutputs { monitors, others })
+}
+
+fn in_dir(dir: &std::path::Path, e: std::io::Error) -> std::io::Error {
+    std::io::Error::new(e.kind(), format!("{}: {e}", dir.display()))
+}
+
+/// The penetration run as a [`Simulation`]: the projectile tracked, its input frame that of the
+/// projectile's shape file, the rocks' the principal frames they are stored in.
+fn penetration_simulation(
+    config: &ExperimentConfig,
+    world: World,
+    projectile: &Projectile,
+    index: usize,
+    time_step: TimeStepInfo,
+    options: &PenetrationOptions,
+) -> Simulation {
+    let imp = &config.impact;
+    let dt = time_step.dt;
+    let mut params = StepParams::new(dt);
+    params.damping = ViscousDamping::None;
+    params.sleeping = config.sleeping.params(config.sleeping.penetration);
+    let run_steps = options
+        .max_steps
+        .unwrap_or_else(|| (imp.max_time / dt).ceil() as u64);
+    let mut frames = vec![Pose::identity(); world.body_count()];
+    frames[index] = projectile.input_from_body;
+    Simulation {
+        end_time: world.time() + imp.max_time,
+        steps: world.step_index() + run_steps,
+        world,
+        params,
+        time_step,
+        output_every: 1,
+        tracked: vec![index],
+        frames,
+    }
+}
+
+/// What the stepping loop of a run gathered.
+struct ImpactRun {
+    outcome: Outcome,
+    rows: Vec<MonitorRow>,
+    steps: u64,
+    counters: StepCounters,
+    max_overlap: Real,
+    warned: u64,
+    snapshots: Vec<Snapshot>,
+}
+
+/// Steps `sim` until the projectile exits, stops, or a limit is reached, handing each step to the outputs.
+fn run_impact(
+    config: &ExperimentConfig,
+    sim: &mut Simulation,
+    (projectile, index): (&Projectile, usize),
+    options: &PenetrationOptions,
+    mut outputs: RunOutputs,
+    mut progress: impl FnMut(&MonitorRow),
+) -> Result<ImpactRun, PenetrationError> {
+    let mut scratch = StepScratch::default();
     let mut counters = StepCounters::default();
-    let t0 = world.time();
-    let length = projectile.params.length;
-    let mut rows = Vec::new();
-    let mut steps = 0u64;
-    let mut warned = 0u64;
-    let mut max_overlap: Real = 0.0;
+    let (mut steps, mut warned, mut max_overlap) = (0u64, 0u64, 0.0 as Real);
     let mut snapshots = Vec::new();
     let mut pending: Vec<Real> = options.snapshot_tip_x.clone();
     pending.sort_by(|a, b| b.total_cmp(a));
+    let start_step = sim.world.step_index();
+    if outputs.others.wants_state(start_step) {
+        outputs.others.observe(sim, start_step)?;
+    }
     let outcome = loop {
         if stop::requested(options.stop.as_ref()) {
             return Err(PenetrationError::Interrupted { steps });
         }
-        let report = step(&params, world, &mut scratch)?;
+        let report = step(&sim.params, &mut sim.world, &mut scratch)?;
         counters.merge(&report.counters);
         steps += 1;
         max_overlap = max_overlap.max(report.max_overlap_ratio);
         if !report.overlap_warnings.is_empty() {
             warned += 1;
         }
-        let body = &world.bodies()[index];
-        let axis = body.orientation * projectile.axis_body;
-        let tip = body.position + axis * (length - axis_offset(projectile));
-        let force = world.loads().forces[index];
-        let contacts = world
-            .contacts()
-            .keys()
-            .iter()
-            .zip(world.contacts().states())
-            .filter(|(k, s)| {
-                matches!(k, ContactKey::Body { b, .. } if *b as usize == index)
-                    && s.force_on_b != Vector::zeros()
-            })
-            .count();
-        let row = MonitorRow {
-            time: world.time() - t0,
-            position: body.position,
-            tip,
-            velocity: body.velocity,
-            force,
-            axial_force: force.dot(&e0),
-            velocity_deflection: angle_deg(&body.velocity, &e0),
-            axis_deflection: angle_deg(&axis, &e0),
-            contacts,
-        };
-        rows.push(row);
-        while pending.last().is_some_and(|&x| tip.x >= x) {
+        let at = sim.world.step_index();
+        outputs.monitors.write(sim, at)?;
+        if outputs.others.wants_state(at) {
+            outputs.others.observe(sim, at)?;
+        }
+        let row = *outputs.monitors.rows().last().expect("a row per step");
+        while pending.last().is_some_and(|&x| row.tip.x >= x) {
             pending.pop();
-            snapshots.push(snapshot(world, row.time, tip));
+            snapshots.push(snapshot(&sim.world, row.time, row.tip));
         }
         if steps.is_multiple_of(100) {
             progress(&row);
         }
-        let base_x = (tip - axis * length).x;
-        if base_x > config.layer.length {
-            break Outcome::Exited;
-        }
-        if body.velocity.norm() < 0.01 * imp.speed {
-            break Outcome::Stopped;
-        }
-        if world.time() - t0 >= imp.max_time {
-            break Outcome::TimeLimit;
-        }
-        if options.max_steps.is_some_and(|max| steps >= max) {
-            break Outcome::StepLimit;
+        let body = sim.world.body(index);
+        if let Some(outcome) = end_of_run(config, body, projectile, &row, steps, options) {
+            break outcome;
         }
     };
-    let last = *rows.last().expect("at least one step");
+    outputs.monitors.flush()?;
+    outputs.others.finish()?;
+    let rows = outputs.monitors.into_rows();
     if !options.snapshot_tip_x.is_empty() {
-        snapshots.push(snapshot(world, last.time, last.tip));
+        let last = rows.last().expect("at least one step");
+        snapshots.push(snapshot(&sim.world, last.time, last.tip));
     }
-    let body = &world.bodies()[index];
-    // Disturbed zone.
-    let aim_y = 0.5 * config.layer.width;
+    Ok(ImpactRun {
+        outcome,
+        rows,
+        steps,
+        counters,
+        max_overlap,
+        warned,
+        snapshots,
+    })
+}
+
+/// How the run ends after the step of `row`, if it does.
+fn end_of_run(
+    config: &ExperimentConfig,
+    body: &RigidBody,
+    projectile: &Projectile,
+    row: &MonitorRow,
+    steps: u64,
+    options: &PenetrationOptions,
+) -> Option<Outcome> {
+    let imp = &config.impact;
+    let axis = body.orientation * projectile.axis_body;
+    let base_x = (row.tip - axis * projectile.params.length).x;
+    if base_x > config.layer.length {
+        Some(Outcome::Exited)
+    } else if body.velocity.norm() < 0.01 * imp.speed {
+        Some(Outcome::Stopped)
+    } else if row.time >= imp.max_time {
+        Some(Outcome::TimeLimit)
+    } else if options.max_steps.is_some_and(|max| steps >= max) {
+        Some(Outcome::StepLimit)
+    } else {
+        None
+    }
+}
+
+/// The report of a run from what its loop gathered and the world at its end.
+#[allow(clippy::too_many_arguments)]
+fn report(
+    config: &ExperimentConfig,
+    world: &World,
+    (projectile, index): (&Projectile, usize),
+    start_positions: &[Point],
+    kinetic0: Real,
+    dt: Real,
+    run: ImpactRun,
+    wall_time: Duration,
+) -> PenetrationReport {
+    let ImpactRun {
+        outcome,
+        rows,
+        steps,
+        counters,
+        max_overlap,
+        warned,
+        snapshots,
+    } = run;
+    let imp = &config.impact;
+    let last = *rows.last().expect("at least one step");
+    let body = world.body(index);
     let aim_z = rows.first().map_or(0.0, |r| r.position.z);
-    let zone = |fraction: Real| -> (usize, Real) {
-        let threshold = fraction * config.rock.mean_size;
-        let mut radii: Vec<Real> = (0..world.bodies().len())
-            .filter(|&i| i != index && world.bodies()[i].is_dynamic())
-            .filter(|&i| (world.bodies()[i].position - start_positions[i]).norm() > threshold)
-            .map(|i| {
-                let p = start_positions[i];
-                ((p.y - aim_y).powi(2) + (p.z - aim_z).powi(2)).sqrt()
-            })
-            .collect();
-        radii.sort_by(|a, b| a.total_cmp(b));
-        let width = if radii.is_empty() {
-            0.0
-        } else {
-            let k = ((0.95 * radii.len() as Real).ceil() as usize).clamp(1, radii.len()) - 1;
-            2.0 * radii[k]
-        };
-        (radii.len(), width)
-    };
+    let zone = |fraction| disturbed_zone(config, world, index, start_positions, aim_z, fraction);
     let (disturbed_rocks, width) = zone(imp.disturbed_threshold);
     let disturbed_by_threshold = DISTURBED_THRESHOLDS
         .iter()
@@ -477,26 +606,21 @@ pub fn penetrate_with(
         .collect();
     let energy = world.energy();
     let kinetic = body.translational_kinetic_energy() + body.rotational_kinetic_energy();
-    Ok(PenetrationReport {
+    let max_of = |of: fn(&MonitorRow) -> Real| rows.iter().map(of).fold(0.0, Real::max);
+    PenetrationReport {
         outcome,
         dt,
         steps,
         rocks: world.bodies().len() - 1,
         projectile_mass: body.mass,
         residual_speed: body.velocity.norm(),
-        residual_axial_velocity: body.velocity.dot(&e0),
+        residual_axial_velocity: body.velocity.dot(&Vector::x()),
         exit_time: (outcome == Outcome::Exited).then_some(last.time),
         final_velocity_deflection: last.velocity_deflection,
         final_axis_deflection: last.axis_deflection,
-        max_velocity_deflection: rows
-            .iter()
-            .map(|r| r.velocity_deflection)
-            .fold(0.0, Real::max),
-        max_axis_deflection: rows.iter().map(|r| r.axis_deflection).fold(0.0, Real::max),
-        max_axial_force: rows
-            .iter()
-            .map(|r| r.axial_force.abs())
-            .fold(0.0, Real::max),
+        max_velocity_deflection: max_of(|r| r.velocity_deflection),
+        max_axis_deflection: max_of(|r| r.axis_deflection),
+        max_axial_force: max_of(|r| r.axial_force.abs()),
         disturbed_rocks,
         disturbed_by_threshold,
         disturbed_width: width,
@@ -510,17 +634,47 @@ pub fn penetrate_with(
         resistance: ResistanceStatistics::from_rows(
             &rows,
             config.layer.length,
-            length,
+            projectile.params.length,
             ((config.rock.mean_size / imp.speed) / dt).round() as usize,
         ),
-        start_positions,
+        start_positions: start_positions.to_vec(),
         snapshots,
-        wall_time: start.elapsed(),
+        wall_time,
         asleep_fraction: counters.sleeping_body_steps as Real
             / (steps as Real * (world.bodies().len() - 1) as Real),
         counters,
         rows,
-    })
+    }
+}
+
+/// The rocks displaced by more than `fraction` of the mean size since `start_positions`, and the width of
+/// the zone they started in (m; see the module docs).
+fn disturbed_zone(
+    config: &ExperimentConfig,
+    world: &World,
+    index: usize,
+    start_positions: &[Point],
+    aim_z: Real,
+    fraction: Real,
+) -> (usize, Real) {
+    let aim_y = 0.5 * config.layer.width;
+    let threshold = fraction * config.rock.mean_size;
+    let mut radii: Vec<Real> = (0..world.bodies().len())
+        .filter(|&i| i != index && world.bodies()[i].is_dynamic())
+        .filter(|&i| (world.bodies()[i].position - start_positions[i]).norm() > threshold)
+        .map(|i| {
+            let p = start_positions[i];
+            ((p.y - aim_y).powi(2) + (p.z - aim_z).powi(2)).sqrt()
+        })
+        .collect();
+    radii.sort_by(|a, b| a.total_cmp(b));
+    let width = if radii.is_empty() {
+        0.0
+    } else {
+        let k = ((0.95 * radii.len() as Real).ceil() as usize).clamp(1, radii.len()) - 1;
+        2.0 * radii[k]
+    };
+    (radii.len(), width)
 }
 
 fn snapshot(world: &World, time: Real, tip: Point) -> Snapshot {

@@ -28,7 +28,7 @@ use std::time::Instant;
 use super::bed::has_checkpoint;
 use super::config::ExperimentConfig;
 use super::experiment::{run_experiment_with, BedSource, ExperimentError, ExperimentResult};
-use super::penetration::{MonitorRow, Outcome, PenetrationOptions};
+use super::penetration::{Outcome, PenetrationFiles, PenetrationOptions};
 use super::section::{draw_sections, SectionError, SectionPicture};
 use super::stop::StopCheck;
 use polydem::math::Real;
@@ -217,18 +217,6 @@ fn io_error(path: &Path) -> impl FnOnce(std::io::Error) -> StudyError + '_ {
     }
 }
 
-/// Writes the monitor rows as CSV.
-pub fn write_monitors(path: &Path, rows: &[MonitorRow]) -> Result<(), StudyError> {
-    let mut csv = String::with_capacity(rows.len() * 200);
-    csv.push_str(MonitorRow::CSV_HEADER);
-    csv.push('\n');
-    for row in rows {
-        csv.push_str(&row.csv_row());
-        csv.push('\n');
-    }
-    std::fs::write(path, csv).map_err(io_error(path))
-}
-
 /// Tip positions of the section instants (m): a quarter of the layer (the projectile before the plane
 /// x = L/2), half its length past the plane (its body in the plane), the right face; the fourth panel is the
 /// end of the run.
@@ -264,6 +252,21 @@ pub fn run_one_with_stop(
     stop: Option<StopCheck>,
     progress: &mut dyn FnMut(&str, String),
 ) -> Result<ExperimentResult, StudyError> {
+    let files = PenetrationFiles::monitors_in(dir);
+    run_one_with_files(config, files, bed, title, stop, progress)
+}
+
+/// [`run_one_with_stop`] into `files.dir`, with the penetration's files of `files` (the monitor series
+/// under its name there, VTK frames when asked for).
+pub fn run_one_with_files(
+    config: &ExperimentConfig,
+    files: PenetrationFiles,
+    bed: Option<&Path>,
+    title: &str,
+    stop: Option<StopCheck>,
+    progress: &mut dyn FnMut(&str, String),
+) -> Result<ExperimentResult, StudyError> {
+    let dir = &files.dir.clone();
     std::fs::create_dir_all(dir).map_err(io_error(dir))?;
     let source = match bed {
         Some(b) => BedSource::Load(b),
@@ -272,6 +275,7 @@ pub fn run_one_with_stop(
     let options = PenetrationOptions {
         snapshot_tip_x: section_instants(config),
         stop,
+        files: Some(files),
         ..PenetrationOptions::default()
     };
     let mut result = run_experiment_with(config, source, &options, progress).map_err(|source| {
@@ -281,7 +285,6 @@ pub fn run_one_with_stop(
             source,
         }
     })?;
-    write_monitors(&dir.join("monitors.csv"), &result.penetration.rows)?;
     if let Some(p) = &result.packing {
         let path = dir.join("packing_trace.csv");
         super::packing::write_packing_trace(&path, &p.trace).map_err(io_error(&path))?;

@@ -181,7 +181,7 @@ fn run_bed(
         let fz = sim
             .world
             .loads()
-            .forces
+            .forces()
             .get(projectile)
             .map_or(0.0, |f| f.z);
         let contacts = sim

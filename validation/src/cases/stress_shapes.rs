@@ -156,7 +156,7 @@ fn run_scene(name: &str, mut sim: Simulation, steps: u64, oracle_every: u64) -> 
             compare_with_oracle(s, &mut oracle);
         }
         if n.is_multiple_of(every) {
-            if let Some(e0) = s.world.ledger().initial_total {
+            if let Some(e0) = s.world.ledger().initial_total() {
                 history.push((s.world.time(), s.world.energy().balance / e0));
             }
         }

@@ -245,7 +245,7 @@ pub fn run_monitored(
             run.first_crossing.get_or_insert(*c);
         }
         // The ledger's initial energy includes the elastic energy of initial overlaps.
-        let e0 = sim.world.ledger().initial_total.unwrap_or(Real::NAN);
+        let e0 = sim.world.ledger().initial_total().unwrap_or(Real::NAN);
         let err = (sim.world.energy().balance / e0).abs();
         run.energy_error_max =
             run.energy_error_max

@@ -163,7 +163,7 @@ impl RunObserver for ProjectileSamples<'_> {
         let fz = s
             .world
             .loads()
-            .forces
+            .forces()
             .get(self.projectile)
             .map_or(0.0, |f| f.z);
         let h = &mut *self.history;
