@@ -12,6 +12,8 @@ use mpi::traits::*;
 use polydem::math::Real;
 use polydem::world::{RebuildConsensus, RebuildVote};
 
+use crate::exchange::Traffic;
+
 /// The decision of one part, agreed with the other ranks at every stage 3.
 #[derive(Debug)]
 pub struct Consensus {
@@ -19,8 +21,10 @@ pub struct Consensus {
     owned: Vec<bool>,
     /// The decision of the last call (whether the last stage 3 rebuilt).
     last: AtomicBool,
-    /// Bytes this rank sent in the agreements (for the communication figures).
-    pub bytes_sent: AtomicU64,
+    /// Bytes this rank sent in the agreements (to each other rank).
+    bytes: AtomicU64,
+    /// Messages this rank sent in the agreements (one to each other rank per agreement).
+    messages: AtomicU64,
 }
 
 impl Consensus {
@@ -29,7 +33,16 @@ impl Consensus {
         Self {
             owned,
             last: AtomicBool::new(false),
-            bytes_sent: AtomicU64::new(0),
+            bytes: AtomicU64::new(0),
+            messages: AtomicU64::new(0),
+        }
+    }
+
+    /// What this rank sent in the agreements so far.
+    pub fn traffic(&self) -> Traffic {
+        Traffic {
+            bytes: self.bytes.load(Ordering::Relaxed),
+            messages: self.messages.load(Ordering::Relaxed),
         }
     }
 
@@ -48,8 +61,10 @@ impl RebuildConsensus for Consensus {
         let world = SimpleCommunicator::world();
         let mut all = vec![0.0 as Real; 4 * world.size() as usize];
         world.all_gather_into(&mine[..], &mut all[..]);
-        self.bytes_sent
-            .fetch_add(std::mem::size_of_val(&mine) as u64, Ordering::Relaxed);
+        let others = world.size() as u64 - 1;
+        let bytes = std::mem::size_of_val(&mine) as u64 * others;
+        self.bytes.fetch_add(bytes, Ordering::Relaxed);
+        self.messages.fetch_add(others, Ordering::Relaxed);
         let forced = all.chunks(4).any(|v| v[0] != 0.0);
         let any_far = all.chunks(4).any(|v| v[1] != 0.0);
         let rebuild = forced

@@ -13,6 +13,10 @@ pub enum DistributedError {
         /// Bodies in the world.
         bodies: usize,
     },
+    /// The world's loads were already evaluated (a restored checkpoint): its broad phase was built at
+    /// positions the parts cannot know, so they could not rebuild when one process would.
+    #[error("a distributed run starts from a fresh scene (restarting a checkpoint on several ranks is not supported yet)")]
+    NotFresh,
     /// A body moved farther between two list rebuilds than the ghost layer allows for.
     #[error(
         "body moved {moved} m since the subdomains were cut, more than the {allowance} m the ghost layer \

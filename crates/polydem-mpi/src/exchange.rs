@@ -18,13 +18,33 @@ use crate::error::DistributedError;
 /// Numbers per ghost in the exchange after each step.
 pub const GHOST_WORDS: usize = 19;
 
-/// Bytes and messages a rank sent.
+/// Bytes and messages a rank sent (payload only: MPI's own headers are not counted).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct Traffic {
     /// Bytes sent.
     pub bytes: u64,
     /// Messages sent (one per destination rank with data).
     pub messages: u64,
+}
+
+impl std::ops::AddAssign for Traffic {
+    fn add_assign(&mut self, other: Self) {
+        self.bytes += other.bytes;
+        self.messages += other.messages;
+    }
+}
+
+/// What a rank sent, by kind of exchange.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct RunTraffic {
+    /// Ghost states and loads after each step.
+    pub ghosts: Traffic,
+    /// The rebuild agreements (four numbers per rank at each stage 3).
+    pub agreements: Traffic,
+    /// The whole state gathered at each cut.
+    pub cuts: Traffic,
+    /// The bodies gathered for the caller (outputs, checks).
+    pub gathers: Traffic,
 }
 
 /// Appends body `body`'s state with its loads to `out`.

@@ -18,6 +18,13 @@
 //!   process. After a rebuild the parts are cut again (migration) with the contact entries (tangential
 //!   springs, solver caches) taken from the rank that owns the pair's lower body.
 //!
+//! # Building and testing
+//! `cargo test --release -p polydem-mpi --features mpi` with `MPI_PKG_CONFIG=mpich` (rsmpi then links
+//! Debian's MPICH even where `mpicc` points at Open MPI); `tests/mpi_bits.rs` launches itself with
+//! `mpirun.mpich -n 1..4` and compares every body's state with one process's, bit for bit. `.ci/mpi.sh`
+//! installs the packages and runs it. Without the feature the crate builds its MPI-free parts only
+//! (decomposition, plan), so the workspace needs no MPI.
+//!
 //! # Limits of this stage
 //! - A cut gathers the whole state on every rank (O(N) memory and traffic per rebuild); the per-step ghost
 //!   exchange is point to point in content (one all-to-all).

@@ -18,7 +18,7 @@ use polydem::world::{
 
 use crate::consensus::Consensus;
 use crate::error::DistributedError;
-use crate::exchange::{all_gather, all_to_all, pack_ghost, unpack_ghost, Traffic, GHOST_WORDS};
+use crate::exchange::{all_gather, all_to_all, pack_ghost, unpack_ghost, RunTraffic, GHOST_WORDS};
 use crate::plan::{Plan, MOVE_ALLOWANCE_IN_SKINS};
 
 /// This rank's part: the world it steps and what it exchanges.
@@ -46,8 +46,8 @@ pub struct DistributedRun {
     whole: World,
     params: StepParams,
     part: Part,
-    /// What this rank sent so far.
-    pub traffic: Traffic,
+    /// What this rank sent so far (the agreements of the current part not yet added).
+    traffic: RunTraffic,
     /// Cuts so far (the first included).
     pub cuts: u64,
 }
@@ -57,6 +57,9 @@ impl DistributedRun {
     /// passes the same world and parameters. The time-step check is not run on the parts (it reads the
     /// state only, so one process's bits do not depend on it).
     pub fn new(world: World, params: StepParams) -> Result<Self, DistributedError> {
+        if world.loads().current {
+            return Err(DistributedError::NotFresh);
+        }
         let comm = SimpleCommunicator::world();
         let rank = comm.rank() as usize;
         let params = StepParams {
@@ -70,7 +73,7 @@ impl DistributedRun {
             whole: world,
             params,
             part,
-            traffic: Traffic::default(),
+            traffic: RunTraffic::default(),
             cuts: 1,
         })
     }
@@ -84,6 +87,13 @@ impl DistributedRun {
     pub fn part_size(&self) -> (usize, usize) {
         let owned = self.part.owned.iter().filter(|&&o| o).count();
         (owned, self.part.owned.len() - owned)
+    }
+
+    /// What this rank sent so far, by kind.
+    pub fn traffic(&self) -> RunTraffic {
+        let mut traffic = self.traffic;
+        traffic.agreements += self.part.consensus.traffic();
+        traffic
     }
 
     /// One step of the whole world.
@@ -107,7 +117,7 @@ impl DistributedRun {
     /// Every body of the whole world in global order (on every rank).
     pub fn gather_bodies(&mut self) -> Result<Vec<RigidBody>, DistributedError> {
         let mine = owned_bodies(&self.part);
-        let all = all_gather(&self.comm, &mine, &mut self.traffic)?;
+        let all = all_gather(&self.comm, &mine, &mut self.traffic.gathers)?;
         let mut bodies = vec![None; self.whole.body_count()];
         for (gid, body, _, _) in all.into_iter().flatten() {
             bodies[gid] = Some(body);
@@ -137,7 +147,7 @@ impl DistributedRun {
             .iter()
             .map(|l| l.len() * GHOST_WORDS)
             .collect();
-        let received = all_to_all(&self.comm, &blocks, &expected, &mut self.traffic);
+        let received = all_to_all(&self.comm, &blocks, &expected, &mut self.traffic.ghosts);
         let ghosts = part.receives.iter().flatten();
         for (&i, w) in ghosts.zip(received.chunks_exact(GHOST_WORDS)) {
             let (body, force, torque) = unpack_ghost(&part.world.bodies()[i], w);
@@ -170,7 +180,7 @@ impl DistributedRun {
     /// these positions, as one process's is).
     fn recut(&mut self) -> Result<(), DistributedError> {
         let mine = (owned_bodies(&self.part), authoritative_contacts(&self.part));
-        let all = all_gather(&self.comm, &mine, &mut self.traffic)?;
+        let all = all_gather(&self.comm, &mine, &mut self.traffic.cuts)?;
         self.whole.copy_walls_and_clock(&self.part.world);
         let mut entries = Vec::new();
         for (bodies, contacts) in all {
@@ -182,6 +192,7 @@ impl DistributedRun {
         entries.sort_by_key(|entry| entry.0);
         let touched = self.part.world.contacts().last_touched();
         self.whole.replace_contacts(entries, touched);
+        self.traffic.agreements += self.part.consensus.traffic();
         self.part = cut(&self.comm, &self.whole, true)?;
         self.cuts += 1;
         Ok(())

@@ -82,18 +82,24 @@ fn child(case: &str) {
         run.step().unwrap_or_else(|e| fail(&comm, e));
     }
     let elapsed = start.elapsed().as_secs_f64();
-    let traffic = run.traffic;
+    let traffic = run.traffic();
+    let per_step = |t: polydem_mpi::exchange::Traffic| {
+        format!(
+            "{:.0} B in {:.2} messages",
+            t.bytes as f64 / steps as f64,
+            t.messages as f64 / steps as f64
+        )
+    };
     let bodies = run.gather_bodies().unwrap_or_else(|e| fail(&comm, e));
     println!(
-        "{case} rank {}/{}: {owned} owned, {ghosts} ghosts at the first cut; {} cuts; sent {} B in {} \
-         messages ({:.0} B, {:.2} messages per step); {elapsed:.2} s",
+        "{case} rank {}/{}: {owned} owned, {ghosts} ghosts at the first cut, {} cuts, {elapsed:.2} s; sent per \
+         step: ghosts {}, agreements {}, cuts {}",
         run.rank(),
         comm.size(),
         run.cuts,
-        traffic.bytes,
-        traffic.messages,
-        traffic.bytes as f64 / steps as f64,
-        traffic.messages as f64 / steps as f64,
+        per_step(traffic.ghosts),
+        per_step(traffic.agreements),
+        per_step(traffic.cuts),
     );
     if run.rank() == 0 {
         compare(case, comm.size(), steps, whole.bodies(), &bodies, &comm);
