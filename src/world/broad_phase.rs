@@ -186,8 +186,20 @@ impl BroadPhase {
         {
             return true;
         }
+        let (d1, d2) = self.largest_moves_sq(centres, |_| true);
+        self.moves_reach_skin(d1, d2, walls)
+    }
+
+    /// The two largest squared moves (m²) since the last build among the bodies `counted` (the largest
+    /// first; equal moves count twice, as in a multiset).
+    pub fn largest_moves_sq(
+        &self,
+        centres: &[Point],
+        counted: impl Fn(usize) -> bool,
+    ) -> (Real, Real) {
         let (mut d1, mut d2) = (0.0, 0.0);
-        for (now, then) in centres.iter().zip(&self.centres_at_build) {
+        let moves = centres.iter().zip(&self.centres_at_build).enumerate();
+        for (_, (now, then)) in moves.filter(|(i, _)| counted(*i)) {
             let d_sq: Real = (now - then).norm_squared();
             if d_sq > d2 {
                 if d_sq > d1 {
@@ -198,6 +210,13 @@ impl BroadPhase {
                 }
             }
         }
+        (d1, d2)
+    }
+
+    /// Whether two bodies that moved `d1_sq`, `d2_sq` (m², the largest moves) and the walls' moves since
+    /// the last build may have brought a pair within reach that the list lacks.
+    pub fn moves_reach_skin(&self, d1_sq: Real, d2_sq: Real, walls: &[Wall]) -> bool {
+        let (d1, d2) = (d1_sq, d2_sq);
         let w1 = walls
             .iter()
             .zip(&self.walls_at_build)

@@ -14,6 +14,7 @@ mod access;
 mod body_inputs;
 pub mod broad_phase;
 pub mod contact_store;
+mod distributed;
 pub mod energy;
 mod loads;
 mod material_presence;
@@ -39,7 +40,7 @@ pub use sleeping::{SleepParams, SleepState};
 pub use sphere_flat::{NotSphereOnly, SphereSim, StepFlatError};
 pub use step::sphere::applies as sphere_step_applies;
 pub use step::{
-    step, StepCounters, StepError, StepParams, StepReport, StepScratch, TimeStepCheck,
-    TimeStepFinding,
+    step, RebuildConsensus, RebuildVote, StepCounters, StepError, StepParams, StepReport,
+    StepScratch, TimeStepCheck, TimeStepFinding,
 };
 pub use world::{Loads, MaterialTable, SetupStats, Wall, World, WorldError};

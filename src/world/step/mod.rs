@@ -57,6 +57,7 @@ mod scratch;
 pub(super) mod sphere;
 mod sphere_kernel;
 
+pub use broad::{RebuildConsensus, RebuildVote};
 pub use counters::StepCounters;
 pub use findings::{TimeStepCheck, TimeStepFinding};
 pub use params::{StepParams, DEFAULT_OVERLAP_WARNING_FRACTION};

@@ -1,11 +1,14 @@
 //! The buffers the step reuses from one step to the next.
 
+use std::sync::Arc;
+
 use crate::law::ContactModel;
 
 use super::super::body_inputs;
 use super::super::contact_store::ContactKey;
 use super::super::parallel::Worker;
 use super::super::sleeping;
+use super::broad::RebuildConsensus;
 use super::laws::Evaluated;
 use super::sphere_kernel;
 
@@ -33,4 +36,14 @@ pub struct StepScratch {
     pub(super) deferred_gather: bool,
     /// What the check of the time step keeps of the world (see [`super::guard`]).
     pub(super) guard: super::guard::Guard,
+    /// The rebuild decision of a world split over processes (none: this world's own).
+    pub(super) consensus: Option<Arc<dyn RebuildConsensus>>,
+}
+
+impl StepScratch {
+    /// Makes stage 3 ask `consensus` whether to rebuild the broad phase (a part of a world split over
+    /// processes); `None` restores the world's own decision.
+    pub fn set_rebuild_consensus(&mut self, consensus: Option<Arc<dyn RebuildConsensus>>) {
+        self.consensus = consensus;
+    }
 }

@@ -1,0 +1,47 @@
+//! What can stop a distributed run.
+
+use polydem::math::Real;
+
+/// Why a distributed run cannot go on.
+#[derive(Debug, thiserror::Error)]
+pub enum DistributedError {
+    /// More ranks than bodies: some subdomain would be empty.
+    #[error("{ranks} ranks for {bodies} bodies: every rank needs at least one body")]
+    TooManyRanks {
+        /// Ranks asked for.
+        ranks: usize,
+        /// Bodies in the world.
+        bodies: usize,
+    },
+    /// The world's loads were already evaluated (a restored checkpoint): its broad phase was built at
+    /// positions the parts cannot know, so they could not rebuild when one process would.
+    #[error("a distributed run starts from a fresh scene (restarting a checkpoint on several ranks is not supported yet)")]
+    NotFresh,
+    /// A body moved farther between two list rebuilds than the ghost layer allows for.
+    #[error(
+        "body moved {moved} m since the subdomains were cut, more than the {allowance} m the ghost layer \
+         allows for (the time step is too large for the skin)"
+    )]
+    HaloExceeded {
+        /// The largest move since the cut (m).
+        moved: Real,
+        /// The move the ghost layer covers (m).
+        allowance: Real,
+    },
+    /// A step of this rank's part failed.
+    #[error("step of rank {rank}: {source}")]
+    Step {
+        /// The rank whose part failed.
+        rank: usize,
+        /// The step's error.
+        source: polydem::world::StepError,
+    },
+    /// A message could not be decoded.
+    #[error("message from rank {rank} could not be decoded: {message}")]
+    Decode {
+        /// The sending rank.
+        rank: usize,
+        /// The decoder's message.
+        message: String,
+    },
+}

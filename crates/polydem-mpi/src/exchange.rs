@@ -1,0 +1,137 @@
+//! The messages of a distributed run: ghost states after every step, the whole state at a cut.
+//!
+//! A ghost's state travels as 19 numbers (position, velocity, orientation quaternion, angular momentum,
+//! force, torque), bit for bit; the receiver knows from the plan which ghost each block fills, so no index
+//! travels. At a cut every rank gathers the bodies and contact entries of every other rank (encoded with
+//! postcard, which keeps each f64's bits).
+
+use mpi::datatype::{Partition, PartitionMut};
+use mpi::topology::SimpleCommunicator;
+use mpi::traits::*;
+use mpi::Count;
+use polydem::dynamics::RigidBody;
+use polydem::math::{Real, Rotation, Vector};
+use serde::{de::DeserializeOwned, Serialize};
+
+use crate::error::DistributedError;
+
+/// Numbers per ghost in the exchange after each step.
+pub const GHOST_WORDS: usize = 19;
+
+/// Bytes and messages a rank sent (payload only: MPI's own headers are not counted).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Traffic {
+    /// Bytes sent.
+    pub bytes: u64,
+    /// Messages sent (one per destination rank with data).
+    pub messages: u64,
+}
+
+impl std::ops::AddAssign for Traffic {
+    fn add_assign(&mut self, other: Self) {
+        self.bytes += other.bytes;
+        self.messages += other.messages;
+    }
+}
+
+/// What a rank sent, by kind of exchange.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct RunTraffic {
+    /// Ghost states and loads after each step.
+    pub ghosts: Traffic,
+    /// The rebuild agreements (four numbers per rank at each stage 3).
+    pub agreements: Traffic,
+    /// The whole state gathered at each cut.
+    pub cuts: Traffic,
+    /// The bodies gathered for the caller (outputs, checks).
+    pub gathers: Traffic,
+}
+
+/// Appends body `body`'s state with its loads to `out`.
+pub fn pack_ghost(body: &RigidBody, force: &Vector, torque: &Vector, out: &mut Vec<Real>) {
+    out.extend(body.position.coords.iter());
+    out.extend(body.velocity.iter());
+    out.extend(body.orientation.coords.iter());
+    out.extend(body.angular_momentum.iter());
+    out.extend(force.iter());
+    out.extend(torque.iter());
+}
+
+/// The state of `template` (its mass properties and motion kept) with the block `w` written over it, and
+/// the loads of the block.
+pub fn unpack_ghost(template: &RigidBody, w: &[Real]) -> (RigidBody, Vector, Vector) {
+    let v = |k: usize| Vector::new(w[k], w[k + 1], w[k + 2]);
+    let mut body = *template;
+    body.position = v(0).into();
+    body.velocity = v(3);
+    let q = nalgebra::Quaternion::from(nalgebra::Vector4::new(w[6], w[7], w[8], w[9]));
+    body.orientation = Rotation::new_unchecked(q);
+    body.angular_momentum = v(10);
+    (body, v(13), v(16))
+}
+
+/// Sends `blocks[q]` to every rank q and returns what each rank sent here (`expected[q]` numbers from q).
+pub fn all_to_all(
+    comm: &SimpleCommunicator,
+    blocks: &[Vec<Real>],
+    expected: &[usize],
+    traffic: &mut Traffic,
+) -> Vec<Real> {
+    let counts: Vec<Count> = blocks.iter().map(|b| b.len() as Count).collect();
+    let send: Vec<Real> = blocks.concat();
+    let recv_counts: Vec<Count> = expected.iter().map(|&n| n as Count).collect();
+    let mut recv = vec![0.0; expected.iter().sum()];
+    let (send_displs, recv_displs) = (displacements(&counts), displacements(&recv_counts));
+    comm.all_to_all_varcount_into(
+        &Partition::new(&send[..], counts.clone(), send_displs),
+        &mut PartitionMut::new(&mut recv[..], recv_counts, recv_displs),
+    );
+    let me = comm.rank() as usize;
+    for (q, block) in blocks.iter().enumerate() {
+        if q != me && !block.is_empty() {
+            traffic.bytes += (block.len() * std::mem::size_of::<Real>()) as u64;
+            traffic.messages += 1;
+        }
+    }
+    recv
+}
+
+/// Gathers `value` from every rank, in rank order.
+pub fn all_gather<T: Serialize + DeserializeOwned>(
+    comm: &SimpleCommunicator,
+    value: &T,
+    traffic: &mut Traffic,
+) -> Result<Vec<T>, DistributedError> {
+    let bytes = postcard::to_allocvec(value).expect("encoding to memory does not fail");
+    let size = comm.size() as usize;
+    let mut counts = vec![0 as Count; size];
+    comm.all_gather_into(&(bytes.len() as Count), &mut counts[..]);
+    let mut all = vec![0u8; counts.iter().map(|&c| c as usize).sum()];
+    let displs = displacements(&counts);
+    comm.all_gather_varcount_into(
+        &bytes[..],
+        &mut PartitionMut::new(&mut all[..], counts.clone(), displs.clone()),
+    );
+    traffic.bytes += (bytes.len() * (size - 1)) as u64;
+    traffic.messages += (size - 1) as u64;
+    (0..size)
+        .map(|q| {
+            let (start, len) = (displs[q] as usize, counts[q] as usize);
+            postcard::from_bytes(&all[start..start + len]).map_err(|e| DistributedError::Decode {
+                rank: q,
+                message: e.to_string(),
+            })
+        })
+        .collect()
+}
+
+fn displacements(counts: &[Count]) -> Vec<Count> {
+    counts
+        .iter()
+        .scan(0, |offset, &c| {
+            let start = *offset;
+            *offset += c;
+            Some(start)
+        })
+        .collect()
+}

@@ -1,0 +1,280 @@
+//! A run of one world split over the ranks of `MPI_COMM_WORLD`, the same bits as one process.
+//!
+//! Each step: the part's step (the engine's, with the rebuild decision agreed by every rank), then either
+//! the ghost exchange (each owner sends its ghosts' states and loads) or, after a rebuild, a cut: every
+//! rank gathers the whole state (owned bodies, the contact entries each rank is authoritative for) and cuts
+//! new parts from it.
+
+use std::sync::Arc;
+
+use mpi::collective::SystemOperation;
+use mpi::topology::SimpleCommunicator;
+use mpi::traits::*;
+use polydem::dynamics::RigidBody;
+use polydem::math::{Point, Real, Vector};
+use polydem::world::{
+    step, ContactKey, ContactState, StepParams, StepScratch, TimeStepCheck, World,
+};
+
+use crate::consensus::Consensus;
+use crate::error::DistributedError;
+use crate::exchange::{all_gather, all_to_all, pack_ghost, unpack_ghost, RunTraffic, GHOST_WORDS};
+use crate::plan::{Plan, MOVE_ALLOWANCE_IN_SKINS};
+
+/// This rank's part: the world it steps and what it exchanges.
+struct Part {
+    world: World,
+    scratch: StepScratch,
+    /// Global index of each local body (increasing).
+    ids: Vec<usize>,
+    /// Whether each local body is owned here.
+    owned: Vec<bool>,
+    /// Per rank, the local indices of the owned bodies it holds as ghosts.
+    sends: Vec<Vec<usize>>,
+    /// Per rank, the local indices of the ghosts it owns.
+    receives: Vec<Vec<usize>>,
+    consensus: Arc<Consensus>,
+    /// Positions of the owned bodies at the cut.
+    at_cut: Vec<Point>,
+}
+
+/// A world stepped on every rank of `MPI_COMM_WORLD`.
+pub struct DistributedRun {
+    comm: SimpleCommunicator,
+    rank: usize,
+    /// The whole world as of the last cut (bodies, contacts); walls and clock taken from the part.
+    whole: World,
+    params: StepParams,
+    part: Part,
+    /// What this rank sent so far (the agreements of the current part not yet added).
+    traffic: RunTraffic,
+    /// Cuts so far (the first included).
+    pub cuts: u64,
+}
+
+impl DistributedRun {
+    /// Splits `world` (fresh: its loads not yet evaluated, as a scene builds it) over the ranks. Every rank
+    /// passes the same world and parameters. The time-step check is not run on the parts (it reads the
+    /// state only, so one process's bits do not depend on it).
+    pub fn new(world: World, params: StepParams) -> Result<Self, DistributedError> {
+        if world.loads().current {
+            return Err(DistributedError::NotFresh);
+        }
+        let comm = SimpleCommunicator::world();
+        let rank = comm.rank() as usize;
+        let params = StepParams {
+            time_step_check: TimeStepCheck::Off,
+            ..params
+        };
+        let part = cut(&comm, &world, false)?;
+        Ok(Self {
+            comm,
+            rank,
+            whole: world,
+            params,
+            part,
+            traffic: RunTraffic::default(),
+            cuts: 1,
+        })
+    }
+
+    /// This rank.
+    pub fn rank(&self) -> usize {
+        self.rank
+    }
+
+    /// Bodies in this rank's part (owned, ghosts).
+    pub fn part_size(&self) -> (usize, usize) {
+        let owned = self.part.owned.iter().filter(|&&o| o).count();
+        (owned, self.part.owned.len() - owned)
+    }
+
+    /// What this rank sent so far, by kind.
+    pub fn traffic(&self) -> RunTraffic {
+        let mut traffic = self.traffic;
+        traffic.agreements += self.part.consensus.traffic();
+        traffic
+    }
+
+    /// One step of the whole world.
+    pub fn step(&mut self) -> Result<(), DistributedError> {
+        let part = &mut self.part;
+        step(&self.params, &mut part.world, &mut part.scratch).map_err(|source| {
+            DistributedError::Step {
+                rank: self.rank,
+                source,
+            }
+        })?;
+        if part.consensus.last_rebuilt() {
+            self.check_moves()?;
+            self.recut()
+        } else {
+            self.exchange_ghosts();
+            Ok(())
+        }
+    }
+
+    /// Every body of the whole world in global order (on every rank).
+    pub fn gather_bodies(&mut self) -> Result<Vec<RigidBody>, DistributedError> {
+        let mine = owned_bodies(&self.part);
+        let all = all_gather(&self.comm, &mine, &mut self.traffic.gathers)?;
+        let mut bodies = vec![None; self.whole.body_count()];
+        for (gid, body, _, _) in all.into_iter().flatten() {
+            bodies[gid] = Some(body);
+        }
+        Ok(bodies
+            .into_iter()
+            .map(|b| b.expect("every body is owned once"))
+            .collect())
+    }
+
+    fn exchange_ghosts(&mut self) {
+        let part = &mut self.part;
+        let (bodies, loads) = (part.world.bodies(), part.world.loads());
+        let blocks: Vec<Vec<Real>> = part
+            .sends
+            .iter()
+            .map(|list| {
+                let mut block = Vec::with_capacity(list.len() * GHOST_WORDS);
+                for &i in list {
+                    pack_ghost(&bodies[i], &loads.forces[i], &loads.torques[i], &mut block);
+                }
+                block
+            })
+            .collect();
+        let expected: Vec<usize> = part
+            .receives
+            .iter()
+            .map(|l| l.len() * GHOST_WORDS)
+            .collect();
+        let received = all_to_all(&self.comm, &blocks, &expected, &mut self.traffic.ghosts);
+        let ghosts = part.receives.iter().flatten();
+        for (&i, w) in ghosts.zip(received.chunks_exact(GHOST_WORDS)) {
+            let (body, force, torque) = unpack_ghost(&part.world.bodies()[i], w);
+            part.world.copy_body_from_owner(i, &body, &force, &torque);
+        }
+    }
+
+    /// Refuses to go on when a body moved beyond the ghost layer's allowance since the cut.
+    fn check_moves(&mut self) -> Result<(), DistributedError> {
+        let part = &self.part;
+        let owned = (0..part.ids.len()).filter(|&i| part.owned[i]);
+        let moved = owned
+            .zip(&part.at_cut)
+            .map(|(i, then)| (part.world.bodies()[i].position - then).norm())
+            .fold(0.0, Real::max);
+        let mut largest = 0.0;
+        self.comm
+            .all_reduce_into(&moved, &mut largest, SystemOperation::max());
+        let allowance = MOVE_ALLOWANCE_IN_SKINS * self.whole.broad_phase().skin();
+        if largest > allowance {
+            return Err(DistributedError::HaloExceeded {
+                moved: largest,
+                allowance,
+            });
+        }
+        Ok(())
+    }
+
+    /// Gathers the whole state and cuts new parts from it (after a rebuild: the parts' lists are built at
+    /// these positions, as one process's is).
+    fn recut(&mut self) -> Result<(), DistributedError> {
+        let mine = (owned_bodies(&self.part), authoritative_contacts(&self.part));
+        let all = all_gather(&self.comm, &mine, &mut self.traffic.cuts)?;
+        self.whole.copy_walls_and_clock(&self.part.world);
+        let mut entries = Vec::new();
+        for (bodies, contacts) in all {
+            for (gid, body, force, torque) in bodies {
+                self.whole.copy_body_from_owner(gid, &body, &force, &torque);
+            }
+            entries.extend(contacts);
+        }
+        entries.sort_by_key(|entry| entry.0);
+        let touched = self.part.world.contacts().last_touched();
+        self.whole.replace_contacts(entries, touched);
+        self.traffic.agreements += self.part.consensus.traffic();
+        self.part = cut(&self.comm, &self.whole, true)?;
+        self.cuts += 1;
+        Ok(())
+    }
+}
+
+type OwnedBody = (usize, RigidBody, Vector, Vector);
+
+fn owned_bodies(part: &Part) -> Vec<OwnedBody> {
+    let (bodies, loads) = (part.world.bodies(), part.world.loads());
+    (0..part.ids.len())
+        .filter(|&i| part.owned[i])
+        .map(|i| (part.ids[i], bodies[i], loads.forces[i], loads.torques[i]))
+        .collect()
+}
+
+/// The part's contact entries this rank answers for, with global keys: a body pair where it owns the body
+/// of lower index, a body–wall pair where it owns the body. Every pair of the whole list is computed,
+/// with its full history, on the rank that owns its lower body.
+fn authoritative_contacts(part: &Part) -> Vec<(ContactKey, ContactState)> {
+    let store = part.world.contacts();
+    let global = |i: u32| part.ids[i as usize] as u32;
+    store
+        .keys()
+        .iter()
+        .zip(store.states())
+        .filter_map(|(key, state)| match *key {
+            ContactKey::Body { a, b } => part.owned[a as usize].then(|| {
+                let key = ContactKey::Body {
+                    a: global(a),
+                    b: global(b),
+                };
+                (key, *state)
+            }),
+            ContactKey::Wall { body, wall } => part.owned[body as usize].then(|| {
+                let key = ContactKey::Wall {
+                    body: global(body),
+                    wall,
+                };
+                (key, *state)
+            }),
+        })
+        .collect()
+}
+
+/// This rank's part of `whole` cut by the plan of its positions.
+fn cut(
+    comm: &SimpleCommunicator,
+    whole: &World,
+    build_broad_phase: bool,
+) -> Result<Part, DistributedError> {
+    let (rank, size) = (comm.rank() as usize, comm.size() as usize);
+    let centres: Vec<Point> = whole.bodies().iter().map(|b| b.position).collect();
+    let plan = Plan::new(&centres, whole.radii(), whole.broad_phase().skin(), size)?;
+    let ids = plan.parts[rank].clone();
+    let local = |gid: &usize| ids.binary_search(gid).expect("held by the plan");
+    let to_local = |lists: Vec<Vec<usize>>| -> Vec<Vec<usize>> {
+        lists
+            .into_iter()
+            .map(|l| l.iter().map(local).collect())
+            .collect()
+    };
+    let owned: Vec<bool> = ids
+        .iter()
+        .map(|&i| plan.decomposition.owner[i] as usize == rank)
+        .collect();
+    let consensus = Arc::new(Consensus::new(owned.clone()));
+    let mut scratch = StepScratch::default();
+    scratch.set_rebuild_consensus(Some(consensus.clone()));
+    let world = whole.part(&ids, build_broad_phase);
+    let at_cut = (0..ids.len())
+        .filter(|&i| owned[i])
+        .map(|i| centres[ids[i]])
+        .collect();
+    Ok(Part {
+        world,
+        scratch,
+        sends: to_local(plan.sends(rank)),
+        receives: to_local(plan.receives(rank)),
+        ids,
+        owned,
+        consensus,
+        at_cut,
+    })
+}
