@@ -152,6 +152,7 @@ fn no_file_imports_a_file_that_imports_it_back() {
         "src",
         "crates/polydem-cli/src",
         "crates/rockfill/src",
+        "crates/polydem-mpi/src",
         "validation/src",
         "python/src",
     ];

@@ -2,12 +2,10 @@
 //! longer covers the moves, the candidate list (kept from the last step unless the grid was rebuilt or a
 //! dynamic flag changed), and the contact models of the step.
 
-use crate::math::Point;
-
-use super::super::broad_phase::BroadPhase;
 use super::super::region_profile::Section;
 use super::super::timing::{Stage, StageClock};
-use super::super::world::{Wall, World};
+use super::super::world::World;
+use super::consensus::RebuildVote;
 use super::counters::StepCounters;
 use super::laws::effective_models;
 use super::params::StepParams;
@@ -72,27 +70,4 @@ pub(super) fn stage(
     effective_models(&world.materials, &params.skips, &mut scratch.models);
     clock.serial_end(Section::SerialInputs, profile_inputs);
     counters.add(Stage::Broad, clock.stop());
-}
-
-/// What one part of a world split over processes knows of the rebuild decision at its stage 3.
-#[derive(Debug)]
-pub struct RebuildVote<'a> {
-    /// A rebuild is due whatever the moves (first build, body count, walls moved half the skin, skin off).
-    pub forced: bool,
-    /// Some body of the part moved more than half the skin since the last build.
-    pub any_far: bool,
-    /// The part's body centres now.
-    pub centres: &'a [Point],
-    /// The part's broad phase (its build positions and skin).
-    pub broad_phase: &'a BroadPhase,
-    /// The walls now.
-    pub walls: &'a [Wall],
-}
-
-/// Takes the broad-phase rebuild decision of a world split over several processes: every part must
-/// rebuild exactly when one process stepping the whole world would (see `crate::world::distributed`).
-/// One call per stage 3 on every part, in the same order (an implementation may communicate).
-pub trait RebuildConsensus: std::fmt::Debug + Send + Sync {
-    /// Whether the broad phase is rebuilt now.
-    fn decide(&self, vote: &RebuildVote<'_>) -> bool;
 }

@@ -43,6 +43,7 @@
 mod accumulate;
 mod broad;
 mod checks;
+mod consensus;
 mod counters;
 mod findings;
 pub(crate) mod guard;
@@ -57,7 +58,7 @@ mod scratch;
 pub(super) mod sphere;
 mod sphere_kernel;
 
-pub use broad::{RebuildConsensus, RebuildVote};
+pub use consensus::{RebuildConsensus, RebuildVote};
 pub use counters::StepCounters;
 pub use findings::{TimeStepCheck, TimeStepFinding};
 pub use params::{StepParams, DEFAULT_OVERLAP_WARNING_FRACTION};

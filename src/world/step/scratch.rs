@@ -8,7 +8,7 @@ use super::super::body_inputs;
 use super::super::contact_store::ContactKey;
 use super::super::parallel::Worker;
 use super::super::sleeping;
-use super::broad::RebuildConsensus;
+use super::consensus::RebuildConsensus;
 use super::laws::Evaluated;
 use super::sphere_kernel;
 
