@@ -27,3 +27,5 @@ export POLYDEM_MPIRUN=mpirun.mpich
 # One rayon thread per rank: the ranks already oversubscribe the cores (the bits do not depend on it).
 export RAYON_NUM_THREADS=1
 cargo test --release -p polydem-mpi --features mpi
+# The workspace clippy stage builds without the feature; the MPI code is linted here.
+cargo clippy --release -p polydem-mpi --features mpi --all-targets -- -D warnings
