@@ -141,12 +141,10 @@ impl Grid {
     /// The cell `c` and its neighbours (3 × 3 × 3, fewer at the edges of the grid).
     #[inline(always)]
     pub(crate) fn neighbourhood(&self, c: [u32; 3]) -> CellRange {
-        let mut range = CellRange::default();
-        for axis in 0..3 {
-            range.lo[axis] = c[axis].saturating_sub(1);
-            range.hi[axis] = (c[axis] + 1).min(self.dims[axis] - 1);
+        CellRange {
+            lo: c.map(|x| x.saturating_sub(1)),
+            hi: [0, 1, 2].map(|k| (c[k] + 1).min(self.dims[k] - 1)),
         }
-        range
     }
 
     #[inline(always)]
