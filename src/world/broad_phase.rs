@@ -10,7 +10,8 @@
 //!
 //! The grid's cell size is the median inflated diameter, so a typical body covers one to eight cells; a body
 //! much larger than its neighbours (a 0.8 m projectile among 0.1 m rocks) is simply entered in every cell
-//! its box covers. A pair is reported once, from the first cell (lowest x, y, z) of the overlap of the two
+//! its box covers (the grid, its binning and its cell walk are `world::grid`'s, shared with the flat
+//! sphere layout's neighbour list). A pair is reported once, from the first cell (lowest x, y, z) of the overlap of the two
 //! bodies' cell ranges, which makes the result exactly the set the O(N²) definition gives — no duplicates
 //! and no misses — and [`brute_force_pairs`] is that definition, kept as the test oracle.
 //!
@@ -28,6 +29,7 @@
 
 use crate::math::{Point, Real, Vector};
 
+use super::grid::{CellRange, Grid, Oversize};
 use super::region_profile::{self, Section};
 use super::timing::StageClock;
 use super::wall::Wall;
@@ -53,9 +55,7 @@ pub struct BroadPhase {
     walls_at_build: Vec<Vector>,
     // Scratch, reused between rebuilds (not part of the state: a checkpoint skips it).
     #[serde(skip)]
-    cell_start: Vec<u32>,
-    #[serde(skip)]
-    cell_bodies: Vec<u32>,
+    grid: Grid,
     #[serde(skip)]
     body_cells: Vec<CellRange>,
     /// A number that identifies the content of `pairs` and `wall_pairs`: a fresh one at every build (unique
@@ -73,34 +73,6 @@ static GENERATIONS: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64:
 /// tags of the lists derived from its pairs.
 pub(crate) fn fresh_generation() -> u64 {
     GENERATIONS.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1
-}
-
-/// The inclusive range of grid cells a body's inflated box covers.
-#[derive(Copy, Clone, Debug, Default, PartialEq, Eq)]
-struct CellRange {
-    lo: [u32; 3],
-    hi: [u32; 3],
-}
-
-/// The grid geometry of one rebuild.
-struct Grid {
-    origin: [Real; 3],
-    cell_size: Real,
-    dims: [u32; 3],
-}
-
-impl Grid {
-    /// The cell coordinate of `x` along `axis`, clamped into the grid.
-    fn coord(&self, x: Real, axis: usize) -> u32 {
-        let c = ((x - self.origin[axis]) / self.cell_size).floor();
-        c.clamp(0.0, (self.dims[axis] - 1) as Real) as u32
-    }
-
-    fn linear(&self, c: [u32; 3]) -> usize {
-        (c[0] as usize)
-            + (self.dims[0] as usize)
-                * ((c[1] as usize) + (self.dims[1] as usize) * (c[2] as usize))
-    }
 }
 
 /// From this many bodies the pair search of a rebuild runs on rayon's current pool (the result is the same
@@ -341,20 +313,15 @@ impl BroadPhase {
         }
         let half_skin = 0.5 * self.skin;
         let profile_grid = clock.serial_start();
-        let grid = self.grid_for(centres, radii);
+        let mut grid = std::mem::take(&mut self.grid);
+        self.shape_grid(&mut grid, centres, radii);
 
         // Cell ranges of every body's inflated box.
         self.body_cells.clear();
         let cells_of = |(c, &r): (&Point, &Real)| {
             // Widened by a relative 1e-9 so that rounding can never drop a pair the sphere test would keep:
             // extra cells only cost a test, a missing cell would lose a contact.
-            let reach = (r + half_skin) * (1.0 + 1e-9);
-            let mut range = CellRange::default();
-            for axis in 0..3 {
-                range.lo[axis] = grid.coord(c[axis] - reach, axis);
-                range.hi[axis] = grid.coord(c[axis] + reach, axis);
-            }
-            range
+            grid.cells_of_box(c, (r + half_skin) * (1.0 + 1e-9))
         };
         if centres.len() >= PARALLEL_SEARCH_MIN_BODIES && rayon::current_num_threads() > 1 {
             // One range per body, in body order (an indexed parallel extend).
@@ -365,28 +332,7 @@ impl BroadPhase {
             self.body_cells
                 .extend(centres.iter().zip(radii).map(cells_of));
         }
-
-        // Counting sort of (cell, body) entries into CSR form: cell_bodies[cell_start[k]..cell_start[k+1]].
-        let num_cells = (grid.dims[0] * grid.dims[1] * grid.dims[2]) as usize;
-        self.cell_start.clear();
-        self.cell_start.resize(num_cells + 1, 0);
-        for range in &self.body_cells {
-            for_each_cell(range, |c| self.cell_start[grid.linear(c) + 1] += 1);
-        }
-        for k in 0..num_cells {
-            self.cell_start[k + 1] += self.cell_start[k];
-        }
-        self.cell_bodies.clear();
-        self.cell_bodies
-            .resize(self.cell_start[num_cells] as usize, 0);
-        let mut fill = self.cell_start.clone();
-        for (body, range) in self.body_cells.iter().enumerate() {
-            for_each_cell(range, |c| {
-                let k = grid.linear(c);
-                self.cell_bodies[fill[k] as usize] = body as u32;
-                fill[k] += 1;
-            });
-        }
+        grid.bin(&self.body_cells, |body| body as u32);
 
         clock.serial_end(Section::SerialGrid, profile_grid);
 
@@ -398,11 +344,8 @@ impl BroadPhase {
         let search = |i: usize, out: &mut Vec<Pair>| {
             let found_before = out.len();
             let range_i = &self.body_cells[i];
-            for_each_cell(range_i, |c| {
-                let k = grid.linear(c);
-                for &j in
-                    &self.cell_bodies[self.cell_start[k] as usize..self.cell_start[k + 1] as usize]
-                {
+            grid.for_each_cell(range_i, |c, bodies| {
+                for &j in bodies {
                     let j_usize = j as usize;
                     if j_usize <= i {
                         continue;
@@ -467,11 +410,13 @@ impl BroadPhase {
             });
             self.pairs = pairs;
         }
+        self.grid = grid;
         debug_assert!(self.pairs.windows(2).all(|w| w[0] < w[1]));
     }
 
-    /// A grid over the inflated boxes of all bodies, with the median inflated diameter as cell size.
-    fn grid_for(&self, centres: &[Point], radii: &[Real]) -> Grid {
+    /// Shapes `grid` over the inflated boxes of all bodies, with the median inflated diameter as cell size
+    /// (a body then covers one to eight cells; a large one is entered in every cell its box covers).
+    fn shape_grid(&self, grid: &mut Grid, centres: &[Point], radii: &[Real]) {
         let half_skin = 0.5 * self.skin;
         let mut lo = [Real::INFINITY; 3];
         let mut hi = [Real::NEG_INFINITY; 3];
@@ -484,43 +429,15 @@ impl BroadPhase {
         let mut diameters: Vec<Real> = radii.iter().map(|&r| 2.0 * (r + half_skin)).collect();
         let mid = diameters.len() / 2;
         let (_, median, _) = diameters.select_nth_unstable_by(mid, |a, b| a.total_cmp(b));
-        let extent = [hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]];
-        let largest_extent = extent.iter().cloned().fold(0.0, Real::max);
+        let largest_extent = (0..3).map(|k| hi[k] - lo[k]).fold(0.0, Real::max);
         // A zero median (point bodies, no skin) would make a degenerate grid: fall back to the scene size.
-        let mut cell_size = if *median > 0.0 {
+        let cell = if *median > 0.0 {
             *median
         } else {
             largest_extent.max(1.0)
         };
-        let dims_for = |size: Real| {
-            extent.map(|e| {
-                ((e / size).floor() as u64)
-                    .saturating_add(1)
-                    .min(u32::MAX as u64)
-            })
-        };
-        loop {
-            let dims = dims_for(cell_size);
-            if (dims[0] as u128) * (dims[1] as u128) * (dims[2] as u128) <= MAX_CELLS as u128 {
-                return Grid {
-                    origin: lo,
-                    cell_size,
-                    dims: dims.map(|d| d as u32),
-                };
-            }
-            cell_size *= 2.0;
-        }
-    }
-}
-
-/// Calls `f` with every cell of an inclusive range.
-fn for_each_cell(range: &CellRange, mut f: impl FnMut([u32; 3])) {
-    for z in range.lo[2]..=range.hi[2] {
-        for y in range.lo[1]..=range.hi[1] {
-            for x in range.lo[0]..=range.hi[0] {
-                f([x, y, z]);
-            }
-        }
+        // A sparse, spread-out scene grows its cells rather than allocating a huge empty grid.
+        grid.shape(lo, hi, cell, MAX_CELLS, Oversize::GrowCells);
     }
 }
 

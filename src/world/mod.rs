@@ -1,6 +1,8 @@
 //! The many-body world: broad phase, contact store, the step pipeline and the energy ledger.
 //!
 //! - [`broad_phase`]: candidate pairs from bounding spheres in a uniform grid with a Verlet skin.
+//! - `grid`: the uniform grid (cell binning, neighbour-cell iteration) of the broad phase and of the flat
+//!   sphere layout's neighbour list.
 //! - [`world`](mod@world): the plain data of a simulation (bodies, walls, shapes, material-pair laws, kept state).
 //! - [`contact_store`]: per-pair state (warm start, tangential history) keyed by the ordered pair.
 //! - [`step`](mod@step): one time step, stage by stage, with timers and counters.
@@ -16,6 +18,7 @@ pub mod broad_phase;
 pub mod contact_store;
 mod distributed;
 pub mod energy;
+mod grid;
 mod loads;
 mod material_presence;
 pub mod parallel;

@@ -20,12 +20,14 @@
 //! sphere bed b in 8 steps).
 //!
 //! # Build
-//! Bodies are binned in a uniform grid of cells `2 r_grid + skin` wide, r_grid the largest radius of the
+//! Bodies are binned in the engine's uniform grid (`world::grid`, shared with the broad phase) with cells
+//! `2 r_grid + skin` wide, r_grid the largest radius of the
 //! grid's bodies; a body more than [`LARGE_RADIUS_FACTOR`] times the median radius (a projectile) is kept
 //! out of the grid and tested against every body, so that one large sphere does not coarsen the grid for
 //! all. The grid spans the box of the centres with at most [`MAX_CELLS_PER_BODY`] cells per body; a body
 //! beyond it is binned into the nearest edge cell (clamping keeps neighbouring cells neighbours, so the
-//! search stays complete, only slower for far outliers). Each body's row is searched independently (in
+//! search stays complete, only slower for far outliers). A body's candidates are the grid's bodies in the
+//! 3 × 3 × 3 cells about its own (the cell is at least the reach of a pair of grid bodies). Each body's row is searched independently (in
 //! parallel on several threads, rows in body order, so the list is the same for any number of threads).
 //!
 //! # Contact history across rebuilds
@@ -44,6 +46,7 @@ use crate::law::pair::effective_contact_radius;
 use crate::law::TangentialHistory;
 use crate::math::{Point, Real, Vector};
 
+use super::super::grid::{CellRange, Grid, Oversize};
 use super::pair::{Props, WallPlane};
 
 /// A body whose radius exceeds this many times the median radius is searched against every body
@@ -107,6 +110,8 @@ pub struct NeighbourList {
     spare: Spare,
     /// Per chunk of bodies of the search, what it found (kept for the capacity; a clone holds none).
     chunks: SpareVec<ChunkRows>,
+    /// The grid of the last build (kept for its capacity).
+    grid: Grid,
 }
 
 /// [`NeighbourList::carried_from`] of a pair new to the lists.
@@ -286,91 +291,28 @@ impl TopTwo {
     }
 }
 
-/// The uniform grid of one build.
-struct Grid {
-    origin: Point,
-    inv_cell: Real,
-    dims: [usize; 3],
-    /// Bodies of cell c: `bodies[start[c]..start[c + 1]]`, increasing index.
-    start: Vec<u32>,
-    bodies: Vec<u32>,
-}
-
-impl Grid {
-    #[inline(always)]
-    fn coord(&self, x: &Point) -> [usize; 3] {
-        let mut c = [0; 3];
+/// Shapes `grid` over the centres of the grid's bodies `members`, with cells `cell` wide, at most
+/// [`MAX_CELLS_PER_BODY`] per body (plus 27), and bins each member in the cell of its centre.
+fn bin_members(grid: &mut Grid, centres: &[Point], members: &[u32], cell: Real) {
+    let (mut lo, mut hi) = ([Real::INFINITY; 3], [Real::NEG_INFINITY; 3]);
+    for &i in members {
+        let x = &centres[i as usize];
         for k in 0..3 {
-            let f = ((x[k] - self.origin[k]) * self.inv_cell).floor();
-            c[k] = if f.is_nan() || f <= 0.0 {
-                0
-            } else {
-                (f as usize).min(self.dims[k] - 1)
-            };
+            lo[k] = lo[k].min(x[k]);
+            hi[k] = hi[k].max(x[k]);
         }
-        c
     }
-
-    #[inline(always)]
-    fn index(&self, c: [usize; 3]) -> usize {
-        (c[2] * self.dims[1] + c[1]) * self.dims[0] + c[0]
+    if members.is_empty() {
+        (lo, hi) = ([0.0; 3], [0.0; 3]);
     }
-
-    fn build(centres: &[Point], members: &[u32], cell: Real) -> Grid {
-        let (mut lo, mut hi) = (
-            Point::new(Real::INFINITY, Real::INFINITY, Real::INFINITY),
-            Point::new(Real::NEG_INFINITY, Real::NEG_INFINITY, Real::NEG_INFINITY),
-        );
-        for &i in members {
-            let x = &centres[i as usize];
-            for k in 0..3 {
-                lo[k] = lo[k].min(x[k]);
-                hi[k] = hi[k].max(x[k]);
-            }
-        }
-        if members.is_empty() {
-            lo = Point::origin();
-            hi = Point::origin();
-        }
-        let mut dims = [1usize; 3];
-        for k in 0..3 {
-            let cells = ((hi[k] - lo[k]) / cell).floor() + 1.0;
-            dims[k] = if cells.is_finite() && cells >= 1.0 {
-                cells.min(1e6) as usize
-            } else {
-                1
-            };
-        }
-        // At most MAX_CELLS_PER_BODY cells per body: shrink the longest axis (the others clamp into it).
-        let limit = MAX_CELLS_PER_BODY * members.len() + 27;
-        while dims[0] * dims[1] * dims[2] > limit {
-            let k = (0..3).max_by_key(|&k| dims[k]).unwrap_or(0);
-            dims[k] = (dims[k] / 2).max(1);
-        }
-        let mut grid = Grid {
-            origin: lo,
-            inv_cell: 1.0 / cell,
-            dims,
-            start: vec![0; dims[0] * dims[1] * dims[2] + 1],
-            bodies: vec![0; members.len()],
-        };
-        let cells: Vec<usize> = members
-            .iter()
-            .map(|&i| grid.index(grid.coord(&centres[i as usize])))
-            .collect();
-        for &c in &cells {
-            grid.start[c + 1] += 1;
-        }
-        for c in 0..grid.start.len() - 1 {
-            grid.start[c + 1] += grid.start[c];
-        }
-        let mut fill = grid.start.clone();
-        for (&i, &c) in members.iter().zip(&cells) {
-            grid.bodies[fill[c] as usize] = i;
-            fill[c] += 1;
-        }
-        grid
-    }
+    // Cut rather than grow: a far outlier clamps into an edge cell and the bed keeps its resolution.
+    let limit = MAX_CELLS_PER_BODY * members.len() + 27;
+    grid.shape(lo, hi, cell, limit, Oversize::CutLongestAxis);
+    let cells: Vec<CellRange> = members
+        .iter()
+        .map(|&i| CellRange::cell(grid.cell_of(&centres[i as usize])))
+        .collect();
+    grid.bin(&cells, |k| members[k]);
 }
 
 impl NeighbourList {
@@ -462,7 +404,8 @@ impl NeighbourList {
             (&layout.large, &layout.members, layout.r_grid, layout.median);
         let is_large = |r: Real| r > LARGE_RADIUS_FACTOR * median;
         let cell = (2.0 * r_grid + skin).max(Real::MIN_POSITIVE);
-        let grid = Grid::build(centres, members, cell);
+        let mut grid = std::mem::take(&mut self.grid);
+        bin_members(&mut grid, centres, members, cell);
 
         // Rows of pairs (i, j > i) per body, in body order.
         let large_skin = skin * LARGE_SKIN_FACTOR;
@@ -482,28 +425,19 @@ impl NeighbourList {
                 return;
             }
             let (x_i, r_i) = (centres[i], props[i].radius);
-            let c = grid.coord(&x_i);
-            let range = |k: usize| c[k].saturating_sub(1)..=(c[k] + 1).min(grid.dims[k] - 1);
-            let (x_lo, x_hi) = (c[0].saturating_sub(1), (c[0] + 1).min(grid.dims[0] - 1));
-            for z in range(2) {
-                for y in range(1) {
-                    // The cells x_lo..=x_hi of a row of the grid are consecutive: one run of bodies
-                    // (the row is sorted below, so the order of the runs does not matter).
-                    let (first, last) = (grid.index([x_lo, y, z]), grid.index([x_hi, y, z]));
-                    let bodies =
-                        &grid.bodies[grid.start[first] as usize..grid.start[last + 1] as usize];
-                    // Neither i nor a body of the grid is large: the plain skin.
-                    for &j in bodies {
-                        let ju = j as usize;
-                        if ju > i {
-                            let r = r_i + props[ju].radius + skin;
-                            if (centres[ju] - x_i).norm_squared() < r * r {
-                                out.push(j);
-                            }
+            // The cells of a row are one run of bodies (the row is sorted below, so the order of the
+            // runs does not matter). Neither i nor a body of the grid is large: the plain skin.
+            grid.for_each_row(&grid.neighbourhood(grid.cell_of(&x_i)), |bodies| {
+                for &j in bodies {
+                    let ju = j as usize;
+                    if ju > i {
+                        let r = r_i + props[ju].radius + skin;
+                        if (centres[ju] - x_i).norm_squared() < r * r {
+                            out.push(j);
                         }
                     }
                 }
-            }
+            });
             out.extend(
                 large
                     .iter()
@@ -653,6 +587,7 @@ impl NeighbourList {
             self.wall_since.extend_from_slice(&rows.wall_since);
         }
         self.chunks = SpareVec(chunks);
+        self.grid = grid;
         // Side-B rows: pairs in key order appended to their second body's row (so increasing a).
         self.as_b_start = recycled(&mut spare.as_b_start.0);
         self.as_b_start.resize(n + 1, 0);
