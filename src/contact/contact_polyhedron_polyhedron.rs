@@ -395,22 +395,35 @@ pub fn intersect_polytopes_cached<A: Polytope + ?Sized, B: Polytope + ?Sized>(
         counters.bounding_sphere_rejections += 1;
         return false;
     }
-    // The support maps of the full query: the same scan below `SCAN_MAX_VERTICES`, hill-climbing beyond.
-    let separated =
-        if a.vertices().len() <= SCAN_MAX_VERTICES && b.vertices().len() <= SCAN_MAX_VERTICES {
-            let (sa, sb) = (
-                VertexScan(a.vertex_columns()),
-                VertexScan(b.vertex_columns()),
-            );
-            let mut pair = MinkowskiPair::new(&sa, &sb, &pos12, cache.hint_a, cache.hint_b);
-            separated_by_gjk(&mut pair, scale, tol, cache, counters)
-        } else {
-            let mut pair = MinkowskiPair::new(a, b, &pos12, cache.hint_a, cache.hint_b);
-            separated_by_gjk(&mut pair, scale, tol, cache, counters)
-        };
-    match separated {
-        Some(separated) => !separated,
-        None => {
+    let mut pair = MinkowskiPair::new(a, b, &pos12, cache.hint_a, cache.hint_b);
+    if cache.dir != Vector::zeros() {
+        // h_A(n) + h_B(−n) < −band along n = −v̂ proves separation.
+        let n = -cache.dir.normalize();
+        let (s, _) = pair.overlap_along(&n);
+        if s < -touch {
+            counters.cached_axis_rejections += 1;
+            cache.hint_a = pair.hint_a;
+            cache.hint_b = pair.hint_b;
+            return false;
+        }
+    }
+    let v0 = if cache.dir != Vector::zeros() {
+        cache.dir
+    } else {
+        -t12
+    };
+    let mut simplex = Simplex::default();
+    let gr = gjk(&mut pair, &v0, scale, tol, GjkMode::Boolean, &mut simplex);
+    counters.gjk_runs += 1;
+    counters.gjk_iterations += gr.iterations as u64;
+    cache.hint_a = pair.hint_a;
+    cache.hint_b = pair.hint_b;
+    cache.dir = gr.v;
+    match gr.outcome {
+        GjkOutcome::SeparatingAxis => false,
+        GjkOutcome::Separated { .. } => false,
+        GjkOutcome::Contact => true,
+        GjkOutcome::MaxIterations => {
             counters.fallback_max_iterations += 1;
             let g = sat_polytopes(
                 pos1,
@@ -422,47 +435,6 @@ pub fn intersect_polytopes_cached<A: Polytope + ?Sized, B: Polytope + ?Sized>(
             );
             g.kind != ContactKind::Separated
         }
-    }
-}
-
-/// The cached axis, then boolean GJK, on `pair` (B at `pos12` in A's frame): `Some(true)` when a
-/// separating plane was found, `Some(false)` on contact, `None` at GJK's iteration cap. Leaves the
-/// search direction and the hints in `cache`.
-fn separated_by_gjk<SA: SupportMap + ?Sized, SB: SupportMap + ?Sized>(
-    pair: &mut MinkowskiPair<'_, SA, SB>,
-    scale: Real,
-    tol: &ContactTolerances,
-    cache: &mut PairCache,
-    counters: &mut QueryCounters,
-) -> Option<bool> {
-    let touch = tol.touching * scale;
-    if cache.dir != Vector::zeros() {
-        // h_A(n) + h_B(−n) < −band along n = −v̂ proves separation.
-        let n = -cache.dir.normalize();
-        let (s, _) = pair.overlap_along(&n);
-        if s < -touch {
-            counters.cached_axis_rejections += 1;
-            cache.hint_a = pair.hint_a;
-            cache.hint_b = pair.hint_b;
-            return Some(true);
-        }
-    }
-    let v0 = if cache.dir != Vector::zeros() {
-        cache.dir
-    } else {
-        -pair.translation12()
-    };
-    let mut simplex = Simplex::default();
-    let gr = gjk(pair, &v0, scale, tol, GjkMode::Boolean, &mut simplex);
-    counters.gjk_runs += 1;
-    counters.gjk_iterations += gr.iterations as u64;
-    cache.hint_a = pair.hint_a;
-    cache.hint_b = pair.hint_b;
-    cache.dir = gr.v;
-    match gr.outcome {
-        GjkOutcome::SeparatingAxis | GjkOutcome::Separated { .. } => Some(true),
-        GjkOutcome::Contact => Some(false),
-        GjkOutcome::MaxIterations => None,
     }
 }
 
