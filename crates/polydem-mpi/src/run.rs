@@ -57,7 +57,7 @@ impl DistributedRun {
     /// passes the same world and parameters. The time-step check is not run on the parts (it reads the
     /// state only, so one process's bits do not depend on it).
     pub fn new(world: World, params: StepParams) -> Result<Self, DistributedError> {
-        if world.loads().current {
+        if world.loads().is_current() {
             return Err(DistributedError::NotFresh);
         }
         let comm = SimpleCommunicator::world();
@@ -137,7 +137,7 @@ impl DistributedRun {
             .map(|list| {
                 let mut block = Vec::with_capacity(list.len() * GHOST_WORDS);
                 for &i in list {
-                    pack_ghost(&bodies[i], &loads.forces[i], &loads.torques[i], &mut block);
+                    pack_ghost(&bodies[i], &loads.forces()[i], &loads.torques()[i], &mut block);
                 }
                 block
             })
@@ -205,7 +205,7 @@ fn owned_bodies(part: &Part) -> Vec<OwnedBody> {
     let (bodies, loads) = (part.world.bodies(), part.world.loads());
     (0..part.ids.len())
         .filter(|&i| part.owned[i])
-        .map(|i| (part.ids[i], bodies[i], loads.forces[i], loads.torques[i]))
+        .map(|i| (part.ids[i], bodies[i], loads.forces()[i], loads.torques()[i]))
         .collect()
 }
 
