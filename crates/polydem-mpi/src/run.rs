@@ -137,7 +137,12 @@ impl DistributedRun {
             .map(|list| {
                 let mut block = Vec::with_capacity(list.len() * GHOST_WORDS);
                 for &i in list {
-                    pack_ghost(&bodies[i], &loads.forces()[i], &loads.torques()[i], &mut block);
+                    pack_ghost(
+                        &bodies[i],
+                        &loads.forces()[i],
+                        &loads.torques()[i],
+                        &mut block,
+                    );
                 }
                 block
             })
@@ -205,7 +210,14 @@ fn owned_bodies(part: &Part) -> Vec<OwnedBody> {
     let (bodies, loads) = (part.world.bodies(), part.world.loads());
     (0..part.ids.len())
         .filter(|&i| part.owned[i])
-        .map(|i| (part.ids[i], bodies[i], loads.forces()[i], loads.torques()[i]))
+        .map(|i| {
+            (
+                part.ids[i],
+                bodies[i],
+                loads.forces()[i],
+                loads.torques()[i],
+            )
+        })
         .collect()
 }
 
