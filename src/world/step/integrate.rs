@@ -11,6 +11,7 @@ use super::super::parallel::{
     for_each_item3_checked, for_each_item4, for_each_item_checked, integration_work,
 };
 use super::super::region_profile::Section;
+use super::super::sleep_state::SleepState;
 use super::super::timing::{Stage, StageClock};
 use super::super::world::World;
 use super::accumulate::sum_body_loads;
@@ -117,26 +118,23 @@ pub(super) fn kick_and_check(
     counters: &mut StepCounters,
 ) -> Result<(), StepError> {
     let (dt, skip) = (params.dt, params.skips);
-    // The pass borrows the world mutably; the sleep flags it reads are lent out of it meanwhile.
-    let asleep = std::mem::take(&mut world.sleep);
-    let result = kick_each_body(
+    kick_each_body(
         params,
         world,
         scratch,
         counters,
-        |i, body, force, torque| {
-            if !(asleep.is_asleep(i) || (skip.non_dynamic_pairs && is_at_rest_fixed(body))) {
+        |sleep, i, body, force, torque| {
+            if !(sleep.is_asleep(i) || (skip.non_dynamic_pairs && is_at_rest_fixed(body))) {
                 integrator.second_half_kick(body, force, torque, dt);
             }
             non_finite_quantity(body, force, torque)
         },
-    );
-    world.sleep = asleep;
-    result
+    )
 }
 
 /// The pass of stages 7–8 that every layout of the general step shares: `kick` on each body with its
-/// loads, the first non-finite quantity it reports (in body order, for any number of threads) the error.
+/// loads and the world's sleep flags, the first non-finite quantity it reports (in body order, for any
+/// number of threads) the error.
 /// When stage 6 left the per-body sums to this pass ([`StepScratch::deferred_gather`]), body i's sums
 /// over its pairs in candidate order (the same additions as stage 6's gather) come first.
 pub(super) fn kick_each_body(
@@ -144,7 +142,7 @@ pub(super) fn kick_each_body(
     world: &mut World,
     scratch: &mut StepScratch,
     counters: &mut StepCounters,
-    kick: impl Fn(usize, &mut RigidBody, &Vector, &Vector) -> Option<&'static str> + Sync,
+    kick: impl Fn(&SleepState, usize, &mut RigidBody, &Vector, &Vector) -> Option<&'static str> + Sync,
 ) -> Result<(), StepError> {
     let mut clock = StageClock::start();
     let parallel_bodies = integration_work(world.bodies.len(), scratch.inputs.summary.anisotropic)
@@ -155,7 +153,7 @@ pub(super) fn kick_each_body(
             world.contacts.body_adjacency(n_bodies)
         });
         let evaluated = &scratch.evaluated;
-        let loads = &mut world.loads;
+        let (loads, sleep) = (&mut world.loads, &world.sleep);
         clock.region(Section::KickChecks, true, || {
             for_each_item3_checked(
                 true,
@@ -164,15 +162,15 @@ pub(super) fn kick_each_body(
                 &mut loads.torques,
                 |i, body, force, torque| {
                     sum_body_loads(adjacency, evaluated, i, force, torque);
-                    kick(i, body, force, torque)
+                    kick(sleep, i, body, force, torque)
                 },
             )
         })
     } else {
-        let loads = &world.loads;
+        let (loads, sleep) = (&world.loads, &world.sleep);
         clock.region(Section::KickChecks, parallel_bodies, || {
             for_each_item_checked(parallel_bodies, &mut world.bodies, |i, body| {
-                kick(i, body, &loads.forces[i], &loads.torques[i])
+                kick(sleep, i, body, &loads.forces[i], &loads.torques[i])
             })
         })
     };

@@ -206,6 +206,6 @@ fn kick_all(
         world,
         scratch,
         counters,
-        |_, body, force, torque| kick_and_check(body, force, torque, translation, dt),
+        |_, _, body, force, torque| kick_and_check(body, force, torque, translation, dt),
     )
 }

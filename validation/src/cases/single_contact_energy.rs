@@ -532,14 +532,14 @@ fn setup_runs(
             Target::at_most(g.finest_energy_error),
             "1",
         );
-        rows.push(vec![
+        rows.push(energy_row(
             format!("{setup:?}"),
-            law_name.to_string(),
-            CaseContext::fmt(errors[g.check_index]),
-            CaseContext::fmt(afters[g.check_index]),
-            CaseContext::fmt(errors[errors.len() - 1]),
-            format!("{order:.3}"),
-        ]);
+            law_name,
+            &errors,
+            Some(afters[g.check_index]),
+            g.check_index,
+            order,
+        ));
         series.push(Series {
             label: format!("{setup:?}"),
             style: SeriesStyle::LinePoints,
@@ -615,36 +615,21 @@ fn reference_variants(
             "1",
         );
     }
-    rows.push(vec![
+    let unchecked = |label: String, errors: &[Real]| {
+        let order = fitted_order(&g.dts, errors);
+        energy_row(label, law_name, errors, None, g.check_index, order)
+    };
+    let naive_errors: Vec<Real> = naive.iter().map(|x| x.1).collect();
+    rows.push(unchecked(
         "VertexFace, normal along the centre line (naive)".into(),
-        law_name.to_string(),
-        CaseContext::fmt(naive[g.check_index].1),
-        "—".into(),
-        CaseContext::fmt(naive[naive.len() - 1].1),
-        format!(
-            "{:.3}",
-            fitted_order(&g.dts, &naive.iter().map(|x| x.1).collect::<Vec<_>>())
-        ),
-    ]);
+        &naive_errors,
+    ));
     for (setup, errors) in &former {
-        rows.push(vec![
-            format!("{setup:?}, former deepest-vertex wall law (not checked)"),
-            law_name.to_string(),
-            CaseContext::fmt(errors[g.check_index]),
-            "—".into(),
-            CaseContext::fmt(errors[errors.len() - 1]),
-            format!("{:.3}", fitted_order(&g.dts, errors)),
-        ]);
+        let label = format!("{setup:?}, former deepest-vertex wall law (not checked)");
+        rows.push(unchecked(label, errors));
     }
     for (label, errors) in &exact_pair {
-        rows.push(vec![
-            format!("{label} (not checked)"),
-            law_name.to_string(),
-            CaseContext::fmt(errors[g.check_index]),
-            "—".into(),
-            CaseContext::fmt(errors[errors.len() - 1]),
-            format!("{:.3}", fitted_order(&g.dts, errors)),
-        ]);
+        rows.push(unchecked(format!("{label} (not checked)"), errors));
     }
     series.push(Series {
         label: "VertexFace, centre-line normal (naive)".into(),
@@ -666,6 +651,26 @@ fn reference_variants(
         });
     }
     series
+}
+
+/// One row of the energy table: the error at the checked time step, the error after the contact (gated
+/// runs only), the error at the finest step and the fitted order.
+fn energy_row(
+    label: String,
+    law_name: &str,
+    errors: &[Real],
+    after: Option<Real>,
+    check_index: usize,
+    order: Real,
+) -> Vec<String> {
+    vec![
+        label,
+        law_name.to_string(),
+        CaseContext::fmt(errors[check_index]),
+        after.map_or_else(|| "—".into(), CaseContext::fmt),
+        CaseContext::fmt(errors[errors.len() - 1]),
+        format!("{order:.3}"),
+    ]
 }
 
 /// The energy table and one plot per law.
