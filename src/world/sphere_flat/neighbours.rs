@@ -400,154 +400,163 @@ impl NeighbourList {
             self.layout = Some(Layout::of(props));
         }
         let layout = self.layout.take().unwrap_or_else(|| Layout::of(props));
-        let (large, members, r_grid, median) =
-            (&layout.large, &layout.members, layout.r_grid, layout.median);
-        let is_large = |r: Real| r > LARGE_RADIUS_FACTOR * median;
-        let cell = (2.0 * r_grid + skin).max(Real::MIN_POSITIVE);
+        let cell = (2.0 * layout.r_grid + skin).max(Real::MIN_POSITIVE);
         let mut grid = std::mem::take(&mut self.grid);
-        bin_members(&mut grid, centres, members, cell);
-
-        // Rows of pairs (i, j > i) per body, in body order.
-        let large_skin = skin * LARGE_SKIN_FACTOR;
-        let reach = |i: usize, j: usize| {
-            let pair_skin = if is_large(props[i].radius) || is_large(props[j].radius) {
-                large_skin
-            } else {
-                skin
-            };
-            let r = props[i].radius + props[j].radius + pair_skin;
-            (centres[j] - centres[i]).norm_squared() < r * r
-        };
-        let row = |i: usize, out: &mut Vec<u32>| {
-            let start = out.len();
-            if is_large(props[i].radius) {
-                out.extend((i as u32 + 1..n as u32).filter(|&j| reach(i, j as usize)));
-                return;
-            }
-            let (x_i, r_i) = (centres[i], props[i].radius);
-            // The cells of a row are one run of bodies (the row is sorted below, so the order of the
-            // runs does not matter). Neither i nor a body of the grid is large: the plain skin.
-            grid.for_each_row(&grid.neighbourhood(grid.cell_of(&x_i)), |bodies| {
-                for &j in bodies {
-                    let ju = j as usize;
-                    if ju > i {
-                        let r = r_i + props[ju].radius + skin;
-                        if (centres[ju] - x_i).norm_squared() < r * r {
-                            out.push(j);
-                        }
-                    }
-                }
-            });
-            out.extend(
-                large
-                    .iter()
-                    .copied()
-                    .filter(|&j| j as usize > i && reach(i, j as usize)),
-            );
-            out[start..].sort_unstable();
-        };
-        let wall_row = |i: usize, out: &mut Vec<u32>| {
-            for (w, plane) in walls.iter().enumerate() {
-                let own_skin = if is_large(props[i].radius) {
-                    large_skin
-                } else {
-                    skin
-                };
-                if plane.height(&centres[i]) - props[i].radius < own_skin {
-                    out.push(w as u32);
-                }
-            }
-        };
+        bin_members(&mut grid, centres, &layout.members, cell);
         let mut chunks = std::mem::take(&mut self.chunks.0);
-        // Each new pair's slot in the old lists, if it was listed there: a merge of the old and new rows
-        // of its first body (both sorted by the second body).
-        let old_row = |a: usize| -> (usize, &[u32]) {
-            match self.row_start.get(a..a + 2) {
-                Some(&[s, e]) => (s as usize, &self.b[s as usize..e as usize]),
-                _ => (0, &[][..]),
-            }
+        let search = Search {
+            centres,
+            props,
+            walls,
+            layout: &layout,
+            grid: &grid,
+            skin,
         };
-        let old_wall = |body: usize, wall: u32| -> Option<usize> {
-            let (s, e) = match self.wall_start.get(body..body + 2) {
-                Some(&[s, e]) => (s as usize, e as usize),
-                _ => return None,
-            };
-            self.wall_of[s..e]
-                .iter()
-                .position(|&w| w == wall)
-                .map(|k| s + k)
-        };
-        // Per chunk of bodies, independently: their rows, walls, and each pair's spring and constants
-        // carried over (the constants are functions of the two bodies: the same bits as forming them
-        // again), or imported, or new: in parallel, since this is a third of a build on two threads.
-        let search = |(range, rows): (std::ops::Range<usize>, &mut ChunkRows)| {
-            rows.clear();
-            for i in range {
-                let (p0, w0) = (rows.partners.len(), rows.walls.len());
-                row(i, &mut rows.partners);
-                wall_row(i, &mut rows.walls);
-                rows.lengths.push((rows.partners.len() - p0) as u32);
-                rows.wall_lengths.push((rows.walls.len() - w0) as u32);
-                let (old_first, old_row) = old_row(i);
-                let mut k = 0;
-                for &j in &rows.partners[p0..] {
-                    while k < old_row.len() && old_row[k] < j {
-                        k += 1;
-                    }
-                    if k < old_row.len() && old_row[k] == j {
-                        let from = old_first + k;
-                        rows.carried.push(from as u32);
-                        rows.histories.push(self.histories[from]);
-                        rows.in_contact.push(!self.histories[from].is_cleared());
-                        rows.since.push(self.since[from]);
-                        rows.root_radius.push(self.root_radius[from]);
-                        rows.effective_mass.push(self.effective_mass[from]);
-                        continue;
-                    }
-                    let (h, since) =
-                        history_of(Some((i as u32, j)), None).unwrap_or((Default::default(), step));
-                    let (pa, pb) = (&props[i], &props[j as usize]);
-                    rows.carried.push(NOT_CARRIED);
-                    rows.histories.push(h);
-                    rows.in_contact.push(!h.is_cleared());
-                    rows.since.push(since);
-                    rows.root_radius
-                        .push(effective_contact_radius(Some(pa.radius), Some(pb.radius)).sqrt());
-                    rows.effective_mass
-                        .push(pa.mass * pb.mass / (pa.mass + pb.mass));
-                }
-                for &wall in &rows.walls[w0..] {
-                    let (h, since) = match old_wall(i, wall) {
-                        Some(k) => (self.wall_histories[k], self.wall_since[k]),
-                        None => history_of(None, Some((i as u32, wall)))
-                            .unwrap_or((Default::default(), step)),
-                    };
-                    rows.wall_histories.push(h);
-                    rows.wall_since.push(since);
-                }
-            }
-        };
-        let chunk = chunk_len(n, parallel);
-        let ranges: Vec<std::ops::Range<usize>> = (0..n)
-            .step_by(chunk.max(1))
-            .map(|s| s..(s + chunk).min(n))
-            .collect();
-        chunks.resize_with(ranges.len(), ChunkRows::default);
-        if parallel {
-            ranges
-                .into_par_iter()
-                .zip(chunks.par_iter_mut())
-                .with_max_len(1)
-                .for_each(search);
-        } else {
-            ranges.into_iter().zip(chunks.iter_mut()).for_each(search);
-        }
+        self.search_chunks(&search, parallel, step, history_of, &mut chunks);
+        let large_flags = (0..n).map(|i| search.is_large(i)).collect();
         // The chunks joined in the vectors of the build before the last (their capacity kept: fresh
         // vectors of a few hundred kB per build came back as page faults on every build).
         let mut old = std::mem::take(self);
         let mut spare = std::mem::take(&mut old.spare);
         self.skin = skin;
         self.builds = old.builds + 1;
+        self.join_chunks(&chunks, &mut spare);
+        self.chunks = SpareVec(chunks);
+        self.grid = grid;
+        self.index_side_b(n, &mut spare);
+        self.wall_in_contact = recycled(&mut spare.wall_in_contact.0);
+        self.wall_in_contact
+            .extend(self.wall_histories.iter().map(|h| !h.is_cleared()));
+        self.centres_at_build = recycled(&mut spare.centres_at_build.0);
+        self.centres_at_build.extend_from_slice(centres);
+        self.large_flags = large_flags;
+        self.layout = Some(layout);
+        self.walls_at_build = walls.iter().map(|w| w.pose.translation.vector).collect();
+        // The old lists' vectors are the next build's.
+        self.spare = Spare::of(old);
+    }
+
+    /// Per chunk of bodies, independently: their rows, walls, and each pair's spring and constants
+    /// (see [`Self::search_body`]); in parallel, since this is a third of a build on two threads.
+    fn search_chunks(
+        &self,
+        search: &Search<'_>,
+        parallel: bool,
+        step: u64,
+        history_of: &ImportHistory<'_>,
+        chunks: &mut Vec<ChunkRows>,
+    ) {
+        let n = search.centres.len();
+        let chunk = chunk_len(n, parallel);
+        let ranges: Vec<std::ops::Range<usize>> = (0..n)
+            .step_by(chunk.max(1))
+            .map(|s| s..(s + chunk).min(n))
+            .collect();
+        chunks.resize_with(ranges.len(), ChunkRows::default);
+        let search_chunk = |(range, rows): (std::ops::Range<usize>, &mut ChunkRows)| {
+            rows.clear();
+            for i in range {
+                self.search_body(search, i, rows, step, history_of);
+            }
+        };
+        if parallel {
+            ranges
+                .into_par_iter()
+                .zip(chunks.par_iter_mut())
+                .with_max_len(1)
+                .for_each(search_chunk);
+        } else {
+            ranges
+                .into_iter()
+                .zip(chunks.iter_mut())
+                .for_each(search_chunk);
+        }
+    }
+
+    /// Body `i`'s row and walls appended to `rows`, each pair's spring and constants carried over from
+    /// the old lists (the constants are functions of the two bodies: the same bits as forming them
+    /// again), or imported, or new.
+    #[inline]
+    fn search_body(
+        &self,
+        search: &Search<'_>,
+        i: usize,
+        rows: &mut ChunkRows,
+        step: u64,
+        history_of: &ImportHistory<'_>,
+    ) {
+        let (p0, w0) = (rows.partners.len(), rows.walls.len());
+        search.row(i, &mut rows.partners);
+        search.wall_row(i, &mut rows.walls);
+        rows.lengths.push((rows.partners.len() - p0) as u32);
+        rows.wall_lengths.push((rows.walls.len() - w0) as u32);
+        // Each new pair's slot in the old lists, if it was listed there: a merge of the old and new
+        // rows of its first body (both sorted by the second body).
+        let (old_first, old_row) = self.old_row(i);
+        let mut k = 0;
+        for &j in &rows.partners[p0..] {
+            while k < old_row.len() && old_row[k] < j {
+                k += 1;
+            }
+            if k < old_row.len() && old_row[k] == j {
+                let from = old_first + k;
+                rows.carried.push(from as u32);
+                rows.histories.push(self.histories[from]);
+                rows.in_contact.push(!self.histories[from].is_cleared());
+                rows.since.push(self.since[from]);
+                rows.root_radius.push(self.root_radius[from]);
+                rows.effective_mass.push(self.effective_mass[from]);
+                continue;
+            }
+            let (h, since) =
+                history_of(Some((i as u32, j)), None).unwrap_or((Default::default(), step));
+            let (pa, pb) = (&search.props[i], &search.props[j as usize]);
+            rows.carried.push(NOT_CARRIED);
+            rows.histories.push(h);
+            rows.in_contact.push(!h.is_cleared());
+            rows.since.push(since);
+            rows.root_radius
+                .push(effective_contact_radius(Some(pa.radius), Some(pb.radius)).sqrt());
+            rows.effective_mass
+                .push(pa.mass * pb.mass / (pa.mass + pb.mass));
+        }
+        for &wall in &rows.walls[w0..] {
+            let (h, since) = match self.old_wall(i, wall) {
+                Some(k) => (self.wall_histories[k], self.wall_since[k]),
+                None => {
+                    history_of(None, Some((i as u32, wall))).unwrap_or((Default::default(), step))
+                }
+            };
+            rows.wall_histories.push(h);
+            rows.wall_since.push(since);
+        }
+    }
+
+    /// Body `a`'s row in these lists: the index of its first pair and the second bodies.
+    #[inline]
+    fn old_row(&self, a: usize) -> (usize, &[u32]) {
+        match self.row_start.get(a..a + 2) {
+            Some(&[s, e]) => (s as usize, &self.b[s as usize..e as usize]),
+            _ => (0, &[][..]),
+        }
+    }
+
+    /// The index of the body–wall pair `(body, wall)` in these lists, if listed.
+    #[inline]
+    fn old_wall(&self, body: usize, wall: u32) -> Option<usize> {
+        let (s, e) = match self.wall_start.get(body..body + 2) {
+            Some(&[s, e]) => (s as usize, e as usize),
+            _ => return None,
+        };
+        self.wall_of[s..e]
+            .iter()
+            .position(|&w| w == wall)
+            .map(|k| s + k)
+    }
+
+    /// The pairs and walls of the chunks, in body order, into the spare vectors of the build before the
+    /// last.
+    fn join_chunks(&mut self, chunks: &[ChunkRows], spare: &mut Spare) {
         self.a = recycled(&mut spare.a.0);
         self.b = recycled(&mut spare.b.0);
         self.row_start = recycled(&mut spare.row_start.0);
@@ -566,7 +575,7 @@ impl NeighbourList {
         self.row_start.push(0);
         self.wall_start.push(0);
         let mut i = 0u32;
-        for rows in &chunks {
+        for rows in chunks {
             for (&len, &wall_len) in rows.lengths.iter().zip(&rows.wall_lengths) {
                 self.a.extend(std::iter::repeat_n(i, len as usize));
                 self.row_start.push(self.a.len() as u32);
@@ -586,9 +595,10 @@ impl NeighbourList {
             self.wall_histories.extend_from_slice(&rows.wall_histories);
             self.wall_since.extend_from_slice(&rows.wall_since);
         }
-        self.chunks = SpareVec(chunks);
-        self.grid = grid;
-        // Side-B rows: pairs in key order appended to their second body's row (so increasing a).
+    }
+
+    /// Side-B rows: pairs in key order appended to their second body's row (so increasing a).
+    fn index_side_b(&mut self, n: usize, spare: &mut Spare) {
         self.as_b_start = recycled(&mut spare.as_b_start.0);
         self.as_b_start.resize(n + 1, 0);
         for &b in &self.b {
@@ -604,16 +614,99 @@ impl NeighbourList {
             self.as_b[fill[b as usize] as usize] = p as u32;
             fill[b as usize] += 1;
         }
-        self.wall_in_contact = recycled(&mut spare.wall_in_contact.0);
-        self.wall_in_contact
-            .extend(self.wall_histories.iter().map(|h| !h.is_cleared()));
-        self.centres_at_build = recycled(&mut spare.centres_at_build.0);
-        self.centres_at_build.extend_from_slice(centres);
-        self.large_flags = (0..n).map(|i| is_large(props[i].radius)).collect();
-        self.layout = Some(layout);
-        self.walls_at_build = walls.iter().map(|w| w.pose.translation.vector).collect();
-        // The old lists' vectors are the next build's.
-        self.spare = Spare {
+    }
+}
+
+/// What decides at a build which pairs are listed: the centres and radii, the grid of the bodies that
+/// are not large, and the skins.
+struct Search<'a> {
+    centres: &'a [Point],
+    props: &'a [Props],
+    walls: &'a [WallPlane],
+    layout: &'a Layout,
+    grid: &'a Grid,
+    skin: Real,
+}
+
+impl Search<'_> {
+    /// Whether body `i` is large (searched against every body, with the wider skin).
+    #[inline]
+    fn is_large(&self, i: usize) -> bool {
+        self.props[i].radius > LARGE_RADIUS_FACTOR * self.layout.median
+    }
+
+    /// The skin of body `i`'s pairs with walls and with bodies that are not large.
+    #[inline]
+    fn own_skin(&self, i: usize) -> Real {
+        if self.is_large(i) {
+            self.skin * LARGE_SKIN_FACTOR
+        } else {
+            self.skin
+        }
+    }
+
+    /// Whether bodies `i` and `j` are within reach: closer than the sum of their radii and the pair's skin.
+    #[inline]
+    fn reach(&self, i: usize, j: usize) -> bool {
+        let pair_skin = if self.is_large(i) || self.is_large(j) {
+            self.skin * LARGE_SKIN_FACTOR
+        } else {
+            self.skin
+        };
+        let r = self.props[i].radius + self.props[j].radius + pair_skin;
+        (self.centres[j] - self.centres[i]).norm_squared() < r * r
+    }
+
+    /// Body `i`'s partners j > i within reach, increasing, appended to `out`.
+    #[inline]
+    fn row(&self, i: usize, out: &mut Vec<u32>) {
+        let (centres, props, n) = (self.centres, self.props, self.centres.len());
+        let start = out.len();
+        if self.is_large(i) {
+            out.extend((i as u32 + 1..n as u32).filter(|&j| self.reach(i, j as usize)));
+            return;
+        }
+        let (x_i, r_i, skin) = (centres[i], props[i].radius, self.skin);
+        let grid = self.grid;
+        // The cells of a row are one run of bodies (the row is sorted below, so the order of the runs
+        // does not matter). Neither i nor a body of the grid is large: the plain skin.
+        grid.for_each_row(&grid.neighbourhood(grid.cell_of(&x_i)), |bodies| {
+            for &j in bodies {
+                let ju = j as usize;
+                if ju > i {
+                    let r = r_i + props[ju].radius + skin;
+                    if (centres[ju] - x_i).norm_squared() < r * r {
+                        out.push(j);
+                    }
+                }
+            }
+        });
+        out.extend(
+            self.layout
+                .large
+                .iter()
+                .copied()
+                .filter(|&j| j as usize > i && self.reach(i, j as usize)),
+        );
+        out[start..].sort_unstable();
+    }
+
+    /// The walls within body `i`'s skin of its sphere, increasing, appended to `out`.
+    #[inline]
+    fn wall_row(&self, i: usize, out: &mut Vec<u32>) {
+        let own_skin = self.own_skin(i);
+        for (w, plane) in self.walls.iter().enumerate() {
+            if plane.height(&self.centres[i]) - self.props[i].radius < own_skin {
+                out.push(w as u32);
+            }
+        }
+    }
+}
+
+impl Spare {
+    /// The vectors of `old` lists, kept for the next build.
+    fn of(old: NeighbourList) -> Self {
+        Self {
             a: SpareVec(old.a),
             b: SpareVec(old.b),
             row_start: SpareVec(old.row_start),
@@ -632,7 +725,7 @@ impl NeighbourList {
             wall_in_contact: SpareVec(old.wall_in_contact),
             centres_at_build: SpareVec(old.centres_at_build),
             carried_from: SpareVec(old.carried_from),
-        };
+        }
     }
 }
 
