@@ -89,7 +89,7 @@ use super::broad_phase::BroadPhase;
 use super::contact_store::{ContactKey, ContactState, ContactStore};
 use super::energy::{ContactWork, EnergyLedger};
 use super::skips;
-use super::step::{effective_model, StepError, StepParams};
+use super::step::{effective_models, StepError, StepParams};
 use super::world::{Wall, World};
 
 pub use blocks::TeamSplit;
@@ -201,90 +201,11 @@ impl SphereSim {
     /// are not current (no step taken yet), the initial loads are evaluated here, as the general step's
     /// stage 0 does (with its ledger's initial total).
     pub fn from_world(world: &World, params: &StepParams) -> Result<Self, StepFlatError> {
-        let need = |ok: bool, what: &'static str| {
-            if ok {
-                Ok(())
-            } else {
-                Err(NotSphereOnly::Params { what })
-            }
-        };
-        let form = match params.rotation {
-            RotationScheme::Splitting { sub_rotation } => sub_rotation,
-            _ => {
-                return Err(NotSphereOnly::Params {
-                    what: "the splitting rotation scheme",
-                }
-                .into())
-            }
-        };
-        need(
-            params.skips.isotropic_rotation && params.skips.still_rotation,
-            "the isotropic_rotation and still_rotation skips",
-        )?;
-        need(
-            params.damping == ViscousDamping::None,
-            "no global viscous damping",
-        )?;
-        need(
-            !params.sleeping.enabled && world.sleep.sleeping == 0,
-            "sleeping off",
-        )?;
+        let form = flat_sub_rotation(world, params)?;
+        let (kin, spin, props) = flat_bodies(world)?;
         let n = world.bodies.len();
-        let mut kin = Vec::with_capacity(n);
-        let mut spin = Vec::with_capacity(n);
-        let mut props = Vec::with_capacity(n);
-        for (i, body) in world.bodies.iter().enumerate() {
-            let name = || world.names[i].clone();
-            let Shape::Sphere(sphere) = world.shape(i) else {
-                return Err(NotSphereOnly::NotASphere {
-                    body: i,
-                    name: name(),
-                }
-                .into());
-            };
-            if !matches!(body.motion, Motion::Dynamic) {
-                return Err(NotSphereOnly::NotDynamic {
-                    body: i,
-                    name: name(),
-                }
-                .into());
-            }
-            if !is_isotropic(&body.inertia.0) {
-                return Err(NotSphereOnly::Anisotropic {
-                    body: i,
-                    name: name(),
-                }
-                .into());
-            }
-            let moment = body.inertia.0.x;
-            kin.push(Kinematic {
-                position: body.position,
-                velocity: body.velocity,
-                omega: body.angular_momentum / moment,
-            });
-            spin.push(Spin {
-                angular_momentum: body.angular_momentum,
-                orientation: body.orientation,
-            });
-            props.push(Props {
-                radius: sphere.radius(),
-                mass: body.mass,
-                moment,
-                material: world.material_of[i],
-            });
-        }
-        let n_materials = world.materials.len();
-        let mut models = Vec::with_capacity(n_materials * n_materials);
-        for a in 0..n_materials as u32 {
-            for b in 0..n_materials as u32 {
-                models.push(
-                    world
-                        .materials
-                        .model(a, b)
-                        .map(|m| effective_model(m, &params.skips)),
-                );
-            }
-        }
+        let mut models = Vec::new();
+        effective_models(&world.materials, &params.skips, &mut models);
         let planes: Vec<WallPlane> = world.walls.iter().map(WallPlane::of).collect();
         let mut sim = Self {
             params: *params,
@@ -300,7 +221,7 @@ impl SphereSim {
             planes,
             wall_forces: vec![Vector::zeros(); world.walls.len()],
             models,
-            n_materials,
+            n_materials: world.materials.len(),
             list: NeighbourList::new(world.broad_phase.skin()),
             reach: Vec::new(),
             pair_constants: Vec::new(),
@@ -324,7 +245,17 @@ impl SphereSim {
             step_index: world.step_index,
             guard: Guard::of(world, params.dt),
         };
-        // The first build imports the springs of the world's contact store.
+        sim.first_build(world);
+        sim.initial_loads(world)?;
+        // The pair loop's blocks for the pool this is made on (so that its first step can already run
+        // as one job of the team: `fused`).
+        sim.ready_blocks();
+        Ok(sim)
+    }
+
+    /// The first build of the lists, importing the springs (and, with the ledger, the last forces) of
+    /// the world's contact store; then the pairs' constants.
+    fn first_build(&mut self, world: &World) {
         let store = &world.contacts;
         let import = |body: Option<(u32, u32)>, wall: Option<(u32, u32)>| {
             let key = match (body, wall) {
@@ -334,45 +265,45 @@ impl SphereSim {
             };
             store.get(&key).map(|s| (s.history, s.since_step))
         };
-        let centres: Vec<Point> = sim.kin.iter().map(|k| k.position).collect();
-        let parallel = sim.parallel_bodies();
-        sim.list.rebuild(
+        let centres: Vec<Point> = self.kin.iter().map(|k| k.position).collect();
+        let parallel = self.parallel_bodies();
+        self.list.rebuild(
             &centres,
-            &sim.props,
-            &sim.planes,
+            &self.props,
+            &self.planes,
             parallel,
             world.step_index,
             &import,
         );
-        if params.energy_ledger {
-            // The last forces of the store's pairs, as their springs.
-            sim.pair_ledger.carry(&mut sim.list, None, Some(store));
+        if self.params.energy_ledger {
+            self.pair_ledger.carry(&mut self.list, None, Some(store));
         }
-        sim.prepare_pairs(parallel);
-        if world.loads.current && world.loads.forces.len() == n {
-            sim.force.clone_from(&world.loads.forces);
-            sim.torque.clone_from(&world.loads.torques);
+        self.prepare_pairs(parallel);
+    }
+
+    /// The world's loads when they are current; else stage 0's: the loads of the initial state with no
+    /// tangential increment, and the ledger's initial total, as the general step forms them.
+    fn initial_loads(&mut self, world: &World) -> Result<(), StepFlatError> {
+        if world.loads.current && world.loads.forces.len() == self.kin.len() {
+            self.force.clone_from(&world.loads.forces);
+            self.torque.clone_from(&world.loads.torques);
             if world.loads.wall_forces.len() == world.walls.len() {
-                sim.wall_forces.clone_from(&world.loads.wall_forces);
+                self.wall_forces.clone_from(&world.loads.wall_forces);
             }
-        } else {
-            // Stage 0: the loads of the initial state, no tangential increment.
-            let found = sim.evaluate(0.0)?;
-            sim.gather_only(found.scattered);
-            // The general step books no term of the initial evaluation either.
-            sim.pair_ledger.take_sums();
-            if sim.ledger.initial_total.is_none() {
-                let mut at_start = world.clone();
-                at_start.loads.forces.clone_from(&sim.force);
-                at_start.loads.torques.clone_from(&sim.torque);
-                at_start.loads.elastic_potential = sim.elastic_potential();
-                sim.ledger.initial_total = Some(at_start.energy().mechanical());
-            }
+            return Ok(());
         }
-        // The pair loop's blocks for the pool this is made on (so that its first step can already run
-        // as one job of the team: `fused`).
-        sim.ready_blocks();
-        Ok(sim)
+        let found = self.evaluate(0.0)?;
+        self.gather_only(found.scattered);
+        // The general step books no term of the initial evaluation either.
+        self.pair_ledger.take_sums();
+        if self.ledger.initial_total.is_none() {
+            let mut at_start = world.clone();
+            at_start.loads.forces.clone_from(&self.force);
+            at_start.loads.torques.clone_from(&self.torque);
+            at_start.loads.elastic_potential = self.elastic_potential();
+            self.ledger.initial_total = Some(at_start.energy().mechanical());
+        }
+        Ok(())
     }
 
     /// Forms the constants of every listed pair (after a build of the lists).
@@ -747,3 +678,86 @@ pub const MIN_PARALLEL_BODIES: usize = 1024;
 
 /// From this many listed pairs on, the pair loop runs on the pool when it has several threads.
 pub const MIN_PARALLEL_PAIRS: usize = 2048;
+
+/// The sub-rotation of the splitting scheme, if `params` and `world` allow the flat layout (the skips of
+/// isotropic and still rotation, no global damping, no sleeping).
+fn flat_sub_rotation(world: &World, params: &StepParams) -> Result<SubRotation, StepFlatError> {
+    let need = |ok: bool, what: &'static str| {
+        if ok {
+            Ok(())
+        } else {
+            Err(NotSphereOnly::Params { what })
+        }
+    };
+    let RotationScheme::Splitting { sub_rotation } = params.rotation else {
+        return Err(NotSphereOnly::Params {
+            what: "the splitting rotation scheme",
+        }
+        .into());
+    };
+    need(
+        params.skips.isotropic_rotation && params.skips.still_rotation,
+        "the isotropic_rotation and still_rotation skips",
+    )?;
+    need(
+        params.damping == ViscousDamping::None,
+        "no global viscous damping",
+    )?;
+    need(
+        !params.sleeping.enabled && world.sleep.sleeping == 0,
+        "sleeping off",
+    )?;
+    Ok(sub_rotation)
+}
+
+/// The flat layout's kinematics, spins and constants of every body, if every body is a free sphere with
+/// an isotropic inertia.
+fn flat_bodies(world: &World) -> Result<(Vec<Kinematic>, Vec<Spin>, Vec<Props>), StepFlatError> {
+    let n = world.bodies.len();
+    let (mut kin, mut spin, mut props) = (
+        Vec::with_capacity(n),
+        Vec::with_capacity(n),
+        Vec::with_capacity(n),
+    );
+    for (i, body) in world.bodies.iter().enumerate() {
+        let name = || world.names[i].clone();
+        let Shape::Sphere(sphere) = world.shape(i) else {
+            return Err(NotSphereOnly::NotASphere {
+                body: i,
+                name: name(),
+            }
+            .into());
+        };
+        if !matches!(body.motion, Motion::Dynamic) {
+            return Err(NotSphereOnly::NotDynamic {
+                body: i,
+                name: name(),
+            }
+            .into());
+        }
+        if !is_isotropic(&body.inertia.0) {
+            return Err(NotSphereOnly::Anisotropic {
+                body: i,
+                name: name(),
+            }
+            .into());
+        }
+        let moment = body.inertia.0.x;
+        kin.push(Kinematic {
+            position: body.position,
+            velocity: body.velocity,
+            omega: body.angular_momentum / moment,
+        });
+        spin.push(Spin {
+            angular_momentum: body.angular_momentum,
+            orientation: body.orientation,
+        });
+        props.push(Props {
+            radius: sphere.radius(),
+            mass: body.mass,
+            moment,
+            material: world.material_of[i],
+        });
+    }
+    Ok((kin, spin, props))
+}

@@ -299,13 +299,13 @@ pub(super) fn overlap_law(
 
 /// The model with the slots the skips make free: no tangential spring when μ = 0, no damping term when its
 /// coefficient is 0 (see [`super::skips`]).
-pub(crate) fn effective_model(model: &ContactModel, skips: &Skips) -> ContactModel {
+fn effective_model(model: &ContactModel, skips: &Skips) -> ContactModel {
     model.with_skips(skips.frictionless_history, skips.undamped_contacts)
 }
 
 /// The contact model of every material pair (row-major `n²`, `None` where no law is set) with the skips
 /// applied ([`effective_model`]), into `models`.
-pub(super) fn effective_models(
+pub(crate) fn effective_models(
     materials: &MaterialTable,
     skips: &Skips,
     models: &mut Vec<Option<ContactModel>>,

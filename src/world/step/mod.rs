@@ -66,7 +66,7 @@ pub use report::{OverlapWarning, StepError, StepReport};
 pub use scratch::StepScratch;
 
 pub(crate) use checks::first_non_finite;
-pub(crate) use laws::effective_model;
+pub(crate) use laws::effective_models;
 
 use super::sleeping;
 use super::world::World;
