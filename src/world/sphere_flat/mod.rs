@@ -202,7 +202,7 @@ impl SphereSim {
     /// stage 0 does (with its ledger's initial total).
     pub fn from_world(world: &World, params: &StepParams) -> Result<Self, StepFlatError> {
         let form = flat_sub_rotation(world, params)?;
-        let (kin, spin, props) = flat_bodies(world)?;
+        let FlatBodies { kin, spin, props } = flat_bodies(world)?;
         let n = world.bodies.len();
         let mut models = Vec::new();
         effective_models(&world.materials, &params.skips, &mut models);
@@ -712,7 +712,7 @@ fn flat_sub_rotation(world: &World, params: &StepParams) -> Result<SubRotation, 
 
 /// The flat layout's kinematics, spins and constants of every body, if every body is a free sphere with
 /// an isotropic inertia.
-fn flat_bodies(world: &World) -> Result<(Vec<Kinematic>, Vec<Spin>, Vec<Props>), StepFlatError> {
+fn flat_bodies(world: &World) -> Result<FlatBodies, StepFlatError> {
     let n = world.bodies.len();
     let (mut kin, mut spin, mut props) = (
         Vec::with_capacity(n),
@@ -759,5 +759,12 @@ fn flat_bodies(world: &World) -> Result<(Vec<Kinematic>, Vec<Spin>, Vec<Props>),
             material: world.material_of[i],
         });
     }
-    Ok((kin, spin, props))
+    Ok(FlatBodies { kin, spin, props })
+}
+
+/// Every body in the flat layout: its kinematics, its spin and its constants.
+struct FlatBodies {
+    kin: Vec<Kinematic>,
+    spin: Vec<Spin>,
+    props: Vec<Props>,
 }
