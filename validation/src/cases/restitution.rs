@@ -226,121 +226,204 @@ impl Case for Restitution {
         profile: Profile,
         ctx: &mut CaseContext,
     ) -> Result<(), SuiteError> {
-        let p: Params = data.params(self.name(), profile)?;
-        let tol = data.tolerance(self.name(), "restitution_rel")?.value;
-        let bound = data.tolerance(self.name(), "first_order_bound")?.value;
-        let reference = data.reference(self.name(), "restitution")?.value;
-        let fail = |msg: String| SuiteError::case("restitution", msg);
+        let inputs = Inputs {
+            p: data.params(self.name(), profile)?,
+            tol: data.tolerance(self.name(), "restitution_rel")?.value,
+            bound: data.tolerance(self.name(), "first_order_bound")?.value,
+            reference: data.reference(self.name(), "restitution")?.value,
+        };
+        let p = &inputs.p;
         ctx.progress().stage(
             "impacts",
             (PAIRS.len() * 2 * (p.restitutions.len() + p.steps_per_contact.len() * 2)) as u64,
         );
-        let mut rows = Vec::new();
-        let mut measured_series = Vec::new();
-        let mut sweep_series = Vec::new();
-        let mut sweep_rows = Vec::new();
-        // Largest error·(t_c/Δt) of the Hertz-type law at e = 0.1 (outside the documented bound's range).
-        let mut hertz_low_e: Real = 0.0;
+        let mut found = Found::default();
         for (law_name, law_tag, law) in laws() {
             for pair in PAIRS {
-                let mut points = Vec::new();
-                let mut worst: Real = 0.0;
-                for &e in &p.restitutions {
-                    let measured = measure(pair, law, e, p.check_at).map_err(fail)?;
-                    let error = (measured / e - reference).abs();
-                    worst = worst.max(error);
-                    rows.push(vec![
-                        format!("{pair:?}"),
-                        law_name.to_string(),
-                        format!("{e}"),
-                        format!("{measured:.6}"),
-                        CaseContext::fmt(error),
-                    ]);
-                    points.push((e, measured));
-                    ctx.progress().inc(1);
-                }
-                ctx.check(
-                    &format!("restitution_rel_error_max_{}_{law_tag}", pair.tag()),
-                    worst,
-                    Target::at_most(tol),
-                    "1",
-                );
-                measured_series.push(Series {
-                    label: format!("{pair:?}, {law_name}"),
-                    style: SeriesStyle::Points,
-                    points,
-                });
-                // dt sweep: the measured error over its first-order bound.
-                let mut ratio: Real = 0.0;
-                for e in [0.1, 0.3, 0.7] {
-                    let mut points = Vec::new();
-                    for &n in &p.steps_per_contact {
-                        let measured = measure(pair, law, e, n).map_err(fail)?;
-                        let error = (measured / e - 1.0).abs();
-                        let over = error / first_order_bound(law, e, 1.0 / n, bound);
-                        // The documented Hertz-type bound covers e ≥ 0.3 only: e = 0.1 is shown, not checked.
-                        if law.exponent == 1.0 || e >= 0.3 {
-                            ratio = ratio.max(over);
-                        } else {
-                            hertz_low_e = hertz_low_e.max(error * n);
-                        }
-                        sweep_rows.push(vec![
-                            format!("{pair:?}"),
-                            law_name.to_string(),
-                            format!("{e}"),
-                            format!("{n}"),
-                            format!("{measured:.6}"),
-                            CaseContext::fmt(error),
-                        ]);
-                        points.push((1.0 / n, error));
-                        ctx.progress().inc(1);
-                    }
-                    sweep_series.push(Series {
-                        label: format!("{pair:?}, {law_name}, e = {e}"),
-                        style: SeriesStyle::LinePoints,
-                        points,
-                    });
-                }
-                ctx.check(
-                    &format!("error_over_bound_max_{}_{law_tag}", pair.tag()),
-                    ratio,
-                    Target::at_most(1.0),
-                    "1",
-                );
+                let run = Run {
+                    pair,
+                    law_name,
+                    law_tag,
+                    law,
+                };
+                measure_against_input(ctx, &inputs, &run, &mut found)?;
+                sweep_time_step(ctx, &inputs, &run, &mut found)?;
             }
         }
-        ctx.section("Measured against input restitution");
-        ctx.text(&format!(
+        report(ctx, &inputs, found)
+    }
+}
+
+/// The case's parameters and gates.
+struct Inputs {
+    p: Params,
+    /// Gate on |e_measured/e_input − reference|.
+    tol: Real,
+    /// The Hertz-type law's first-order constant (error ≤ bound · Δt/t_c).
+    bound: Real,
+    reference: Real,
+}
+
+/// One pair under one law.
+struct Run {
+    pair: Pair,
+    law_name: &'static str,
+    law_tag: &'static str,
+    law: NormalLaw,
+}
+
+/// The tables and series of the report.
+#[derive(Default)]
+struct Found {
+    rows: Vec<Vec<String>>,
+    measured_series: Vec<Series>,
+    sweep_rows: Vec<Vec<String>>,
+    sweep_series: Vec<Series>,
+    /// Largest error·(t_c/Δt) of the Hertz-type law at e = 0.1 (outside the documented bound's range).
+    hertz_low_e: Real,
+}
+
+fn fail(msg: String) -> SuiteError {
+    SuiteError::case("restitution", msg)
+}
+
+/// The measured restitution at every input e, at the checked time step; the largest error gated.
+fn measure_against_input(
+    ctx: &mut CaseContext,
+    inputs: &Inputs,
+    run: &Run,
+    found: &mut Found,
+) -> Result<(), SuiteError> {
+    let Run {
+        pair,
+        law_name,
+        law_tag,
+        law,
+    } = *run;
+    let mut points = Vec::new();
+    let mut worst: Real = 0.0;
+    for &e in &inputs.p.restitutions {
+        let measured = measure(pair, law, e, inputs.p.check_at).map_err(fail)?;
+        let error = (measured / e - inputs.reference).abs();
+        worst = worst.max(error);
+        found.rows.push(vec![
+            format!("{pair:?}"),
+            law_name.to_string(),
+            format!("{e}"),
+            format!("{measured:.6}"),
+            CaseContext::fmt(error),
+        ]);
+        points.push((e, measured));
+        ctx.progress().inc(1);
+    }
+    ctx.check(
+        &format!("restitution_rel_error_max_{}_{law_tag}", pair.tag()),
+        worst,
+        Target::at_most(inputs.tol),
+        "1",
+    );
+    found.measured_series.push(Series {
+        label: format!("{pair:?}, {law_name}"),
+        style: SeriesStyle::Points,
+        points,
+    });
+    Ok(())
+}
+
+/// The time-step sweep: the measured error over its first-order bound, gated at 1.
+fn sweep_time_step(
+    ctx: &mut CaseContext,
+    inputs: &Inputs,
+    run: &Run,
+    found: &mut Found,
+) -> Result<(), SuiteError> {
+    let Run {
+        pair,
+        law_name,
+        law_tag,
+        law,
+    } = *run;
+    let mut ratio: Real = 0.0;
+    for e in [0.1, 0.3, 0.7] {
+        let mut points = Vec::new();
+        for &n in &inputs.p.steps_per_contact {
+            let measured = measure(pair, law, e, n).map_err(fail)?;
+            let error = (measured / e - 1.0).abs();
+            let over = error / first_order_bound(law, e, 1.0 / n, inputs.bound);
+            // The documented Hertz-type bound covers e ≥ 0.3 only: e = 0.1 is shown, not checked.
+            if law.exponent == 1.0 || e >= 0.3 {
+                ratio = ratio.max(over);
+            } else {
+                found.hertz_low_e = found.hertz_low_e.max(error * n);
+            }
+            found.sweep_rows.push(vec![
+                format!("{pair:?}"),
+                law_name.to_string(),
+                format!("{e}"),
+                format!("{n}"),
+                format!("{measured:.6}"),
+                CaseContext::fmt(error),
+            ]);
+            points.push((1.0 / n, error));
+            ctx.progress().inc(1);
+        }
+        found.sweep_series.push(Series {
+            label: format!("{pair:?}, {law_name}, e = {e}"),
+            style: SeriesStyle::LinePoints,
+            points,
+        });
+    }
+    ctx.check(
+        &format!("error_over_bound_max_{}_{law_tag}", pair.tag()),
+        ratio,
+        Target::at_most(1.0),
+        "1",
+    );
+    Ok(())
+}
+
+/// The two tables and plots.
+fn report(ctx: &mut CaseContext, inputs: &Inputs, found: Found) -> Result<(), SuiteError> {
+    let (p, bound) = (&inputs.p, inputs.bound);
+    let Found {
+        rows,
+        mut measured_series,
+        sweep_rows,
+        mut sweep_series,
+        hertz_low_e,
+    } = found;
+    ctx.section("Measured against input restitution");
+    ctx.text(&format!(
             "Impact speed {SPEED} m/s, density {DENSITY} kg/m³, spheres of radius {RADIUS} m, cube of side {SIDE} m \
              face-on (contact core: plane–polyhedron path); dt = t_c/{} with t_c the elastic contact time.",
             p.check_at
         ));
-        ctx.table(
-            Some("restitution"),
-            &["pair", "law", "e input", "e measured", "|e_meas/e_in − 1|"],
-            &rows,
-        )?;
-        let diagonal: Vec<(Real, Real)> = p.restitutions.iter().map(|&e| (e, e)).collect();
-        measured_series.push(Series {
-            label: "input (e_measured = e_input)".into(),
-            style: SeriesStyle::Line,
-            points: diagonal,
-        });
-        ctx.plot(&Plot {
-            name: "measured_vs_input".into(),
-            title: "Measured against input coefficient of restitution".into(),
-            x_label: "input e (1)".into(),
-            y_label: "measured e (1)".into(),
-            x_log: false,
-            y_log: false,
-            series: measured_series,
-            caption: format!(
-                "All pairs and laws at dt = t_c/{}; the line is e_measured = e_input.",
-                p.check_at
-            ),
-        })?;
-        ctx.section("Error against the time step");
-        ctx.text(
+    ctx.table(
+        Some("restitution"),
+        &["pair", "law", "e input", "e measured", "|e_meas/e_in − 1|"],
+        &rows,
+    )?;
+    let diagonal: Vec<(Real, Real)> = p.restitutions.iter().map(|&e| (e, e)).collect();
+    measured_series.push(Series {
+        label: "input (e_measured = e_input)".into(),
+        style: SeriesStyle::Line,
+        points: diagonal,
+    });
+    ctx.plot(&Plot {
+        name: "measured_vs_input".into(),
+        title: "Measured against input coefficient of restitution".into(),
+        x_label: "input e (1)".into(),
+        y_label: "measured e (1)".into(),
+        x_log: false,
+        y_log: false,
+        series: measured_series,
+        caption: format!(
+            "All pairs and laws at dt = t_c/{}; the line is e_measured = e_input.",
+            p.check_at
+        ),
+    })?;
+    ctx.section("Error against the time step");
+    ctx.text(
             "The damping force is evaluated at the step ends, and the contact ends between two steps, so the \
              restitution error is first order in Δt, with a constant that depends on where the end falls \
              (erratic from one Δt to the next). Linear law: the damping force jumps at both ends of the contact \
@@ -348,34 +431,34 @@ impl Case for Restitution {
              (ζ̂ = c/√(m* k)); checked as max(error/bound) ≤ 1. Hertz-type law: no jump (the damping vanishes with \
              δ^(1/4)); the documented bound 2Δt/t_c (line) is checked for e = 0.3 and 0.7.",
         );
-        ctx.table(
-            Some("dt_sweep"),
-            &[
-                "pair",
-                "law",
-                "e input",
-                "t_c/Δt",
-                "e measured",
-                "|e_meas/e_in − 1|",
-            ],
-            &sweep_rows,
-        )?;
-        ctx.text(&format!(
+    ctx.table(
+        Some("dt_sweep"),
+        &[
+            "pair",
+            "law",
+            "e input",
+            "t_c/Δt",
+            "e measured",
+            "|e_meas/e_in − 1|",
+        ],
+        &sweep_rows,
+    )?;
+    ctx.text(&format!(
             "Not checked: the Hertz-type law at e = 0.1 reaches error = {:.2} Δt/t_c, above the documented \
              2Δt/t_c (which was established for e = 0.3 and 0.7): the bound does not hold for strongly damped \
              Hertz-type impacts.",
             hertz_low_e
         ));
-        sweep_series.push(Series {
-            label: "Hertz-type bound 2Δt/t_c".into(),
-            style: SeriesStyle::Line,
-            points: p
-                .steps_per_contact
-                .iter()
-                .map(|n| (1.0 / n, bound / n))
-                .collect(),
-        });
-        ctx.plot(&Plot {
+    sweep_series.push(Series {
+        label: "Hertz-type bound 2Δt/t_c".into(),
+        style: SeriesStyle::Line,
+        points: p
+            .steps_per_contact
+            .iter()
+            .map(|n| (1.0 / n, bound / n))
+            .collect(),
+    });
+    ctx.plot(&Plot {
             name: "error_vs_dt".into(),
             title: "Restitution error against the time step".into(),
             x_label: "Δt / t_c".into(),
@@ -385,6 +468,5 @@ impl Case for Restitution {
             series: sweep_series,
             caption: "Each pair and law at e = 0.1, 0.3 and 0.7. Errors of exactly 0 cannot be shown on the log axis.".into(),
         })?;
-        Ok(())
-    }
+    Ok(())
 }
