@@ -13,7 +13,9 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use serde::Deserialize;
 
-use super::stress_util::{box_points, drift_fit, ellipsoid_points, random_unit, SceneText};
+use super::stress_util::{
+    box_points, drift_fit, ellipsoid_points, random_unit, DriftFit, SceneText,
+};
 use crate::case::{Case, CaseData, Profile, Target};
 use crate::context::CaseContext;
 use crate::error::SuiteError;
@@ -247,91 +249,28 @@ impl Case for StressLongRun {
         ctx: &mut CaseContext,
     ) -> Result<(), SuiteError> {
         let p: Params = data.params(CASE, profile)?;
-        let tol_drift = data.tolerance(CASE, "drift_to_scatter")?.value;
-        let min_contacts = data.tolerance(CASE, "body_contacts_min")?.value;
+        let gates = Gates {
+            drift: data.tolerance(CASE, "drift_to_scatter")?.value,
+            min_contacts: data.tolerance(CASE, "body_contacts_min")?.value,
+        };
         let mut rows = Vec::new();
         let mut series = Vec::new();
         let mut jump_rows = Vec::new();
         for container in [Container::Slabs, Container::Walls] {
             let c = container.name();
-            let tol_max = data
+            let max_error = data
                 .tolerance(CASE, &format!("energy_error_max_{c}"))?
                 .value;
             let r = long_run(&p, container, ctx)?;
             let fit = drift_fit(&r.history);
-            let ratio = fit.fitted_change.abs() / fit.residual_std;
-            ctx.check(
-                &format!("{c}_step_errors"),
-                if r.step_error.is_some() { 1.0 } else { 0.0 },
-                Target::equal(0.0),
-                "1",
-            );
-            ctx.check(
-                &format!("{c}_energy_error_max"),
-                r.worst,
-                Target::at_most(tol_max),
-                "1",
-            );
-            ctx.check(
-                &format!("{c}_drift_fitted_change_over_scatter"),
-                ratio,
-                Target::at_most(tol_drift),
-                "1",
-            );
-            ctx.check(
-                &format!("{c}_bodies_outside_box"),
-                r.outside as f64,
-                Target::equal(0.0),
-                "1",
-            );
-            ctx.check(
-                &format!("{c}_contact_pairs_created"),
-                r.counters.contacts_created as f64,
-                Target::at_least(min_contacts),
-                "1",
-            );
-            if let Some(e) = &r.step_error {
-                ctx.text(&format!("**The {c} run stopped with a step error:** {e}"));
-            }
+            check_run(ctx, c, &r, &fit, &gates, max_error);
+            jump_rows.extend(largest_jumps(c, &r.history));
+            rows.push(run_row(c, &r, &fit));
             let t_end = r.history.last().map_or(0.0, |h| h.0);
-            let mut jumps: Vec<(Real, Real, Real)> = r
-                .history
-                .windows(2)
-                .map(|w| (w[1].1 - w[0].1, w[0].0, w[1].0))
-                .collect();
-            jumps.sort_by(|a, b| b.0.abs().total_cmp(&a.0.abs()));
-            for (jump, t0, t1) in jumps.iter().take(3) {
-                jump_rows.push(vec![
-                    c.to_string(),
-                    format!("{t0:.5} – {t1:.5}"),
-                    format!("{jump:+.3e}"),
-                ]);
-            }
-            rows.push(vec![
-                c.to_string(),
-                r.bodies.to_string(),
-                r.counters.steps.to_string(),
-                format!("{:.3e} = t_c/{}", r.dt, r.contact_time / r.dt),
-                format!("{t_end:.3}"),
-                format!("{:.4e}", r.e0),
-                format!("{:.3e}", r.worst),
-                format!("{:.3e}", r.history.last().map_or(0.0, |h| h.1)),
-                format!("{:.3e}", fit.slope),
-                format!("{:.3e}", fit.fitted_change),
-                format!("{:.3e}", fit.residual_std),
-                format!("{:.3e}", r.max_overlap),
-                r.counters.contacts_created.to_string(),
-                r.counters.contacts.to_string(),
-                format!(
-                    "{}/{}",
-                    r.counters.query.fallback_max_iterations, r.counters.query.fallback_degenerate
-                ),
-                format!("{:.1}", r.counters.total_time().as_secs_f64()),
-            ]);
             series.push(Series {
                 label: format!("{c}: balance/E0"),
                 style: SeriesStyle::Line,
-                points: r.history.clone(),
+                points: r.history,
             });
             series.push(Series {
                 label: format!("{c}: least-squares line"),
@@ -342,31 +281,142 @@ impl Case for StressLongRun {
                 ],
             });
         }
-        ctx.section("Runs");
-        ctx.table(
-            Some("runs"),
-            &[
-                "container",
-                "bodies",
-                "steps",
-                "Δt (s)",
-                "simulated (s)",
-                "E0 (J)",
-                "max abs(balance)/E0",
-                "final balance/E0",
-                "fitted slope (1/s)",
-                "fitted change",
-                "scatter (std)",
-                "max overlap/size",
-                "store entries created",
-                "contact evaluations",
-                "SAT fallbacks (max it./degenerate)",
-                "wall time (s)",
-            ],
-            &rows,
-        )?;
-        ctx.section("Largest changes of the energy error between two samples");
-        ctx.text(
+        report(ctx, &p, rows, jump_rows, series)
+    }
+}
+
+/// The gates common to both containers.
+struct Gates {
+    /// The drift's fitted change over the scatter.
+    drift: Real,
+    /// Store entries a run must create.
+    min_contacts: Real,
+}
+
+/// The gates of one container's run; a step error is also shown in the report.
+fn check_run(
+    ctx: &mut CaseContext,
+    c: &str,
+    r: &RunResult,
+    fit: &DriftFit,
+    gates: &Gates,
+    max_error: Real,
+) {
+    let ratio = fit.fitted_change.abs() / fit.residual_std;
+    ctx.check(
+        &format!("{c}_step_errors"),
+        if r.step_error.is_some() { 1.0 } else { 0.0 },
+        Target::equal(0.0),
+        "1",
+    );
+    ctx.check(
+        &format!("{c}_energy_error_max"),
+        r.worst,
+        Target::at_most(max_error),
+        "1",
+    );
+    ctx.check(
+        &format!("{c}_drift_fitted_change_over_scatter"),
+        ratio,
+        Target::at_most(gates.drift),
+        "1",
+    );
+    ctx.check(
+        &format!("{c}_bodies_outside_box"),
+        r.outside as f64,
+        Target::equal(0.0),
+        "1",
+    );
+    ctx.check(
+        &format!("{c}_contact_pairs_created"),
+        r.counters.contacts_created as f64,
+        Target::at_least(gates.min_contacts),
+        "1",
+    );
+    if let Some(e) = &r.step_error {
+        ctx.text(&format!("**The {c} run stopped with a step error:** {e}"));
+    }
+}
+
+/// The three largest changes of the energy error between two samples, as rows.
+fn largest_jumps(c: &str, history: &[(Real, Real)]) -> Vec<Vec<String>> {
+    let mut jumps: Vec<(Real, Real, Real)> = history
+        .windows(2)
+        .map(|w| (w[1].1 - w[0].1, w[0].0, w[1].0))
+        .collect();
+    jumps.sort_by(|a, b| b.0.abs().total_cmp(&a.0.abs()));
+    jumps
+        .iter()
+        .take(3)
+        .map(|(jump, t0, t1)| {
+            vec![
+                c.to_string(),
+                format!("{t0:.5} – {t1:.5}"),
+                format!("{jump:+.3e}"),
+            ]
+        })
+        .collect()
+}
+
+/// One container's row of the runs table.
+fn run_row(c: &str, r: &RunResult, fit: &DriftFit) -> Vec<String> {
+    let t_end = r.history.last().map_or(0.0, |h| h.0);
+    vec![
+        c.to_string(),
+        r.bodies.to_string(),
+        r.counters.steps.to_string(),
+        format!("{:.3e} = t_c/{}", r.dt, r.contact_time / r.dt),
+        format!("{t_end:.3}"),
+        format!("{:.4e}", r.e0),
+        format!("{:.3e}", r.worst),
+        format!("{:.3e}", r.history.last().map_or(0.0, |h| h.1)),
+        format!("{:.3e}", fit.slope),
+        format!("{:.3e}", fit.fitted_change),
+        format!("{:.3e}", fit.residual_std),
+        format!("{:.3e}", r.max_overlap),
+        r.counters.contacts_created.to_string(),
+        r.counters.contacts.to_string(),
+        format!(
+            "{}/{}",
+            r.counters.query.fallback_max_iterations, r.counters.query.fallback_degenerate
+        ),
+        format!("{:.1}", r.counters.total_time().as_secs_f64()),
+    ]
+}
+
+/// The runs table, the largest jumps and the energy plot.
+fn report(
+    ctx: &mut CaseContext,
+    p: &Params,
+    rows: Vec<Vec<String>>,
+    jump_rows: Vec<Vec<String>>,
+    series: Vec<Series>,
+) -> Result<(), SuiteError> {
+    ctx.section("Runs");
+    ctx.table(
+        Some("runs"),
+        &[
+            "container",
+            "bodies",
+            "steps",
+            "Δt (s)",
+            "simulated (s)",
+            "E0 (J)",
+            "max abs(balance)/E0",
+            "final balance/E0",
+            "fitted slope (1/s)",
+            "fitted change",
+            "scatter (std)",
+            "max overlap/size",
+            "store entries created",
+            "contact evaluations",
+            "SAT fallbacks (max it./degenerate)",
+            "wall time (s)",
+        ],
+        &rows,
+    )?;
+    ctx.section("Largest changes of the energy error between two samples");
+    ctx.text(
             "A discretisation error shrinks with Δt; a change that does not is a jump of the potential. \
              A diagnosis (every step with |Δ balance| > 2e-5 E0 logged with the contacts that changed, \
              quick profile): no contact appears with a finite depth and every depth is continuous, so the \
@@ -382,12 +432,12 @@ impl Case for StressLongRun {
              its rule (h = V √(m/k), the peak overlap at the scene's speed); with the default band (1e-4 L, \
              100 times below these overlaps) its wall contacts jump in the same way (point moves of 5e-2 m).",
         );
-        ctx.table(
-            Some("jumps"),
-            &["container", "interval (s)", "change of balance/E0"],
-            &jump_rows,
-        )?;
-        ctx.plot(&Plot {
+    ctx.table(
+        Some("jumps"),
+        &["container", "interval (s)", "change of balance/E0"],
+        &jump_rows,
+    )?;
+    ctx.plot(&Plot {
             name: "energy_error".into(),
             title: "Energy error of the elastic box over the run".into(),
             x_label: "t (s)".into(),
@@ -401,6 +451,5 @@ impl Case for StressLongRun {
                 p.steps, p.steps_per_contact
             ),
         })?;
-        Ok(())
-    }
+    Ok(())
 }
