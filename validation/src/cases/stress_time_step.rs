@@ -182,67 +182,11 @@ impl Case for StressTimeStep {
         for (k, s) in p.settings.iter().enumerate() {
             let (base, e_scale) = build(s, p.seed)?;
             let theory = base.time_step.stability_limit;
-            let mass = base.world.bodies()[0].mass;
-            let k_n = s.stiffness;
             let is = |dt: Real| trial(&base, e_scale, dt, p.steps, p.error_limit);
-            let (mut lo, mut hi) = (0.05 * theory, 50.0 * theory);
-            let (lo_ok, _) = is(lo);
-            let (hi_ok, _) = is(hi);
-            let mut bisections = 0;
-            if lo_ok && !hi_ok {
-                while hi / lo > 1.0 + p.resolution {
-                    let mid = (lo * hi).sqrt();
-                    if is(mid).0 {
-                        lo = mid;
-                    } else {
-                        hi = mid;
-                    }
-                    bisections += 1;
-                }
-            }
-            let found = if lo_ok && !hi_ok { lo } else { Real::NAN };
-            ctx.check(
-                &format!("{}_stable_at_0.05_theory", s.name),
-                if lo_ok { 1.0 } else { 0.0 },
-                Target::equal(1.0),
-                "1",
-            );
-            ctx.check(
-                &format!("{}_unstable_at_50_theory", s.name),
-                if hi_ok { 0.0 } else { 1.0 },
-                Target::equal(1.0),
-                "1",
-            );
-            ctx.check(
-                &format!("{}_found_over_theory", s.name),
-                found / theory,
-                Target::at_least(min_ratio),
-                "1",
-            );
-            // Translation alone (κ = 1) at the peak overlap: the Verlet limit 2/ω of the normal mode.
-            let n = s.exponent;
-            let delta_peak = ((n + 1.0) * mass * GRAVITY / k_n).powf(1.0 / n);
-            let k_tangent = n * k_n * delta_peak.powf(n - 1.0);
-            let translation_limit = 2.0 * (mass / k_tangent).sqrt();
-            rows.push(vec![
-                s.name.clone(),
-                s.shape.clone(),
-                if n == 1.0 {
-                    "linear".into()
-                } else {
-                    format!("power n = {n}")
-                },
-                format!("{k_n:.1e}"),
-                format!("{mass:.4e}"),
-                format!("{:.4e}", base.time_step.contact_time),
-                format!("{theory:.4e}"),
-                format!("{translation_limit:.4e}"),
-                format!("{found:.4e}"),
-                format!("{:.3}", found / theory),
-                format!("{:.3}", found / translation_limit),
-                bisections.to_string(),
-            ]);
-            bar_found.push((k as Real, found / theory));
+            let limit = bisect_limit(&is, theory, p.resolution);
+            check_limit(ctx, s, &limit, theory, min_ratio);
+            rows.push(setting_row(s, &base, &limit));
+            bar_found.push((k as Real, limit.found / theory));
             // A scan of the growth ratio around the limit, for the plot.
             let points: Vec<(Real, Real)> = (0..p.scan_points)
                 .map(|i| {
@@ -257,33 +201,133 @@ impl Case for StressTimeStep {
             });
             ctx.progress().inc(1);
         }
-        ctx.section("Largest stable step against the theory");
-        ctx.text(&format!(
+        report(ctx, &p, rows, scan_series, bar_found)
+    }
+}
+
+/// The largest stable step of one setting, by bisection between 0.05 and 50 times the theory.
+struct Limit {
+    /// Whether the ends of the bracket are stable.
+    lo_ok: bool,
+    hi_ok: bool,
+    /// The largest stable step found (NaN when the bracket does not hold the limit).
+    found: Real,
+    bisections: u32,
+}
+
+/// Bisects `is` (stable at a step?) in a geometric bracket about `theory` to a relative `resolution`.
+fn bisect_limit(is: &impl Fn(Real) -> (bool, Real), theory: Real, resolution: Real) -> Limit {
+    let (mut lo, mut hi) = (0.05 * theory, 50.0 * theory);
+    let (lo_ok, _) = is(lo);
+    let (hi_ok, _) = is(hi);
+    let mut bisections = 0;
+    if lo_ok && !hi_ok {
+        while hi / lo > 1.0 + resolution {
+            let mid = (lo * hi).sqrt();
+            if is(mid).0 {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+            bisections += 1;
+        }
+    }
+    let found = if lo_ok && !hi_ok { lo } else { Real::NAN };
+    Limit {
+        lo_ok,
+        hi_ok,
+        found,
+        bisections,
+    }
+}
+
+/// The gates of one setting: the bracket holds the limit, and the found step is at least `min_ratio`
+/// times the theory.
+fn check_limit(ctx: &mut CaseContext, s: &Setting, limit: &Limit, theory: Real, min_ratio: Real) {
+    ctx.check(
+        &format!("{}_stable_at_0.05_theory", s.name),
+        if limit.lo_ok { 1.0 } else { 0.0 },
+        Target::equal(1.0),
+        "1",
+    );
+    ctx.check(
+        &format!("{}_unstable_at_50_theory", s.name),
+        if limit.hi_ok { 0.0 } else { 1.0 },
+        Target::equal(1.0),
+        "1",
+    );
+    ctx.check(
+        &format!("{}_found_over_theory", s.name),
+        limit.found / theory,
+        Target::at_least(min_ratio),
+        "1",
+    );
+}
+
+/// One setting's row of the bisection table.
+fn setting_row(s: &Setting, base: &Simulation, limit: &Limit) -> Vec<String> {
+    let (theory, found) = (base.time_step.stability_limit, limit.found);
+    let mass = base.world.bodies()[0].mass;
+    let (n, k_n) = (s.exponent, s.stiffness);
+    // Translation alone (κ = 1) at the peak overlap: the Verlet limit 2/ω of the normal mode.
+    let delta_peak = ((n + 1.0) * mass * GRAVITY / k_n).powf(1.0 / n);
+    let k_tangent = n * k_n * delta_peak.powf(n - 1.0);
+    let translation_limit = 2.0 * (mass / k_tangent).sqrt();
+    vec![
+        s.name.clone(),
+        s.shape.clone(),
+        if n == 1.0 {
+            "linear".into()
+        } else {
+            format!("power n = {n}")
+        },
+        format!("{k_n:.1e}"),
+        format!("{mass:.4e}"),
+        format!("{:.4e}", base.time_step.contact_time),
+        format!("{theory:.4e}"),
+        format!("{translation_limit:.4e}"),
+        format!("{found:.4e}"),
+        format!("{:.3}", found / theory),
+        format!("{:.3}", found / translation_limit),
+        limit.bisections.to_string(),
+    ]
+}
+
+/// The bisection table, the growth scan and the found-over-theory plot.
+fn report(
+    ctx: &mut CaseContext,
+    p: &Params,
+    rows: Vec<Vec<String>>,
+    scan_series: Vec<Series>,
+    bar_found: Vec<(Real, Real)>,
+) -> Result<(), SuiteError> {
+    ctx.section("Largest stable step against the theory");
+    ctx.text(&format!(
             "Δt_max(theory) is the scene's stability limit f(n) · 2/ω_max with κ = 1 + m r_b²/J_min and the overshoot factor f(n) (1 linear, 0.7314 for n = 3/2); the translation-only \
              limit is 2√(m/k_eff) with k_eff the tangent stiffness at the peak overlap. Found: the largest stable Δt \
              by bisection to a relative {:.0e} ({} steps per trial, unstable when the energy error exceeds {} \
              m g L (L the body's size: enough to throw it its own size out of the contact), or a step fails).",
             p.resolution, p.steps, p.error_limit
         ));
-        ctx.table(
-            Some("bisection"),
-            &[
-                "setting",
-                "shape",
-                "law",
-                "k_n (N/m^n)",
-                "m (kg)",
-                "t_c (s)",
-                "Δt_max theory (s)",
-                "translation-only 2/ω (s)",
-                "found (s)",
-                "found / theory",
-                "found / translation-only",
-                "bisection steps",
-            ],
-            &rows,
-        )?;
-        ctx.plot(&Plot {
+    ctx.table(
+        Some("bisection"),
+        &[
+            "setting",
+            "shape",
+            "law",
+            "k_n (N/m^n)",
+            "m (kg)",
+            "t_c (s)",
+            "Δt_max theory (s)",
+            "translation-only 2/ω (s)",
+            "found (s)",
+            "found / theory",
+            "found / translation-only",
+            "bisection steps",
+        ],
+        &rows,
+    )?;
+    ctx.plot(&Plot {
             name: "growth_scan".into(),
             title: "Energy error against the time step".into(),
             x_label: "Δt / Δt_max(theory) (1)".into(),
@@ -297,7 +341,7 @@ impl Case for StressTimeStep {
                 p.steps, p.error_limit
             ),
         })?;
-        ctx.plot(&Plot {
+    ctx.plot(&Plot {
             name: "found_over_theory".into(),
             title: "Largest stable step / theoretical limit, per setting".into(),
             x_label: "setting index (table order)".into(),
@@ -318,6 +362,5 @@ impl Case for StressTimeStep {
             ],
             caption: "Above 1: the guard is conservative (it refuses only steps that are stable); below 1 it would admit unstable steps.".into(),
         })?;
-        Ok(())
-    }
+    Ok(())
 }
