@@ -417,31 +417,7 @@ fn run_variant(
     let template = std::fs::read_to_string(root.join(template_path))
         .map_err(SuiteError::io(root.join(template_path)))?;
     let (text, bodies) = scene_for_variant(&root, v).map_err(fail)?;
-
-    // The generated bed: volumes and initial overlaps.
-    let placed = generate::place(&bodies).map_err(fail)?;
-    let volume_error = bodies
-        .iter()
-        .zip(&placed)
-        .map(|(b, pl)| {
-            let sphere = 4.0 / 3.0 * std::f64::consts::PI * b.radius.powi(3);
-            (pl.poly.mass_properties().volume / sphere - 1.0).abs()
-        })
-        .fold(0.0, Real::max);
-    let bed_density = scene_density(&template, "bed")?;
-    let law = bounds::BedLaw::from_scene(&template).map_err(fail)?;
-    let r_min = spheres
-        .iter()
-        .map(|s| s.radius)
-        .fold(Real::INFINITY, Real::min);
-    let bed_mass: Real = spheres
-        .iter()
-        .map(|s| bed_density * 4.0 / 3.0 * std::f64::consts::PI * s.radius.powi(3))
-        .sum();
-    // The bed's whole weight on one contact of the two smallest grains: no static contact carries more.
-    let static_bound = law.static_overlap(bed_mass * 9.81, 0.5 * r_min);
-    let initial = initial_overlap(&bodies, gates.box_side)?;
-
+    let bed = BedBounds::of(&bodies, spheres, &template, gates)?;
     let sim_poly = parse_scene(&text, Path::new(&format!("polyhedra_bed_{v}.toml")))
         .map_err(|e| fail(e.to_string()))?;
     let sim_sphere = load_scene(&root.join(template_path)).map_err(|e| fail(e.to_string()))?;
@@ -460,7 +436,7 @@ fn run_variant(
         &format!("{v} polyhedra"),
         ctx,
     )?;
-    let overlap_bound = law.energy_overlap(poly_run.ke0, 0.5 * r_min);
+    let overlap_bound = bed.law.energy_overlap(poly_run.ke0, 0.5 * bed.r_min);
     let t_end = *poly_run.history.t.last().unwrap_or(&0.0);
 
     ctx.section(&format!("{v} (t ≤ {:.4} ms)", t_end * 1e3));
@@ -468,8 +444,6 @@ fn run_variant(
         metrics(&format!("{v} spheres"), &spheres_run)?,
         metrics(&format!("{v} polyhedra"), &poly_run)?,
     );
-    // Both runs count the projectile's contacts at every sample.
-    let contacts = |m: &Metrics| m.mean_contacts.unwrap_or(Real::NAN);
     let solid_fraction = |top: Real| {
         spheres
             .iter()
@@ -488,6 +462,74 @@ fn run_variant(
         poly_run.bed_top * 1e3,
         solid_fraction(poly_run.bed_top),
     ));
+    comparison_table(ctx, v, &ms, &mp)?;
+    checks_table(ctx, p, gates, &spheres_run, &poly_run)?;
+    check_variant(ctx, v, gates, &bed, &poly_run, overlap_bound);
+    plot_variant(ctx, v, &spheres_run, &poly_run)?;
+    out.paragraphs.push(paragraph(v, t_end, &ms, &mp));
+    closing_rows(out, v, (&ms, &mp), (&spheres_run, &poly_run));
+    Ok(())
+}
+
+/// The generated bed's gated facts and the bounds its overlaps are held to.
+struct BedBounds {
+    /// The largest relative volume error of a polyhedron against its sphere.
+    volume_error: Real,
+    law: bounds::BedLaw,
+    /// The smallest grain radius.
+    r_min: Real,
+    /// The bed's whole weight on one contact of the two smallest grains: no static contact carries more.
+    static_bound: Real,
+    /// The largest initial overlap.
+    initial: Real,
+}
+
+impl BedBounds {
+    fn of(
+        bodies: &[generate::BedBody],
+        spheres: &[polydem::scene::body_file::SphereRow],
+        template: &str,
+        gates: &Gates,
+    ) -> Result<Self, SuiteError> {
+        let placed = generate::place(bodies).map_err(fail)?;
+        let volume_error = bodies
+            .iter()
+            .zip(&placed)
+            .map(|(b, pl)| {
+                let sphere = 4.0 / 3.0 * std::f64::consts::PI * b.radius.powi(3);
+                (pl.poly.mass_properties().volume / sphere - 1.0).abs()
+            })
+            .fold(0.0, Real::max);
+        let bed_density = scene_density(template, "bed")?;
+        let law = bounds::BedLaw::from_scene(template).map_err(fail)?;
+        let r_min = spheres
+            .iter()
+            .map(|s| s.radius)
+            .fold(Real::INFINITY, Real::min);
+        let bed_mass: Real = spheres
+            .iter()
+            .map(|s| bed_density * 4.0 / 3.0 * std::f64::consts::PI * s.radius.powi(3))
+            .sum();
+        let static_bound = law.static_overlap(bed_mass * 9.81, 0.5 * r_min);
+        Ok(Self {
+            volume_error,
+            law,
+            r_min,
+            static_bound,
+            initial: initial_overlap(bodies, gates.box_side)?,
+        })
+    }
+}
+
+/// The quantities of both beds side by side.
+fn comparison_table(
+    ctx: &mut CaseContext,
+    v: &str,
+    ms: &Metrics,
+    mp: &Metrics,
+) -> Result<(), SuiteError> {
+    // Both runs count the projectile's contacts at every sample.
+    let contacts = |m: &Metrics| m.mean_contacts.unwrap_or(Real::NAN);
     let row = |heading: String, a: Real, b: Real| {
         vec![
             heading,
@@ -498,19 +540,29 @@ fn run_variant(
     };
     let mut rows: Vec<Vec<String>> = QUANTITIES
         .iter()
-        .map(|q| row(q.heading(), q.of(&ms), q.of(&mp)))
+        .map(|q| row(q.heading(), q.of(ms), q.of(mp)))
         .collect();
     rows.push(row(
         "mean projectile contacts after first contact [-]".into(),
-        contacts(&ms),
-        contacts(&mp),
+        contacts(ms),
+        contacts(mp),
     ));
     ctx.table(
         Some(&format!("{v}_table")),
         &["quantity", "spheres", "polyhedra", "polyhedra / spheres"],
         &rows,
-    )?;
-    let checks_rows = [("spheres", &spheres_run), ("polyhedra", &poly_run)]
+    )
+}
+
+/// The checks of both runs (the polyhedral one gated).
+fn checks_table(
+    ctx: &mut CaseContext,
+    p: &Params,
+    gates: &Gates,
+    spheres_run: &BedRun,
+    poly_run: &BedRun,
+) -> Result<(), SuiteError> {
+    let checks_rows = [("spheres", spheres_run), ("polyhedra", poly_run)]
         .iter()
         .map(|(bed, r)| {
             vec![
@@ -541,22 +593,18 @@ fn run_variant(
             "non-finite values",
         ],
         &checks_rows,
-    )?;
-    let initial_bound = (initial, static_bound);
-    check_variant(
-        ctx,
-        v,
-        gates,
-        &law,
-        volume_error,
-        initial_bound,
-        &poly_run,
-        overlap_bound,
-    );
-    plot_variant(ctx, v, &spheres_run, &poly_run)?;
-    out.paragraphs.push(paragraph(v, t_end, &ms, &mp));
+    )
+}
+
+/// A variant's rows of the closing summary and speed tables.
+fn closing_rows(
+    out: &mut Closing,
+    v: &str,
+    (ms, mp): (&Metrics, &Metrics),
+    (spheres_run, poly_run): (&BedRun, &BedRun),
+) {
     out.summary_rows.push(vec![
-        v.clone(),
+        v.to_owned(),
         format!("{:.3}", ms.final_depth * 1e3),
         format!("{:.3}", mp.final_depth * 1e3),
         format!("{:.3}", ms.peak_force),
@@ -565,9 +613,9 @@ fn run_variant(
         format!("{:.3}", mp.final_vz),
         format!("{:.3}", relative_difference(ms.impulse, mp.impulse)),
     ]);
-    for (bed, r) in [("spheres", &spheres_run), ("polyhedra", &poly_run)] {
+    for (bed, r) in [("spheres", spheres_run), ("polyhedra", poly_run)] {
         out.speed_rows.push(vec![
-            v.clone(),
+            v.to_owned(),
             bed.to_owned(),
             format!("{}", r.steps),
             format!("{:.2}", r.wall_time_s),
@@ -577,21 +625,24 @@ fn run_variant(
             ),
         ]);
     }
-    Ok(())
 }
 
 /// The gated rows of a variant (the polyhedral run's).
-#[allow(clippy::too_many_arguments)]
 fn check_variant(
     ctx: &mut CaseContext,
     v: &str,
     gates: &Gates,
-    law: &bounds::BedLaw,
-    volume_error: Real,
-    (initial, static_bound): (Real, Real),
+    bed: &BedBounds,
     poly_run: &BedRun,
     overlap_bound: Real,
 ) {
+    let BedBounds {
+        volume_error,
+        ref law,
+        static_bound,
+        initial,
+        ..
+    } = *bed;
     ctx.check(
         &format!("{v}_volume_rel_error"),
         volume_error,
