@@ -244,60 +244,12 @@ pub fn epa<A: SupportMap + ?Sized, B: SupportMap + ?Sized>(
 ) -> EpaResult {
     let gap_tol = tol.epa_gap * scale;
     let vis_eps = 0.5 * gap_tol;
-    scratch.verts.clear();
-    scratch.faces.clear();
-    scratch.live_offsets.clear();
-    let mut ok = false;
-    if simplex.len == 4 {
-        scratch.verts.extend_from_slice(&simplex.pts);
-        ok = scratch.start_tetrahedron([0, 1, 2, 3]);
-    }
-    if !ok {
-        scratch.verts.clear();
-        scratch.verts.extend_from_slice(&simplex.pts[..simplex.len]);
-        // Supports along the axes of a fixed, irregular frame (coordinate axes are tie-prone for aligned
-        // shapes), then along the diagonals of that frame if the first six are not enough.
-        for d in START_DIRECTIONS[..6].iter() {
-            let s = pair.support(d);
-            scratch.verts.push(s);
-        }
-        if spread_tetrahedron(&scratch.verts).is_none() {
-            for d in START_DIRECTIONS[6..].iter() {
-                let s = pair.support(d);
-                scratch.verts.push(s);
-            }
-        }
-        // Still flat (all supports so far in one plane through a face of A ⊖ B's symmetric core): the
-        // supports along the plane's two normals leave it, since A ⊖ B has volume.
-        if let Some((i0, i1, i2)) = spread_triangle(&scratch.verts) {
-            if spread_tetrahedron(&scratch.verts).is_none() {
-                let (p0, p1, p2) = (
-                    scratch.verts[i0].w,
-                    scratch.verts[i1].w,
-                    scratch.verts[i2].w,
-                );
-                let nrm = (p1 - p0).cross(&(p2 - p0));
-                let nrm = nrm / nrm.norm();
-                let up = pair.support(&nrm);
-                let down = pair.support(&-nrm);
-                scratch.verts.push(up);
-                scratch.verts.push(down);
-            }
-        }
-        let Some(idx) = spread_tetrahedron(&scratch.verts) else {
-            return EpaResult {
-                outcome: EpaOutcome::Degenerate(Degeneracy::FlatStart),
-                iterations: 0,
-            };
+    if let Err(why) = start_polytope(pair, simplex, scratch) {
+        return EpaResult {
+            outcome: EpaOutcome::Degenerate(why),
+            iterations: 0,
         };
-        if !scratch.start_tetrahedron(idx) {
-            return EpaResult {
-                outcome: EpaOutcome::Degenerate(Degeneracy::FlatStart),
-                iterations: 0,
-            };
-        }
     }
-
     let degenerate = |iterations, why| EpaResult {
         outcome: EpaOutcome::Degenerate(why),
         iterations,
@@ -341,51 +293,129 @@ pub fn epa<A: SupportMap + ?Sized, B: SupportMap + ?Sized>(
         scratch.verts.push(s);
         let wi = scratch.verts.len() as u32 - 1;
 
-        scratch.horizon.clear();
-        scratch.faces[best as usize].alive = false;
-        scratch.live_offsets[best as usize] = Real::INFINITY;
-        for e in 0..3 {
-            scratch.silhouette(face.adj[e], face.adj_edge[e], &s.w, vis_eps);
+        if let Err(why) = scratch.replace_visible(best, &face, &s.w, wi, vis_eps) {
+            return degenerate(iterations, why);
         }
-        if scratch.horizon.len() < 3 {
-            return degenerate(iterations, Degeneracy::BrokenHorizon);
+    }
+}
+
+/// The start polytope: GJK's terminal simplex when it is a proper tetrahedron, else a tetrahedron of
+/// supports along fixed directions (and, for a flat set, along the plane's normals).
+#[inline]
+fn start_polytope<A: SupportMap + ?Sized, B: SupportMap + ?Sized>(
+    pair: &mut MinkowskiPair<'_, A, B>,
+    simplex: &Simplex,
+    scratch: &mut EpaScratch,
+) -> Result<(), Degeneracy> {
+    scratch.verts.clear();
+    scratch.faces.clear();
+    scratch.live_offsets.clear();
+    if simplex.len == 4 {
+        scratch.verts.extend_from_slice(&simplex.pts);
+        if scratch.start_tetrahedron([0, 1, 2, 3]) {
+            return Ok(());
+        }
+    }
+    scratch.verts.clear();
+    scratch.verts.extend_from_slice(&simplex.pts[..simplex.len]);
+    // Supports along the axes of a fixed, irregular frame (coordinate axes are tie-prone for aligned
+    // shapes), then along the diagonals of that frame if the first six are not enough.
+    for d in START_DIRECTIONS[..6].iter() {
+        let s = pair.support(d);
+        scratch.verts.push(s);
+    }
+    if spread_tetrahedron(&scratch.verts).is_none() {
+        for d in START_DIRECTIONS[6..].iter() {
+            let s = pair.support(d);
+            scratch.verts.push(s);
+        }
+    }
+    // Still flat (all supports so far in one plane through a face of A ⊖ B's symmetric core): the
+    // supports along the plane's two normals leave it, since A ⊖ B has volume.
+    if let Some((i0, i1, i2)) = spread_triangle(&scratch.verts) {
+        if spread_tetrahedron(&scratch.verts).is_none() {
+            let (p0, p1, p2) = (
+                scratch.verts[i0].w,
+                scratch.verts[i1].w,
+                scratch.verts[i2].w,
+            );
+            let nrm = (p1 - p0).cross(&(p2 - p0));
+            let nrm = nrm / nrm.norm();
+            let up = pair.support(&nrm);
+            let down = pair.support(&-nrm);
+            scratch.verts.push(up);
+            scratch.verts.push(down);
+        }
+    }
+    match spread_tetrahedron(&scratch.verts) {
+        Some(idx) if scratch.start_tetrahedron(idx) => Ok(()),
+        _ => Err(Degeneracy::FlatStart),
+    }
+}
+
+impl EpaScratch {
+    /// Removes face `best` (a copy: `face`) and every face visible from the new vertex `w` (index `wi`),
+    /// and closes the hole with a fan of faces from the horizon to `w`.
+    #[inline(always)]
+    fn replace_visible(
+        &mut self,
+        best: u32,
+        face: &Face,
+        w: &Vector,
+        wi: u32,
+        vis_eps: Real,
+    ) -> Result<(), Degeneracy> {
+        self.horizon.clear();
+        self.faces[best as usize].alive = false;
+        self.live_offsets[best as usize] = Real::INFINITY;
+        for e in 0..3 {
+            self.silhouette(face.adj[e], face.adj_edge[e], w, vis_eps);
+        }
+        if self.horizon.len() < 3 {
+            return Err(Degeneracy::BrokenHorizon);
         }
         // A fan of new faces, one per horizon edge: [end, start, w] of the (reversed) horizon edge.
-        scratch.new_faces.clear();
-        for h_idx in 0..scratch.horizon.len() {
-            let (g, k) = scratch.horizon[h_idx];
-            let gf = &scratch.faces[g as usize];
+        self.new_faces.clear();
+        for h_idx in 0..self.horizon.len() {
+            let (g, k) = self.horizon[h_idx];
+            let gf = &self.faces[g as usize];
             let p = gf.v[(k as usize + 1) % 3];
             let q = gf.v[k as usize];
-            let Some(nf) = scratch.push_face([p, q, wi]) else {
-                return degenerate(iterations, Degeneracy::FaceWithoutNormal);
+            let Some(nf) = self.push_face([p, q, wi]) else {
+                return Err(Degeneracy::FaceWithoutNormal);
             };
-            scratch.faces[nf as usize].adj[0] = g;
-            scratch.faces[nf as usize].adj_edge[0] = k;
-            scratch.faces[g as usize].adj[k as usize] = nf;
-            scratch.faces[g as usize].adj_edge[k as usize] = 0;
-            scratch.new_faces.push((nf, p, q));
+            self.faces[nf as usize].adj[0] = g;
+            self.faces[nf as usize].adj_edge[0] = k;
+            self.faces[g as usize].adj[k as usize] = nf;
+            self.faces[g as usize].adj_edge[k as usize] = 0;
+            self.new_faces.push((nf, p, q));
         }
-        // Link the fan: face j's edge 1 (q_j → w) meets face i's edge 2 (w → p_i) where p_i = q_j. The
-        // horizon must be one simple loop: every q matches exactly one p.
-        for &(fj, _, qj) in scratch.new_faces.iter() {
+        self.link_fan()
+    }
+
+    /// Links the fan: face j's edge 1 (q_j → w) meets face i's edge 2 (w → p_i) where p_i = q_j. The
+    /// horizon must be one simple loop: every q matches exactly one p.
+    #[inline(always)]
+    fn link_fan(&mut self) -> Result<(), Degeneracy> {
+        for &(fj, _, qj) in self.new_faces.iter() {
             let mut found = u32::MAX;
-            for &(fi, pi, _) in scratch.new_faces.iter() {
+            for &(fi, pi, _) in self.new_faces.iter() {
                 if pi == qj {
                     if found != u32::MAX {
-                        return degenerate(iterations, Degeneracy::BrokenHorizon);
+                        return Err(Degeneracy::BrokenHorizon);
                     }
                     found = fi;
                 }
             }
-            if found == u32::MAX || scratch.faces[found as usize].adj[2] != u32::MAX {
-                return degenerate(iterations, Degeneracy::BrokenHorizon);
+            if found == u32::MAX || self.faces[found as usize].adj[2] != u32::MAX {
+                return Err(Degeneracy::BrokenHorizon);
             }
-            scratch.faces[fj as usize].adj[1] = found;
-            scratch.faces[fj as usize].adj_edge[1] = 2;
-            scratch.faces[found as usize].adj[2] = fj;
-            scratch.faces[found as usize].adj_edge[2] = 1;
+            self.faces[fj as usize].adj[1] = found;
+            self.faces[fj as usize].adj_edge[1] = 2;
+            self.faces[found as usize].adj[2] = fj;
+            self.faces[found as usize].adj_edge[2] = 1;
         }
+        Ok(())
     }
 }
 
