@@ -4,11 +4,13 @@
 //! c1 = c_A + r_A n, c2 = c_B − r_B n (so c1 − c2 = δ n). Concentric spheres have no preferred direction;
 //! the normal is then the world x axis, deterministically. Exact up to round-off; status `Exact`.
 
-use super::tolerances::ContactTolerances;
+use super::tolerances::{pair_length_scale, ContactTolerances};
 use super::{ContactGeometry, ContactKind, SolverStatus};
 use crate::math::{Point, Real, Vector};
 
-/// Contact of the sphere (centre `c1`, radius `r1`) with the sphere (`c2`, `r2`), world frame.
+/// Contact of the sphere (centre `c1`, radius `r1`) with the sphere (`c2`, `r2`), world frame. The
+/// touching band follows the smaller diameter (floored as [`pair_length_scale`] floors it), the scale at
+/// which the pair's force and energy error live.
 pub fn contact_sphere_sphere(
     c1: &Point,
     r1: Real,
@@ -16,8 +18,7 @@ pub fn contact_sphere_sphere(
     r2: Real,
     tol: &ContactTolerances,
 ) -> ContactGeometry {
-    let scale = 2.0 * r1.max(r2);
-    let touch = tol.touching * scale;
+    let touch = tol.touching * pair_length_scale(2.0 * r1, 2.0 * r2);
     let d_vec = c2 - c1;
     let (normal, signed) = sphere_sphere_normal(&d_vec, d_vec.norm_squared(), r1 + r2);
     let (point_a, point_b) = sphere_sphere_points(c1, r1, c2, r2, &normal);
@@ -116,5 +117,28 @@ mod tests {
             (g.depth - 1.5).abs() < 1e-15 && g.normal == Vector::x(),
             "{g:?}"
         );
+    }
+
+    /// A pebble against a boulder 1e4 times larger: a gap or an overlap of 1e-9 of the pebble's diameter
+    /// is far above the round-off of the centre distance (a few ε · 10 m) and must not fall in the
+    /// touching band, which follows the pebble.
+    #[test]
+    fn pebble_boulder_band_follows_the_pebble() {
+        let tol = ContactTolerances::default();
+        let (r_boulder, r_pebble) = (10.0, 1e-3);
+        let band = tol.touching * pair_length_scale(2.0 * r_boulder, 2.0 * r_pebble);
+        for signed_gap in [1e-9 * 2.0 * r_pebble, -1e-9 * 2.0 * r_pebble] {
+            let centre = Point::new(r_boulder + r_pebble + signed_gap, 0.0, 0.0);
+            let g = contact_sphere_sphere(&Point::origin(), r_boulder, &centre, r_pebble, &tol);
+            let expected = if signed_gap > 0.0 {
+                ContactKind::Separated
+            } else {
+                ContactKind::Overlap
+            };
+            assert_eq!(
+                g.kind, expected,
+                "radii {r_boulder} and {r_pebble}, gap {signed_gap:e} m, band {band:e} m: {g:?}"
+            );
+        }
     }
 }

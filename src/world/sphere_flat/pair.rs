@@ -17,6 +17,7 @@
 
 use crate::contact::contact_sphere_plane::plane_sphere_points;
 use crate::contact::contact_sphere_sphere::{sphere_sphere_normal, sphere_sphere_points};
+use crate::contact::tolerances::pair_length_scale;
 use crate::contact::ContactTolerances;
 #[cfg(doc)]
 use crate::contact::{contact_plane_sphere, contact_sphere_sphere};
@@ -214,7 +215,8 @@ pub(crate) struct PairContext<'a> {
 pub(crate) struct PairConstants {
     pub(crate) radius_a: Real,
     pub(crate) radius_b: Real,
-    /// The touching band of [`contact_sphere_sphere`]: tolerance × the larger diameter (m).
+    /// The touching band of [`contact_sphere_sphere`]: tolerance × the pair's length scale, the smaller
+    /// diameter floored at a fraction of the larger ([`pair_length_scale`]) (m).
     pub(crate) touch: Real,
     /// The smaller diameter (m): the overlap ratio's scale.
     pub(crate) scale: Real,
@@ -237,7 +239,7 @@ impl PairConstants {
         Self {
             radius_a: pa.radius,
             radius_b: pb.radius,
-            touch: tolerances.touching * (2.0 * pa.radius.max(pb.radius)),
+            touch: tolerances.touching * pair_length_scale(2.0 * pa.radius, 2.0 * pb.radius),
             scale: (2.0 * pa.radius).min(2.0 * pb.radius),
             law: model.map(|m| scaled(m, root_radius).prepared(effective_mass)),
         }
