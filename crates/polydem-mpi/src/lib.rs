@@ -42,6 +42,12 @@ pub mod consensus;
 #[cfg(feature = "mpi")]
 pub mod exchange;
 #[cfg(feature = "mpi")]
+pub mod gather;
+#[cfg(feature = "mpi")]
+pub mod observed;
+#[cfg(feature = "mpi")]
+pub mod pieces;
+#[cfg(feature = "mpi")]
 pub mod run;
 
 pub use error::DistributedError;
