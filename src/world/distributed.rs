@@ -159,4 +159,11 @@ impl World {
     pub fn set_broad_phase(&mut self, broad_phase: BroadPhase) {
         self.broad_phase = broad_phase;
     }
+
+    /// The walls' contact forces of the last evaluation replaced by `wall_forces` (one per wall; summed
+    /// elsewhere from the contact entries of a world split over processes).
+    pub fn replace_wall_forces(&mut self, wall_forces: Vec<Vector>) {
+        debug_assert_eq!(wall_forces.len(), self.walls.len());
+        self.loads.wall_forces = wall_forces;
+    }
 }

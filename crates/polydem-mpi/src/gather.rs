@@ -1,6 +1,7 @@
-//! The whole world's state gathered on rank 0 for outputs: every owned body's state and loads, and, for
-//! an output that reads them (a checkpoint), the whole contact store and broad phase as one process holds
-//! them.
+//! The whole world's state gathered on rank 0 for outputs: every owned body's state and loads, the
+//! touching body–wall entries (the walls' forces are summed from them on rank 0, in the order and with
+//! the bits of one process's step), and, for an output that reads them (a checkpoint), the whole contact
+//! store and broad phase as one process holds them.
 //!
 //! The contact entries come from the ranks that answer for them (a body pair from the owner of its lower
 //! body, a body–wall pair from the body's owner), in key order. The whole broad phase is a function of the
@@ -8,8 +9,9 @@
 //! them when asked, with the build count the parts kept in step (a restored world's list is held as
 //! restored until its first rebuild).
 
+use polydem::math::Vector;
 use polydem::world::broad_phase::BroadPhase;
-use polydem::world::World;
+use polydem::world::{ContactKey, ContactState, World};
 
 use crate::error::DistributedError;
 use crate::exchange::gather_to_root;
@@ -24,11 +26,11 @@ impl DistributedRun {
         world: Option<&mut World>,
         contacts: bool,
     ) -> Result<(), DistributedError> {
-        let entries = if contacts {
-            authoritative_contacts(&self.part)
-        } else {
-            Vec::new()
-        };
+        let mut entries = authoritative_contacts(&self.part);
+        if !contacts {
+            entries
+                .retain(|(key, state)| matches!(key, ContactKey::Wall { .. }) && state.is_active());
+        }
         let mine = (owned_bodies(&self.part), entries);
         let all = gather_to_root(&self.comm, &mine, &mut self.traffic.gathers)?;
         let (Some(world), Some(all)) = (world, all) else {
@@ -42,8 +44,9 @@ impl DistributedRun {
             }
             store.extend(entries);
         }
+        store.sort_by_key(|entry| entry.0);
+        world.replace_wall_forces(wall_forces(&store, world.walls().len()));
         if contacts {
-            store.sort_by_key(|entry| entry.0);
             let touched = self.part.world.contacts().last_touched();
             world.replace_contacts(store, touched);
             world.set_broad_phase(self.whole_list().clone());
@@ -60,4 +63,16 @@ impl DistributedRun {
         }
         self.whole.broad_phase()
     }
+}
+
+/// The contact force on each of `walls` walls: the opposite of the force on the body of every touching
+/// body–wall entry of `entries` (in key order), summed from zero in that order as the step sums them.
+fn wall_forces(entries: &[(ContactKey, ContactState)], walls: usize) -> Vec<Vector> {
+    let mut forces = vec![Vector::zeros(); walls];
+    for (key, state) in entries {
+        if let (ContactKey::Wall { wall, .. }, true) = (key, state.is_active()) {
+            forces[*wall as usize] -= state.force_on_b;
+        }
+    }
+    forces
 }
