@@ -221,7 +221,10 @@ fn assert_same_frames(case: &str, kind: &str, got: &Path, expected: &Path) {
             .filter_map(|l| l.trim().strip_prefix("<Piece Source=\""))
             .map(|l| got.join("vtk").join(&l[..l.find('"').expect("quote")]))
             .collect();
-        let (a, b) = (vtk_by_body(&pieces), vtk_by_body(&[path.clone()]));
+        let (a, b) = (
+            vtk_by_body(&pieces),
+            vtk_by_body(std::slice::from_ref(&path)),
+        );
         assert!(!b.is_empty(), "{case}: {} has no body data", path.display());
         if a != b {
             let first = b
