@@ -100,15 +100,15 @@ fn distributed_lines(
 ) -> String {
     let steps = summary.part.steps.max(1) as f64;
     let per_step = |t: polydem_mpi::exchange::Traffic| t.bytes as f64 / steps;
+    let gathered = traffic.received_at_root.bytes as f64 / summary.gathers.max(1) as f64;
     format!(
-        "distributed over {ranks} ranks: {} cuts, {} gathers for the outputs; rank 0 sent per step {:.0} B \
-         of ghosts, {:.0} B of agreements, {:.0} B at cuts, {:.0} B to outputs (the counters above are rank \
-         0's part, its ghosts included)\n",
+        "distributed over {ranks} ranks: {} cuts; rank 0 sent per step {:.0} B of ghosts, {:.0} B of \
+         agreements, {:.0} B at cuts; {} gathers for the outputs, {gathered:.0} B received per gather (the \
+         counters above are rank 0's part, its ghosts included)\n",
         summary.cuts,
-        summary.gathers,
         per_step(traffic.ghosts),
         per_step(traffic.agreements),
         per_step(traffic.cuts),
-        per_step(traffic.gathers),
+        summary.gathers,
     )
 }

@@ -32,7 +32,13 @@ impl DistributedRun {
                 .retain(|(key, state)| matches!(key, ContactKey::Wall { .. }) && state.is_active());
         }
         let mine = (owned_bodies(&self.part), entries);
-        let all = gather_to_root(&self.comm, &mine, &mut self.traffic.gathers)?;
+        let traffic = &mut self.traffic;
+        let all = gather_to_root(
+            &self.comm,
+            &mine,
+            &mut traffic.gathers,
+            &mut traffic.received_at_root,
+        )?;
         let (Some(world), Some(all)) = (world, all) else {
             return Ok(());
         };

@@ -126,28 +126,20 @@ impl VtkPieces {
             let kind = self.series[k].0;
             let stem = format!("{}_{step:09}", kind.name());
             let mut text = String::new();
-            let frame = match (kind, whole) {
-                (SeriesKind::Walls, Some(whole)) => {
-                    walls_vtu(&mut text, whole, self.encoding);
-                    format!("vtk/{stem}.vtu")
+            let frame = if kind == SeriesKind::Walls {
+                let Some(whole) = whole else { continue };
+                walls_vtu(&mut text, whole, self.encoding);
+                format!("vtk/{stem}.vtu")
+            } else {
+                body_piece(&mut text, kind, part, piece, self.encoding);
+                self.write_file(&format!("vtk/{stem}_{:04}.vtu", self.rank), &text)?;
+                if self.rank != 0 {
+                    continue;
                 }
-                (SeriesKind::Walls, None) => continue,
-                (body_kind, _) => {
-                    let name = format!("vtk/{stem}_{:04}.vtu", self.rank);
-                    body_piece(&mut text, body_kind, part, piece, self.encoding);
-                    self.write_file(&name, &text)?;
-                    if self.rank != 0 {
-                        continue;
-                    }
-                    let pvtu = parallel_file(&text, &stem, self.ranks);
-                    self.write_file(&format!("vtk/{stem}.pvtu"), &pvtu)?;
-                    text.clear();
-                    format!("vtk/{stem}.pvtu")
-                }
+                text = parallel_file(&text, &stem, self.ranks);
+                format!("vtk/{stem}.pvtu")
             };
-            if !text.is_empty() {
-                self.write_file(&frame, &text)?;
-            }
+            self.write_file(&frame, &text)?;
             let entries = &mut self.series[k].1;
             entries.retain(|(_, f)| *f != frame);
             entries.push((part.time(), frame));
