@@ -254,9 +254,9 @@ impl DistributedRun {
     }
 }
 
-pub(crate) type OwnedBody = (usize, RigidBody, Vector, Vector);
+type OwnedBody = (usize, RigidBody, Vector, Vector);
 
-pub(crate) fn owned_bodies(part: &Part) -> Vec<OwnedBody> {
+fn owned_bodies(part: &Part) -> Vec<OwnedBody> {
     let (bodies, loads) = (part.world.bodies(), part.world.loads());
     (0..part.ids.len())
         .filter(|&i| part.owned[i])
