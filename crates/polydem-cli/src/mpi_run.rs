@@ -70,6 +70,10 @@ fn distributed(args: &RunArgs, comm: &SimpleCommunicator) -> Result<()> {
     let quiet = args.quiet || rank != 0;
     if !quiet {
         eprintln!("{} on {ranks} ranks", super::run_header(&origin, &sim));
+        eprintln!(
+            "note: on several ranks energy.csv and the energy terms of checkpoints are rank 0's part's, not \
+             the whole world's (bodies.csv, walls.csv, VTK and the state of checkpoints are one process's)"
+        );
     }
     let bar = super::progress_bar(quiet, &origin, &sim)?;
     if let Some(outputs) = outputs.as_mut() {
