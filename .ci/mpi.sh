@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
-# The MPI stage of CI: installs Debian's MPICH (and libclang for rsmpi's bindgen), builds polydem-mpi with
-# `--features mpi` against MPICH, and runs its tests; the bitwise test launches `mpirun -n 1..4` itself,
-# oversubscribed on a small machine. Runs as root without standard input.
+# The MPI stage of CI: installs Debian's MPICH (and libclang for rsmpi's bindgen), builds polydem-mpi and the
+# command line with `--features mpi` against MPICH, and runs their MPI tests; they launch `mpirun -n 1..4`
+# themselves, oversubscribed on a small machine. Runs as root without standard input.
 #
 # Why MPICH: Open MPI (installed on this machine as a dependency of YADE) refuses to run as root unless
 # OMPI_ALLOW_RUN_AS_ROOT and OMPI_ALLOW_RUN_AS_ROOT_CONFIRM are set, and oversubscription needs another
@@ -27,5 +27,8 @@ export POLYDEM_MPIRUN=mpirun.mpich
 # One rayon thread per rank: the ranks already oversubscribe the cores (the bits do not depend on it).
 export RAYON_NUM_THREADS=1
 cargo test --release -p polydem-mpi --features mpi
-# The workspace clippy stage builds without the feature; the MPI code is linted here.
-cargo clippy --release -p polydem-mpi --features mpi --all-targets -- -D warnings
+# `mpirun -n P polydem run`: outputs, restarts across rank counts, a failing rank.
+cargo test --release -p polydem-cli --features mpi --test cli_mpi
+# The workspace clippy stage builds without the features; the MPI code is linted here.
+cargo clippy --release -p polydem-mpi -p polydem-cli --features polydem-mpi/mpi,polydem-cli/mpi \
+    --all-targets -- -D warnings

@@ -363,9 +363,45 @@ fn frame_step(series: &str, file: &str) -> Option<u64> {
 
 /// The `.vtu` text of the polyhedral bodies (see the module docs).
 pub fn polyhedra_vtu(out: &mut String, world: &World, format: VtkEncoding) -> PieceCounts {
-    let items: Vec<(usize, &ConvexPolyhedron)> = (0..world.bodies().len())
-        .filter_map(|i| match world.shape(i) {
-            Shape::Polyhedron(p) => Some((i, p.as_ref())),
+    polyhedra_piece_vtu(out, world, format, &BodyPiece::whole(world))
+}
+
+/// The bodies a `.vtu` of bodies holds: a piece of a world split over processes writes the bodies its
+/// process owns, each labelled (in the `body` arrays) by its index in the whole world.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct BodyPiece {
+    /// Indices of the bodies written, increasing.
+    pub bodies: Vec<usize>,
+    /// The `body` value written for each.
+    pub labels: Vec<usize>,
+}
+
+impl BodyPiece {
+    /// Every body of `world`, labelled by its index.
+    pub fn whole(world: &World) -> Self {
+        let all: Vec<usize> = (0..world.bodies().len()).collect();
+        Self {
+            bodies: all.clone(),
+            labels: all,
+        }
+    }
+
+    fn items(&self) -> impl Iterator<Item = (usize, usize)> + '_ {
+        self.bodies.iter().copied().zip(self.labels.iter().copied())
+    }
+}
+
+/// [`polyhedra_vtu`] of the bodies of `piece`.
+pub fn polyhedra_piece_vtu(
+    out: &mut String,
+    world: &World,
+    format: VtkEncoding,
+    piece: &BodyPiece,
+) -> PieceCounts {
+    let items: Vec<(usize, usize, &ConvexPolyhedron)> = piece
+        .items()
+        .filter_map(|(i, label)| match world.shape(i) {
+            Shape::Polyhedron(p) => Some((i, label, p.as_ref())),
             _ => None,
         })
         .collect();
@@ -375,10 +411,22 @@ pub fn polyhedra_vtu(out: &mut String, world: &World, format: VtkEncoding) -> Pi
 /// The `.vtu` text of the bodies of the other bounded shapes (ellipsoids, …) as their
 /// [`ConvexShape::surface_mesh`](crate::shape::ConvexShape::surface_mesh), written like the polyhedra.
 pub fn surfaces_vtu(out: &mut String, world: &World, format: VtkEncoding) -> PieceCounts {
-    let meshes: Vec<(usize, SurfaceMesh)> = (0..world.bodies().len())
-        .filter_map(|i| surface_body(world.shape(i)).map(|m| (i, m)))
+    surfaces_piece_vtu(out, world, format, &BodyPiece::whole(world))
+}
+
+/// [`surfaces_vtu`] of the bodies of `piece`.
+pub fn surfaces_piece_vtu(
+    out: &mut String,
+    world: &World,
+    format: VtkEncoding,
+    piece: &BodyPiece,
+) -> PieceCounts {
+    let meshes: Vec<(usize, usize, SurfaceMesh)> = piece
+        .items()
+        .filter_map(|(i, label)| surface_body(world.shape(i)).map(|m| (i, label, m)))
         .collect();
-    let items: Vec<(usize, &SurfaceMesh)> = meshes.iter().map(|(i, m)| (*i, m)).collect();
+    let items: Vec<(usize, usize, &SurfaceMesh)> =
+        meshes.iter().map(|(i, label, m)| (*i, *label, m)).collect();
     mesh_vtu(out, world, format, &items)
 }
 
@@ -421,17 +469,18 @@ impl MeshView for SurfaceMesh {
     }
 }
 
-/// The `.vtu` text of bodies drawn as polygonal surfaces: `items` are (body index, its mesh).
+/// The `.vtu` text of bodies drawn as polygonal surfaces: `items` are (body index, its label, its mesh).
 fn mesh_vtu<M: MeshView + ?Sized>(
     out: &mut String,
     world: &World,
     format: VtkEncoding,
-    items: &[(usize, &M)],
+    items: &[(usize, usize, &M)],
 ) -> PieceCounts {
-    let bodies: Vec<usize> = items.iter().map(|(i, _)| *i).collect();
+    let bodies: Vec<usize> = items.iter().map(|(i, _, _)| *i).collect();
     let position: std::collections::HashMap<usize, usize> =
         bodies.iter().enumerate().map(|(k, &i)| (i, k)).collect();
-    let poly = |i: usize| items[position[&i]].1;
+    let poly = |i: usize| items[position[&i]].2;
+    let label = |i: usize| items[position[&i]].1;
     let points: usize = bodies.iter().map(|&i| poly(i).vertices().len()).sum();
     let cells: usize = bodies.iter().map(|&i| poly(i).num_faces()).sum();
     let counts = PieceCounts { points, cells };
@@ -484,7 +533,7 @@ fn mesh_vtu<M: MeshView + ?Sized>(
     data_array(out, format, "body", "Int32", 1, |s| {
         for &i in &bodies {
             for _ in 0..faces(i) {
-                s.int(i);
+                s.int(label(i));
             }
         }
     });
@@ -504,7 +553,7 @@ fn mesh_vtu<M: MeshView + ?Sized>(
     data_array(out, format, "body", "Int32", 1, |s| {
         for &i in &bodies {
             for _ in poly(i).vertices() {
-                s.int(i);
+                s.int(label(i));
             }
         }
     });
@@ -524,9 +573,20 @@ fn mesh_vtu<M: MeshView + ?Sized>(
 
 /// The `.vtu` text of the spherical bodies (see the module docs).
 pub fn spheres_vtu(out: &mut String, world: &World, format: VtkEncoding) -> PieceCounts {
-    let spheres: Vec<(usize, Real)> = (0..world.bodies().len())
-        .filter_map(|i| match world.shape(i) {
-            Shape::Sphere(s) => Some((i, s.radius())),
+    spheres_piece_vtu(out, world, format, &BodyPiece::whole(world))
+}
+
+/// [`spheres_vtu`] of the bodies of `piece`.
+pub fn spheres_piece_vtu(
+    out: &mut String,
+    world: &World,
+    format: VtkEncoding,
+    piece: &BodyPiece,
+) -> PieceCounts {
+    let spheres: Vec<(usize, Real, usize)> = piece
+        .items()
+        .filter_map(|(i, label)| match world.shape(i) {
+            Shape::Sphere(s) => Some((i, s.radius(), label)),
             _ => None,
         })
         .collect();
@@ -537,7 +597,7 @@ pub fn spheres_vtu(out: &mut String, world: &World, format: VtkEncoding) -> Piec
     begin_piece(out, counts, format);
     out.push_str("      <Points>\n");
     data_array(out, format, "Points", "Real", 3, |s| {
-        for &(i, _) in &spheres {
+        for &(i, _, _) in &spheres {
             s.vec(&world.bodies()[i].position.coords);
         }
     });
@@ -555,17 +615,19 @@ pub fn spheres_vtu(out: &mut String, world: &World, format: VtkEncoding) -> Piec
     out.push_str("      </Cells>\n");
     out.push_str("      <PointData Scalars=\"diameter\" Vectors=\"velocity\">\n");
     data_array(out, format, "body", "Int32", 1, |s| {
-        spheres.iter().for_each(|&(i, _)| s.int(i))
+        spheres.iter().for_each(|&(_, _, label)| s.int(label))
     });
     data_array(out, format, "radius", "Real", 1, |s| {
-        spheres.iter().for_each(|&(_, r)| s.real(r))
+        spheres.iter().for_each(|&(_, r, _)| s.real(r))
     });
     data_array(out, format, "diameter", "Real", 1, |s| {
-        spheres.iter().for_each(|&(_, r)| s.real(2.0 * r))
+        spheres.iter().for_each(|&(_, r, _)| s.real(2.0 * r))
     });
     for (name, value) in body_vectors() {
         data_array(out, format, name, "Real", 3, |s| {
-            spheres.iter().for_each(|&(i, _)| s.vec(&value(world, i)))
+            spheres
+                .iter()
+                .for_each(|&(i, _, _)| s.vec(&value(world, i)))
         });
     }
     out.push_str("      </PointData>\n");

@@ -119,7 +119,7 @@ impl BroadPhase {
     }
 
     /// The body centres at the last build (empty before the first).
-    pub(crate) fn centres_at_build(&self) -> &[Point] {
+    pub fn centres_at_build(&self) -> &[Point] {
         &self.centres_at_build
     }
 
@@ -195,6 +195,42 @@ impl BroadPhase {
             .map(|(w, then)| (w.pose.translation.vector - then).norm_squared())
             .fold(0.0, Real::max);
         d1.sqrt() + d2.max(w1).sqrt() >= self.skin * (1.0 - 1e-9)
+    }
+
+    /// This list restricted to the bodies `ids` (strictly increasing), renumbered 0, 1, … in that order:
+    /// the pairs and body–wall pairs among kept bodies, their centres at the build, the walls' build
+    /// translations and the build count. Every pair among kept bodies keeps its place in the order, so the
+    /// result is the list a build at the kept centres would give (a part of a world split over processes,
+    /// cut from a restored world whose list was built elsewhere).
+    pub fn restricted(&self, ids: &[usize]) -> BroadPhase {
+        debug_assert!(ids.windows(2).all(|w| w[0] < w[1]));
+        let mut local = vec![u32::MAX; self.centres_at_build.len()];
+        for (k, &i) in ids.iter().enumerate() {
+            local[i] = k as u32;
+        }
+        let kept = |&(i, j): &Pair| {
+            let (a, b) = (local[i as usize], local[j as usize]);
+            (a != u32::MAX && b != u32::MAX).then_some((a, b))
+        };
+        let kept_wall = |&(i, w): &Pair| {
+            let a = local[i as usize];
+            (a != u32::MAX).then_some((a, w))
+        };
+        BroadPhase {
+            skin: self.skin,
+            centres_at_build: ids.iter().map(|&i| self.centres_at_build[i]).collect(),
+            pairs: self.pairs.iter().filter_map(kept).collect(),
+            rebuilds: self.rebuilds,
+            wall_pairs: self.wall_pairs.iter().filter_map(kept_wall).collect(),
+            walls_at_build: self.walls_at_build.clone(),
+            ..BroadPhase::default()
+        }
+    }
+
+    /// Sets the build count, for a list built in step with another that counts the builds (a part of a
+    /// world split over processes, whose list is built anew at each cut).
+    pub fn set_rebuilds(&mut self, rebuilds: u64) {
+        self.rebuilds = rebuilds;
     }
 
     /// The body–wall candidates `(body, wall)` of the last [`update_with_walls`](Self::update_with_walls),

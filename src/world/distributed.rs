@@ -10,17 +10,32 @@
 use crate::dynamics::RigidBody;
 use crate::math::{Point, Vector};
 
+use super::broad_phase::BroadPhase;
 use super::contact_store::{ContactKey, ContactState, ContactStore};
 use super::world::{Loads, World};
+
+/// The broad phase a part of a world starts with ([`World::part`]).
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+pub enum PartBroadPhase {
+    /// None: the next step builds it, as a fresh world's (the whole world's is not built either).
+    Unbuilt,
+    /// Built at the current positions and walls as the `rebuilds`-th build: a part cut right after the
+    /// step that rebuilt the whole world's list (whose build positions are these).
+    Build {
+        /// The whole world's build count after that step.
+        rebuilds: u64,
+    },
+    /// The whole world's list restricted to the part ([`BroadPhase::restricted`]): a part of a restored
+    /// world, whose list was built at earlier positions.
+    Restrict,
+}
 
 impl World {
     /// The world restricted to the bodies `ids` (strictly increasing), renumbered 0, 1, … in that order,
     /// with every shape, wall and material, the clock, the loads of the kept bodies and the contact entries
-    /// whose bodies are all kept. The energy ledger starts empty and no body sleeps. With
-    /// `build_broad_phase` the broad phase is built at the current positions (a part cut right after the
-    /// step that rebuilt the whole world's, whose build positions are these); without, it is built by the
-    /// next step, as a fresh world's is.
-    pub fn part(&self, ids: &[usize], build_broad_phase: bool) -> World {
+    /// whose bodies are all kept, and its broad phase as `broad_phase` says. The energy ledger starts
+    /// empty and no body sleeps.
+    pub fn part(&self, ids: &[usize], broad_phase: PartBroadPhase) -> World {
         debug_assert!(ids.windows(2).all(|w| w[0] < w[1]));
         let mut local = vec![u32::MAX; self.bodies.len()];
         for (k, &i) in ids.iter().enumerate() {
@@ -68,10 +83,15 @@ impl World {
         part.time = self.time;
         part.step_index = self.step_index;
         part.replace_contacts(kept.collect(), self.contacts.last_touched());
-        if build_broad_phase {
-            let centres: Vec<Point> = part.bodies.iter().map(|b| b.position).collect();
-            part.broad_phase
-                .rebuild_with_walls(&centres, &part.radii, &part.walls);
+        match broad_phase {
+            PartBroadPhase::Unbuilt => {}
+            PartBroadPhase::Build { rebuilds } => {
+                let centres: Vec<Point> = part.bodies.iter().map(|b| b.position).collect();
+                part.broad_phase
+                    .rebuild_with_walls(&centres, &part.radii, &part.walls);
+                part.broad_phase.set_rebuilds(rebuilds);
+            }
+            PartBroadPhase::Restrict => part.broad_phase = self.broad_phase.restricted(ids),
         }
         part
     }
@@ -107,8 +127,10 @@ impl World {
     }
 
     /// The walls, the clock and the loads other than the bodies' (wall forces, sums) of `other` (a part of
-    /// this world stepped elsewhere) taken over, for a whole world reassembled from its parts.
+    /// this world stepped elsewhere) taken over, for a whole world reassembled from its parts; the sleeping
+    /// state covers every body, as a step leaves it (no body sleeps in a split world).
     pub fn copy_walls_and_clock(&mut self, other: &World) {
+        self.sleep.resize(self.bodies.len());
         self.walls = other.walls.clone();
         self.time = other.time;
         self.step_index = other.step_index;
@@ -122,5 +144,26 @@ impl World {
             torques,
             ..other.loads.clone()
         };
+    }
+
+    /// The broad phase rebuilt at the current positions and walls, as the `rebuilds`-th build (a whole
+    /// world reassembled from parts cut at its last build, whose list each part built for itself).
+    pub fn rebuild_broad_phase_as(&mut self, rebuilds: u64) {
+        let centres: Vec<Point> = self.bodies.iter().map(|b| b.position).collect();
+        self.broad_phase
+            .rebuild_with_walls(&centres, &self.radii, &self.walls);
+        self.broad_phase.set_rebuilds(rebuilds);
+    }
+
+    /// The broad phase replaced by `broad_phase` (of the same bodies).
+    pub fn set_broad_phase(&mut self, broad_phase: BroadPhase) {
+        self.broad_phase = broad_phase;
+    }
+
+    /// The walls' contact forces of the last evaluation replaced by `wall_forces` (one per wall; summed
+    /// elsewhere from the contact entries of a world split over processes).
+    pub fn replace_wall_forces(&mut self, wall_forces: Vec<Vector>) {
+        debug_assert_eq!(wall_forces.len(), self.walls.len());
+        self.loads.wall_forces = wall_forces;
     }
 }

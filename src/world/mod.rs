@@ -36,6 +36,7 @@ mod wall;
 pub mod world;
 
 pub use contact_store::{ContactKey, ContactState, ContactStore};
+pub use distributed::PartBroadPhase;
 pub use energy::{EnergyLedger, EnergyReport};
 pub use parallel::Parallelism;
 pub use skips::Skips;

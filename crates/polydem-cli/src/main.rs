@@ -13,6 +13,8 @@
 //!   a terminal, unless `--quiet`.
 //! - `polydem run --restart FILE --out DIR [--end-time T] ...`: continues a checkpoint bit for bit; into the
 //!   earlier run's directory it continues its CSV and VTK series (`polydem::io::csv_continue`).
+//! - Built with the feature `mpi`, `mpirun -n P polydem run …` with P > 1 steps the scene split over the
+//!   ranks (`mpi_run`); one rank runs as without MPI.
 //! - `polydem rockfill [--full] [--out DIR] …`: the paper's rockfill experiment (`polydem_rockfill::cli`).
 
 use std::fs::File;
@@ -24,6 +26,9 @@ use clap::{Parser, Subcommand};
 
 use polydem::contact::query_polyhedra;
 use polydem::io::pairs_jsonl::answer_stream;
+
+#[cfg(feature = "mpi")]
+mod mpi_run;
 
 #[derive(Parser)]
 #[command(
@@ -56,28 +61,35 @@ enum Command {
 fn main() -> std::process::ExitCode {
     let result = match Cli::parse().command {
         Command::Contact { pairs, out } => contact(&pairs, out.as_deref()),
+        #[cfg(feature = "mpi")]
+        Command::Run(args) => mpi_run::run(&args),
+        #[cfg(not(feature = "mpi"))]
         Command::Run(args) => run(&args),
         Command::Rockfill(args) => polydem_rockfill::cli::run(&args),
     };
     match result {
         Ok(()) => std::process::ExitCode::SUCCESS,
         Err(e) => {
-            // The whole chain on one line ("what failed: why"), without a backtrace: these are user errors.
-            // A cause that its parent's message already quotes is not repeated.
-            let mut line = String::new();
-            for cause in e.chain() {
-                let text = cause.to_string();
-                if !line.contains(&text) {
-                    if !line.is_empty() {
-                        line.push_str(": ");
-                    }
-                    line.push_str(&text);
-                }
-            }
-            eprintln!("error: {line}");
+            eprintln!("error: {}", one_line(&e));
             std::process::ExitCode::FAILURE
         }
     }
+}
+
+/// The whole chain of `e` on one line ("what failed: why"), without a backtrace: these are user errors. A
+/// cause that its parent's message already quotes is not repeated.
+fn one_line(e: &anyhow::Error) -> String {
+    let mut line = String::new();
+    for cause in e.chain() {
+        let text = cause.to_string();
+        if !line.contains(&text) {
+            if !line.is_empty() {
+                line.push_str(": ");
+            }
+            line.push_str(&text);
+        }
+    }
+    line
 }
 
 fn contact(pairs: &std::path::Path, out: Option<&std::path::Path>) -> Result<()> {
@@ -120,7 +132,7 @@ fn stdout_is_regular_file() -> bool {
 }
 
 /// Options of `polydem run`.
-#[derive(clap::Args)]
+#[derive(clap::Args, Clone)]
 struct RunArgs {
     /// The scene file (TOML); omit it with --restart.
     #[arg(required_unless_present = "restart", conflicts_with = "restart")]
@@ -163,8 +175,33 @@ struct RunArgs {
 }
 
 fn run(args: &RunArgs) -> Result<()> {
+    let (mut sim, origin, start) = load_run(args)?;
+    let mut outputs = run_outputs(args, &sim, &start)?;
+    if !args.quiet {
+        eprintln!("{}", run_header(&origin, &sim));
+    }
+    let bar = progress_bar(args.quiet, &origin, &sim)?;
+    let start_step = origin.start_step;
+    let shown = bar.clone();
+    outputs.on_progress(move |n| shown.set_position(n - start_step));
+    let summary = sim
+        .run_observed(&mut outputs)
+        .with_context(|| format!("running {}", origin.source))?;
+    let record = outputs.finish()?;
+    bar.finish_and_clear();
+    write_summaries(args, &origin, &sim, &summary, &record, "")
+}
+
+/// The simulation `polydem run` continues or starts, where it comes from, and how its outputs start.
+fn load_run(
+    args: &RunArgs,
+) -> Result<(
+    polydem::scene::Simulation,
+    polydem::io::run_summary::RunOrigin,
+    polydem::io::run_outputs::RunStart,
+)> {
     use polydem::io::run_outputs::RunStart;
-    use polydem::io::run_summary::{summary_json, summary_text, RunOrigin};
+    use polydem::io::run_summary::RunOrigin;
 
     let (mut sim, source, run) = match (&args.restart, &args.scene) {
         (Some(file), _) => {
@@ -188,36 +225,33 @@ fn run(args: &RunArgs) -> Result<()> {
         sim.set_end_time_within(t, limit)
             .with_context(|| format!("--end-time {t}"))?;
     }
-    let restarted = matches!(run, RunStart::Restart { .. });
     let origin = RunOrigin {
         source,
-        restarted,
+        restarted: matches!(run, RunStart::Restart { .. }),
         start_step: sim.world.step_index(),
         start_time: sim.world.time(),
     };
-    let out_dir = args.out.as_path();
-    let mut outputs = run_outputs(args, &sim, &run)?;
-    if !args.quiet {
-        eprintln!("{}", run_header(&origin, &sim));
-    }
-    let bar = progress_bar(args.quiet, &origin, &sim)?;
-    let start_step = origin.start_step;
-    let shown = bar.clone();
-    outputs.on_progress(move |n| shown.set_position(n - start_step));
-    let summary = sim
-        .run_observed(&mut outputs)
-        .with_context(|| format!("running {}", origin.source))?;
-    let record = outputs.finish()?;
-    bar.finish_and_clear();
+    Ok((sim, origin, run))
+}
 
-    let text = summary_text(&origin, &sim, &summary, &record);
+/// Prints the run summary (with `extra` lines after it) and writes `summary.txt` and `summary.json`.
+fn write_summaries(
+    args: &RunArgs,
+    origin: &polydem::io::run_summary::RunOrigin,
+    sim: &polydem::scene::Simulation,
+    summary: &polydem::scene::RunSummary,
+    record: &polydem::io::run_summary::OutputRecord,
+    extra: &str,
+) -> Result<()> {
+    use polydem::io::run_summary::{summary_json, summary_text};
+    let text = summary_text(origin, sim, summary, record) + extra;
     print!("{text}");
     let write = |name: &str, contents: &str| -> Result<()> {
-        let path = out_dir.join(name);
+        let path = args.out.join(name);
         std::fs::write(&path, contents).with_context(|| format!("cannot write {}", path.display()))
     };
     write("summary.txt", &text)?;
-    let json = summary_json(&origin, &sim, &summary, &record);
+    let json = summary_json(origin, sim, summary, record);
     write(
         "summary.json",
         &(serde_json::to_string_pretty(&json)? + "\n"),

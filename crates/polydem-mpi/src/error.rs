@@ -13,10 +13,9 @@ pub enum DistributedError {
         /// Bodies in the world.
         bodies: usize,
     },
-    /// The world's loads were already evaluated (a restored checkpoint): its broad phase was built at
-    /// positions the parts cannot know, so they could not rebuild when one process would.
-    #[error("a distributed run starts from a fresh scene (restarting a checkpoint on several ranks is not supported yet)")]
-    NotFresh,
+    /// The parameters let bodies fall asleep: the parts' sleeping sets would not be one process's.
+    #[error("sleeping is not supported on several ranks (set sleeping off in the scene)")]
+    Sleeping,
     /// A body moved farther between two list rebuilds than the ghost layer allows for.
     #[error(
         "body moved {moved} m since the subdomains were cut, more than the {allowance} m the ghost layer \

@@ -45,6 +45,8 @@ pub struct RunTraffic {
     pub cuts: Traffic,
     /// The bodies gathered for the caller (outputs, checks).
     pub gathers: Traffic,
+    /// What rank 0 received from the other ranks for the outputs ([`gather_to_root`]; zero elsewhere).
+    pub received_at_root: Traffic,
 }
 
 /// Appends body `body`'s state with its loads to `out`.
@@ -123,6 +125,43 @@ pub fn all_gather<T: Serialize + DeserializeOwned>(
             })
         })
         .collect()
+}
+
+/// Gathers `value` from every rank on rank 0, in rank order (`None` on the other ranks); `traffic` counts
+/// what this rank sent, `received` what rank 0 received.
+pub fn gather_to_root<T: Serialize + DeserializeOwned>(
+    comm: &SimpleCommunicator,
+    value: &T,
+    traffic: &mut Traffic,
+    received: &mut Traffic,
+) -> Result<Option<Vec<T>>, DistributedError> {
+    let bytes = postcard::to_allocvec(value).expect("encoding to memory does not fail");
+    let root = comm.process_at_rank(0);
+    if comm.rank() != 0 {
+        root.gather_into(&(bytes.len() as Count));
+        root.gather_varcount_into(&bytes[..]);
+        traffic.bytes += bytes.len() as u64;
+        traffic.messages += 1;
+        return Ok(None);
+    }
+    let mut counts = vec![0 as Count; comm.size() as usize];
+    root.gather_into_root(&(bytes.len() as Count), &mut counts[..]);
+    let mut all = vec![0u8; counts.iter().map(|&c| c as usize).sum()];
+    received.bytes += (all.len() - bytes.len()) as u64;
+    received.messages += counts.len() as u64 - 1;
+    let displs = displacements(&counts);
+    root.gather_varcount_into_root(
+        &bytes[..],
+        &mut PartitionMut::new(&mut all[..], counts.clone(), displs.clone()),
+    );
+    let decoded = (0..counts.len()).map(|q| {
+        let (start, len) = (displs[q] as usize, counts[q] as usize);
+        postcard::from_bytes(&all[start..start + len]).map_err(|e| DistributedError::Decode {
+            rank: q,
+            message: e.to_string(),
+        })
+    });
+    decoded.collect::<Result<Vec<T>, _>>().map(Some)
 }
 
 fn displacements(counts: &[Count]) -> Vec<Count> {

@@ -18,20 +18,52 @@
 //!   process. After a rebuild the parts are cut again (migration) with the contact entries (tangential
 //!   springs, solver caches) taken from the rank that owns the pair's lower body.
 //!
+//! - **Restarts** ([`DistributedRun::new`]): a world restored from a checkpoint (written by any number of
+//!   ranks: the format is one) is cut at the centres its broad phase was built at, as if the cut had
+//!   happened at that build, and each part takes the whole list restricted to its bodies; the rebuild
+//!   decision and the ghost allowance then count the moves since that build, as one process does.
+//! - **Outputs** ([`observed`]): rank 0 holds the whole [`Simulation`](polydem::scene::Simulation) and
+//!   hands it to the engine's observer (CSV series, checkpoints, contact network) at the steps it asks
+//!   for, after every rank sent it its owned bodies ([`gather`]); for a checkpoint also the contact entries
+//!   and the whole broad phase, rebuilt on rank 0 from the positions and walls of the last cut (the list
+//!   is a function of them) with the build count the parts keep. VTK frames are parallel pieces
+//!   ([`pieces`]). `polydem run` takes this path under `mpirun` with more than one rank (feature `mpi` of
+//!   `polydem-cli`).
+//!
+//! # What is bitwise
+//! On any number of ranks, equal to one process: every body's state and loads, `bodies.csv`, the walls'
+//! forces (`walls.csv`, summed on rank 0 from the touching body–wall entries in key order, as the step
+//! sums them), the VTK pieces' data body by body, and a checkpoint's bodies, loads per body, walls, clock,
+//! contact store and broad phase. A checkpoint saved on P ranks continues on Q ranks (or without MPI) to
+//! the bits of the uninterrupted run. A scene of spheres only, which one process runs on the flat sphere
+//! layout, has one difference of form: one process's checkpoint holds the layout's own lists (no broad
+//! phase, an entry per listed pair) where this one holds the general step's; the touching entries are
+//! equal and a restart from either gives the same bits.
+//!
 //! # Building and testing
 //! `cargo test --release -p polydem-mpi --features mpi` with `MPI_PKG_CONFIG=mpich` (rsmpi then links
 //! Debian's MPICH even where `mpicc` points at Open MPI); `tests/mpi_bits.rs` launches itself with
-//! `mpirun.mpich -n 1..4` and compares every body's state with one process's, bit for bit. `.ci/mpi.sh`
-//! installs the packages and runs it. Without the feature the crate builds its MPI-free parts only
-//! (decomposition, plan), so the workspace needs no MPI.
+//! `mpirun.mpich -n 1..4` and compares every body's state with one process's, bit for bit. The command
+//! line's test (`crates/polydem-cli/tests/cli_mpi.rs`, feature `mpi`) runs `polydem run` on 2 to 4 ranks
+//! and compares its files with one process's, restarts across rank counts, and stops a run whose rank 0
+//! fails. `.ci/mpi.sh` installs the packages and runs both. Without the feature the crate builds its
+//! MPI-free parts only (decomposition, plan), so the workspace needs no MPI.
 //!
 //! # Limits of this stage
-//! - A cut gathers the whole state on every rank (O(N) memory and traffic per rebuild); the per-step ghost
-//!   exchange is point to point in content (one all-to-all).
-//! - The time-step check, sleeping, and the energy ledger's sums are not distributed (the ledger of a part
-//!   counts its ghosts' contacts).
-//! - A rank whose step fails returns the error; the caller must abort the communicator (the others wait in
-//!   the next collective).
+//! - The energy ledger and the sums over contacts of an evaluation other than the walls' forces (elastic
+//!   potential, the step's work terms, external power) are those of rank 0's part (its ghosts' contacts
+//!   counted, the other parts' missing): `energy.csv` of a run on several ranks is not the whole world's,
+//!   and neither are those fields of its checkpoints. Making them whole needs each part to sum only the
+//!   pairs it answers for and a reduction per step (not in one process's order, so not bitwise).
+//! - Sleeping is refused ([`DistributedError::Sleeping`]); the time-step check does not run on the parts.
+//! - A cut gathers the whole state on every rank (O(N) memory and traffic per rebuild); an output step
+//!   gathers the owned bodies on rank 0 (O(N) there); the per-step ghost exchange is point to point in
+//!   content (one all-to-all).
+//! - A rank whose step or output fails returns the error; the caller aborts the communicator
+//!   (`polydem run` prints `rank R: error: …` and does), else the others wait in the next collective.
+//! - Subdomains by recursive bisection of the body centres never leave a rank without a body (P larger
+//!   than the bodies is refused, [`DistributedError::TooManyRanks`]); a body larger than its subdomain is
+//!   covered, since the ghost layer is sized by the largest bounding radius.
 
 pub mod decomposition;
 pub mod error;
@@ -41,6 +73,12 @@ pub mod plan;
 pub mod consensus;
 #[cfg(feature = "mpi")]
 pub mod exchange;
+#[cfg(feature = "mpi")]
+pub mod gather;
+#[cfg(feature = "mpi")]
+pub mod observed;
+#[cfg(feature = "mpi")]
+pub mod pieces;
 #[cfg(feature = "mpi")]
 pub mod run;
 

@@ -13,7 +13,8 @@ use mpi::traits::*;
 use polydem::dynamics::RigidBody;
 use polydem::math::{Point, Real, Vector};
 use polydem::world::{
-    step, ContactKey, ContactState, StepParams, StepScratch, TimeStepCheck, World,
+    step, ContactKey, ContactState, PartBroadPhase, StepParams, StepReport, StepScratch,
+    TimeStepCheck, World,
 };
 
 use crate::consensus::Consensus;
@@ -22,51 +23,76 @@ use crate::exchange::{all_gather, all_to_all, pack_ghost, unpack_ghost, RunTraff
 use crate::plan::{Plan, MOVE_ALLOWANCE_IN_SKINS};
 
 /// This rank's part: the world it steps and what it exchanges.
-struct Part {
-    world: World,
-    scratch: StepScratch,
+pub(crate) struct Part {
+    pub(crate) world: World,
+    pub(crate) scratch: StepScratch,
     /// Global index of each local body (increasing).
-    ids: Vec<usize>,
+    pub(crate) ids: Vec<usize>,
     /// Whether each local body is owned here.
-    owned: Vec<bool>,
+    pub(crate) owned: Vec<bool>,
     /// Per rank, the local indices of the owned bodies it holds as ghosts.
-    sends: Vec<Vec<usize>>,
+    pub(crate) sends: Vec<Vec<usize>>,
     /// Per rank, the local indices of the ghosts it owns.
-    receives: Vec<Vec<usize>>,
-    consensus: Arc<Consensus>,
+    pub(crate) receives: Vec<Vec<usize>>,
+    pub(crate) consensus: Arc<Consensus>,
     /// Positions of the owned bodies at the cut.
-    at_cut: Vec<Point>,
+    pub(crate) at_cut: Vec<Point>,
 }
 
 /// A world stepped on every rank of `MPI_COMM_WORLD`.
 pub struct DistributedRun {
-    comm: SimpleCommunicator,
-    rank: usize,
+    pub(crate) comm: SimpleCommunicator,
+    pub(crate) rank: usize,
     /// The whole world as of the last cut (bodies, contacts); walls and clock taken from the part.
-    whole: World,
-    params: StepParams,
-    part: Part,
+    pub(crate) whole: World,
+    pub(crate) params: StepParams,
+    pub(crate) part: Part,
     /// What this rank sent so far (the agreements of the current part not yet added).
-    traffic: RunTraffic,
+    pub(crate) traffic: RunTraffic,
     /// Cuts so far (the first included).
     pub cuts: u64,
+    /// Whether `whole`'s broad phase is the whole world's list (a restored world until its first rebuild);
+    /// else the list is the one built at `whole`'s positions and walls (those of the last cut).
+    pub(crate) whole_list_held: bool,
 }
 
 impl DistributedRun {
-    /// Splits `world` (fresh: its loads not yet evaluated, as a scene builds it) over the ranks. Every rank
-    /// passes the same world and parameters. The time-step check is not run on the parts (it reads the
-    /// state only, so one process's bits do not depend on it).
+    /// Splits `world` over the ranks: a fresh one (its loads not yet evaluated, as a scene builds it) or
+    /// one restored from a checkpoint (its loads and broad phase those one process had). Every rank passes
+    /// the same world and parameters. The time-step check is not run on the parts (it reads the state
+    /// only, so one process's bits do not depend on it).
+    ///
+    /// A restored world is cut at the centres its broad phase was built at, as if the cut had happened at
+    /// that build, and each part takes the whole list restricted to its bodies: the parts then rebuild
+    /// when one process would, and the ghost allowance counts the moves since that build. A restored world
+    /// without a list (saved from the flat sphere layout, which keeps lists of its own) is cut at its
+    /// positions, and its first step builds the lists, as one process's does.
     pub fn new(world: World, params: StepParams) -> Result<Self, DistributedError> {
-        if world.loads().is_current() {
-            return Err(DistributedError::NotFresh);
-        }
         let comm = SimpleCommunicator::world();
         let rank = comm.rank() as usize;
         let params = StepParams {
             time_step_check: TimeStepCheck::Off,
             ..params
         };
-        let part = cut(&comm, &world, false)?;
+        if params.sleeping.enabled {
+            return Err(DistributedError::Sleeping);
+        }
+        let restored = world.loads().is_current();
+        let list = world.broad_phase();
+        let built = list.rebuilds() > 0 && list.centres_at_build().len() == world.body_count();
+        let part = if restored && built {
+            cut(
+                &comm,
+                &world,
+                list.centres_at_build(),
+                PartBroadPhase::Restrict,
+            )?
+        } else {
+            // A fresh world, or a restored one without a list (saved from a layout with lists of its
+            // own): the next step builds the list, in one process as in every part.
+            let centres: Vec<Point> = world.bodies().iter().map(|b| b.position).collect();
+            cut(&comm, &world, &centres, PartBroadPhase::Unbuilt)?
+        };
         Ok(Self {
             comm,
             rank,
@@ -75,6 +101,7 @@ impl DistributedRun {
             part,
             traffic: RunTraffic::default(),
             cuts: 1,
+            whole_list_held: restored,
         })
     }
 
@@ -89,6 +116,24 @@ impl DistributedRun {
         (owned, self.part.owned.len() - owned)
     }
 
+    /// The communicator the run steps on.
+    pub fn communicator(&self) -> &SimpleCommunicator {
+        &self.comm
+    }
+
+    /// This rank's part of the world (owned bodies and ghosts, numbered in global order).
+    pub fn part_world(&self) -> &World {
+        &self.part.world
+    }
+
+    /// The bodies this rank owns, as a VTK piece labelled by their global indices.
+    pub fn owned_piece(&self) -> polydem::io::vtk::BodyPiece {
+        let owned = (0..self.part.ids.len()).filter(|&i| self.part.owned[i]);
+        let bodies: Vec<usize> = owned.collect();
+        let labels = bodies.iter().map(|&i| self.part.ids[i]).collect();
+        polydem::io::vtk::BodyPiece { bodies, labels }
+    }
+
     /// What this rank sent so far, by kind.
     pub fn traffic(&self) -> RunTraffic {
         let mut traffic = self.traffic;
@@ -96,10 +141,11 @@ impl DistributedRun {
         traffic
     }
 
-    /// One step of the whole world.
-    pub fn step(&mut self) -> Result<(), DistributedError> {
+    /// One step of the whole world; the report is that of this rank's part (its counters count the part's
+    /// work, ghosts included).
+    pub fn step(&mut self) -> Result<StepReport, DistributedError> {
         let part = &mut self.part;
-        step(&self.params, &mut part.world, &mut part.scratch).map_err(|source| {
+        let report = step(&self.params, &mut part.world, &mut part.scratch).map_err(|source| {
             DistributedError::Step {
                 rank: self.rank,
                 source,
@@ -107,11 +153,11 @@ impl DistributedRun {
         })?;
         if part.consensus.last_rebuilt() {
             self.check_moves()?;
-            self.recut()
+            self.recut()?;
         } else {
             self.exchange_ghosts();
-            Ok(())
         }
+        Ok(report)
     }
 
     /// Every body of the whole world in global order (on every rank).
@@ -198,7 +244,11 @@ impl DistributedRun {
         let touched = self.part.world.contacts().last_touched();
         self.whole.replace_contacts(entries, touched);
         self.traffic.agreements += self.part.consensus.traffic();
-        self.part = cut(&self.comm, &self.whole, true)?;
+        let rebuilds = self.part.world.broad_phase().rebuilds();
+        let centres: Vec<Point> = self.whole.bodies().iter().map(|b| b.position).collect();
+        let built = PartBroadPhase::Build { rebuilds };
+        self.part = cut(&self.comm, &self.whole, &centres, built)?;
+        self.whole_list_held = false;
         self.cuts += 1;
         Ok(())
     }
@@ -224,7 +274,7 @@ fn owned_bodies(part: &Part) -> Vec<OwnedBody> {
 /// The part's contact entries this rank answers for, with global keys: a body pair where it owns the body
 /// of lower index, a body–wall pair where it owns the body. Every pair of the whole list is computed,
 /// with its full history, on the rank that owns its lower body.
-fn authoritative_contacts(part: &Part) -> Vec<(ContactKey, ContactState)> {
+pub(crate) fn authoritative_contacts(part: &Part) -> Vec<(ContactKey, ContactState)> {
     let store = part.world.contacts();
     let global = |i: u32| part.ids[i as usize] as u32;
     store
@@ -250,15 +300,16 @@ fn authoritative_contacts(part: &Part) -> Vec<(ContactKey, ContactState)> {
         .collect()
 }
 
-/// This rank's part of `whole` cut by the plan of its positions.
+/// This rank's part of `whole` cut by the plan of `centres` (the positions of the whole world's last list
+/// build), with its broad phase as `broad_phase` says.
 fn cut(
     comm: &SimpleCommunicator,
     whole: &World,
-    build_broad_phase: bool,
+    centres: &[Point],
+    broad_phase: PartBroadPhase,
 ) -> Result<Part, DistributedError> {
     let (rank, size) = (comm.rank() as usize, comm.size() as usize);
-    let centres: Vec<Point> = whole.bodies().iter().map(|b| b.position).collect();
-    let plan = Plan::new(&centres, whole.radii(), whole.broad_phase().skin(), size)?;
+    let plan = Plan::new(centres, whole.radii(), whole.broad_phase().skin(), size)?;
     let ids = plan.parts[rank].clone();
     let local = |gid: &usize| ids.binary_search(gid).expect("held by the plan");
     let to_local = |lists: Vec<Vec<usize>>| -> Vec<Vec<usize>> {
@@ -274,7 +325,7 @@ fn cut(
     let consensus = Arc::new(Consensus::new(owned.clone()));
     let mut scratch = StepScratch::default();
     scratch.set_rebuild_consensus(Some(consensus.clone()));
-    let world = whole.part(&ids, build_broad_phase);
+    let world = whole.part(&ids, broad_phase);
     let at_cut = (0..ids.len())
         .filter(|&i| owned[i])
         .map(|i| centres[ids[i]])

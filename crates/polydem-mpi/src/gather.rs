@@ -1,0 +1,109 @@
+//! The whole world's state gathered on rank 0 for outputs: every owned body's state and loads (19 numbers,
+//! as in the ghost exchange), the
+//! touching body–wall entries (the walls' forces are summed from them on rank 0, in the order and with
+//! the bits of one process's step), and, for an output that reads them (a checkpoint), the whole contact
+//! store and broad phase as one process holds them.
+//!
+//! The contact entries come from the ranks that answer for them (a body pair from the owner of its lower
+//! body, a body–wall pair from the body's owner), in key order. The whole broad phase is a function of the
+//! centres, radii and walls at its last build, which are those of the last cut: rank 0 rebuilds it from
+//! them when asked, with the build count the parts kept in step (a restored world's list is held as
+//! restored until its first rebuild).
+
+use polydem::math::{Real, Vector};
+use polydem::world::broad_phase::BroadPhase;
+use polydem::world::{ContactKey, World};
+
+use crate::error::DistributedError;
+use crate::exchange::{gather_to_root, pack_ghost, unpack_ghost, GHOST_WORDS};
+use crate::run::{authoritative_contacts, DistributedRun, Part};
+
+impl DistributedRun {
+    /// Collective: gathers the whole state on rank 0 and writes it into `world` there (the whole world
+    /// this run was started from, or a copy of it; `None` on the other ranks): the bodies with their loads,
+    /// the walls, the clock, and with `contacts` the contact store and the broad phase.
+    pub fn gather_into(
+        &mut self,
+        world: Option<&mut World>,
+        contacts: bool,
+    ) -> Result<(), DistributedError> {
+        let entries = authoritative_contacts(&self.part);
+        let touching_walls: Vec<(ContactKey, Vector)> = entries
+            .iter()
+            .filter(|(key, state)| matches!(key, ContactKey::Wall { .. }) && state.is_active())
+            .map(|(key, state)| (*key, state.force_on_b))
+            .collect();
+        let entries = if contacts { entries } else { Vec::new() };
+        let (ids, states) = owned_states(&self.part);
+        let mine = (ids, states, touching_walls, entries);
+        let traffic = &mut self.traffic;
+        let all = gather_to_root(
+            &self.comm,
+            &mine,
+            &mut traffic.gathers,
+            &mut traffic.received_at_root,
+        )?;
+        let (Some(world), Some(all)) = (world, all) else {
+            return Ok(());
+        };
+        world.copy_walls_and_clock(&self.part.world);
+        let (mut store, mut walls) = (Vec::new(), Vec::new());
+        for (ids, states, touching_walls, entries) in all {
+            for (&gid, w) in ids.iter().zip(states.chunks_exact(GHOST_WORDS)) {
+                let (body, force, torque) = unpack_ghost(&world.bodies()[gid as usize], w);
+                world.copy_body_from_owner(gid as usize, &body, &force, &torque);
+            }
+            walls.extend(touching_walls);
+            store.extend(entries);
+        }
+        walls.sort_by_key(|entry| entry.0);
+        world.replace_wall_forces(wall_forces(&walls, world.walls().len()));
+        if contacts {
+            store.sort_by_key(|entry| entry.0);
+            let touched = self.part.world.contacts().last_touched();
+            world.replace_contacts(store, touched);
+            world.set_broad_phase(self.whole_list().clone());
+        }
+        Ok(())
+    }
+
+    /// The whole world's broad phase as one process holds it now.
+    fn whole_list(&mut self) -> &BroadPhase {
+        if !self.whole_list_held {
+            let rebuilds = self.part.world.broad_phase().rebuilds();
+            self.whole.rebuild_broad_phase_as(rebuilds);
+            self.whole_list_held = true;
+        }
+        self.whole.broad_phase()
+    }
+}
+
+/// The contact force on each of `walls` walls: the opposite of the force on the body of every touching
+/// body–wall entry (`touching`, in key order), summed from zero in that order as the step sums them.
+fn wall_forces(touching: &[(ContactKey, Vector)], walls: usize) -> Vec<Vector> {
+    let mut forces = vec![Vector::zeros(); walls];
+    for (key, force_on_b) in touching {
+        if let ContactKey::Wall { wall, .. } = key {
+            forces[*wall as usize] -= force_on_b;
+        }
+    }
+    forces
+}
+
+/// The global indices of the bodies `part` owns and their states and loads, packed as the ghost exchange
+/// packs them (the mass properties and motion, which do not change, stay behind).
+fn owned_states(part: &Part) -> (Vec<u32>, Vec<Real>) {
+    let (bodies, loads) = (part.world.bodies(), part.world.loads());
+    let owned: Vec<usize> = (0..part.ids.len()).filter(|&i| part.owned[i]).collect();
+    let mut states = Vec::with_capacity(owned.len() * GHOST_WORDS);
+    for &i in &owned {
+        pack_ghost(
+            &bodies[i],
+            &loads.forces()[i],
+            &loads.torques()[i],
+            &mut states,
+        );
+    }
+    let ids = owned.iter().map(|&i| part.ids[i] as u32).collect();
+    (ids, states)
+}
