@@ -27,7 +27,10 @@ pub fn calibrations<'a>(
          T(P, N) per step, for an interior rank of n = N/P bodies in a near-cubic subdomain of side \
          a = n^(1/3) spacings with a ghost layer w spacings wide (g = (a + 2w)³ − a³ ghosts, 26 \
          neighbours), α–β messages (`polydem_mpi::scaling::model`):\n\n\
-         - compute t_c (n + g): the ghosts are stepped with the owned bodies;\n\
+         - compute t_c (n + g): the ghosts are stepped with the owned bodies (their pairs with \
+         each other included, work a halo that only evaluates pairs with owned bodies would not do: an \
+         upper bound, and the term that limits the neighbour-only efficiency below, since w is \
+         2 r_max + 4 skins wide);\n\
          - ghost exchange 26 α + 152 g/β;\n\
          - rebuild agreement: today an all-gather of 4 f64 per rank, ⌈log₂P⌉ α + 32 (P − 1)/β;\n\
          - a cut every k steps. **Today every rank gathers the whole world at a cut** and plans every \
@@ -43,9 +46,8 @@ pub fn calibrations<'a>(
          cores step a body as fast as this machine's, and its interconnect has α = {:.1} µs and \
          β = {:.0} GB/s — MPI over EDR/HDR InfiniBand (link rates 100/200 Gb/s = 12.5/25 GB/s; a \
          published osu_latency sample shows 1.3 µs for 8 B: QLogic InfiniPath user guide, benchmark 1, \
-         <https://manualsdump.com/en/manuals/q-logic-ib6054601-00_d/125031/66>); a range of 1–2 µs \
-         and 10–25 GB/s moves the efficiencies below by a few points at most, as the halo's bytes are \
-         small beside its compute.\n\n\
+         <https://manualsdump.com/en/manuals/q-logic-ib6054601-00_d/125031/66>); the comparison with exaDEM \
+         below gives the spread over 1–2 µs and 10–25 GB/s.\n\n\
          | scene | t_c (µs/body-step) | t_cut (µs/body) | k (steps/cut) | b (B/body) | w (spacings) | t_plan (ns/body/rank) | model T₂ on loopback (ms/step) | measured T₂ (ms/step) | status of T₂ |\n\
          |---|---|---|---|---|---|---|---|---|---|",
         CLUSTER.latency_s * 1e6,
@@ -130,6 +132,32 @@ fn extrapolation_table(page: &mut String, scene: &str, cal: &Calibration) {
         "\nE: strong-scaling efficiency relative to {} ranks, T(64)·64 / (T(P)·P).\n",
         CLUSTER_RANKS[0]
     );
+    weak_table(page, cal);
+}
+
+/// Bodies per rank of the weak-scaling extrapolation (10⁸ bodies on 4096 ranks).
+const WEAK_PER_RANK: f64 = 1e8 / 4096.0;
+
+fn weak_table(page: &mut String, cal: &Calibration) {
+    let _ = writeln!(
+        page,
+        "Weak scaling at {WEAK_PER_RANK:.0} bodies per rank (10⁸ on 4096 ranks), E = T(1, n)/T(P, nP):\n\n\
+         | P | N | E today | E neighbour-only |\n|---|---|---|---|"
+    );
+    let e = |p: usize, m| {
+        let one = step_cost(cal, &CLUSTER, WEAK_PER_RANK, 1, m).total();
+        one / step_cost(cal, &CLUSTER, WEAK_PER_RANK * p as f64, p, m).total()
+    };
+    for p in CLUSTER_RANKS {
+        let _ = writeln!(
+            page,
+            "| {p} | {:.2e} | {:.1} % | {:.0} % |",
+            WEAK_PER_RANK * p as f64,
+            100.0 * e(p, Migration::WholeWorld),
+            100.0 * e(p, Migration::Neighbours)
+        );
+    }
+    let _ = writeln!(page);
 }
 
 /// The extrapolation tables, the plot, and the comparison with exaDEM.
@@ -184,12 +212,31 @@ pub fn model(
     Ok(())
 }
 
+/// The least and greatest of `f` over the corners of the interconnect range (1–2 µs, 10–25 GB/s).
+fn over_networks(f: impl Fn(&Network) -> f64) -> (f64, f64) {
+    let corners = [(1e-6, 10e9), (1e-6, 25e9), (2e-6, 10e9), (2e-6, 25e9)];
+    corners
+        .iter()
+        .map(|&(latency_s, bandwidth)| {
+            f(&Network {
+                latency_s,
+                bandwidth,
+            })
+        })
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
+            (lo.min(v), hi.max(v))
+        })
+}
+
 fn exadem(page: &mut String, poly: &Calibration) {
     let e = |m| strong_efficiency(poly, &CLUSTER, EXADEM_BODIES, 64, 2048, m);
+    let spread = |m| over_networks(|net| strong_efficiency(poly, net, EXADEM_BODIES, 64, 2048, m));
+    let (whole, local) = (spread(Migration::WholeWorld), spread(Migration::Neighbours));
     let _ = writeln!(
         page,
         "![strong-scaling efficiency](mpi/strong_efficiency.svg)\n\n\
-         Data: [mpi/strong_efficiency.csv](mpi/strong_efficiency.csv).\n\n\
+         Data: [mpi/strong_efficiency.csv](mpi/strong_efficiency.csv). The two \"today\" curves \
+         coincide: the whole-world cut, the same for any N per rank, dominates both.\n\n\
          ## Against exaDEM\n\n\
          exaDEM's polyhedra benchmark (\"Blade\", 1,651,637 polyhedra, 10,000 steps, MPI + OpenMP on \
          the Skylake nodes of CCRT-IRENE up to 16,384 cores, best with 24 OpenMP threads per MPI \
@@ -201,7 +248,7 @@ fn exadem(page: &mut String, poly: &Calibration) {
          used **as stated in the issue**.\n\n\
          The model for the same number of polyhedra (our cubes' per-body cost), 64 → 2048 ranks of \
          one thread: **{:.0} %** with today's whole-world cut, **{:.0} %** with a neighbour-only \
-         migration. The comparison is on paper: exaDEM's bodies are more costly polyhedra (more \
+         migration ({:.0}–{:.0} % and {:.0}–{:.0} % over α = 1–2 µs, β = 10–25 GB/s). The comparison is on paper: exaDEM's bodies are more costly polyhedra (more \
          compute per body hides more communication), its ranks are 24-thread processes (fewer, \
          larger subdomains: a smaller halo per core), and our per-body cost is this machine's.\n\n\
          **What the model says about today's code.** The ghost exchange and the compute on ghosts \
@@ -213,5 +260,9 @@ fn exadem(page: &mut String, poly: &Calibration) {
         100.0 * EXADEM_EFFICIENCY,
         100.0 * e(Migration::WholeWorld),
         100.0 * e(Migration::Neighbours),
+        100.0 * whole.0,
+        100.0 * whole.1,
+        100.0 * local.0,
+        100.0 * local.1,
     );
 }

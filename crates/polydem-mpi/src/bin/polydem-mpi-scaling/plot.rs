@@ -1,4 +1,4 @@
-//! A line plot with a logarithmic x axis, rendered to SVG with plotters (no font feature: text is written
+//! A line plot with a base-2 logarithmic x axis (rank counts), rendered to SVG with plotters (no font feature: text is written
 //! as SVG `<text>`, so the output does not depend on the system's fonts), and the CSV behind it.
 
 use std::path::Path;
@@ -23,7 +23,7 @@ const COLORS: [RGBColor; 6] = [
     RGBColor(0, 0, 0),
 ];
 
-/// Writes `stem.svg` and `stem.csv` (series,x,y) for `series` against log10 x.
+/// Writes `stem.svg` and `stem.csv` (series,x,y) for `series` against log2 x.
 pub fn write(
     stem: &Path,
     title: &str,
@@ -33,7 +33,7 @@ pub fn write(
 ) -> Result<(), Error> {
     let xs = series
         .iter()
-        .flat_map(|s| s.points.iter().map(|p| p.0.log10()));
+        .flat_map(|s| s.points.iter().map(|p| p.0.log2()));
     let (x_lo, x_hi) = xs.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), x| {
         (lo.min(x), hi.max(x))
     });
@@ -55,11 +55,19 @@ pub fn write(
             .configure_mesh()
             .x_desc(x_label)
             .y_desc(y_label)
-            .x_label_formatter(&|v| format!("{:.0}", 10f64.powf(*v)))
+            .x_labels((x_hi - x_lo).round() as usize + 1)
+            .x_label_formatter(&|v| {
+                // Labels at the powers of two only.
+                if (v - v.round()).abs() < 1e-6 {
+                    format!("{:.0}", 2f64.powf(v.round()))
+                } else {
+                    String::new()
+                }
+            })
             .draw()?;
         for (k, s) in series.iter().enumerate() {
             let color = COLORS[k % COLORS.len()];
-            let points: Vec<(f64, f64)> = s.points.iter().map(|&(x, y)| (x.log10(), y)).collect();
+            let points: Vec<(f64, f64)> = s.points.iter().map(|&(x, y)| (x.log2(), y)).collect();
             let drawn = if s.markers_only {
                 chart.draw_series(
                     points
