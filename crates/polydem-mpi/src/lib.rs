@@ -68,6 +68,7 @@
 pub mod decomposition;
 pub mod error;
 pub mod plan;
+pub mod scaling;
 
 #[cfg(feature = "mpi")]
 pub mod consensus;
