@@ -1,0 +1,135 @@
+//! The impact split over the ranks of an MPI job (feature `mpi`): [`polydem_mpi::DistributedRun`] steps
+//! the world, each rank the bodies of its subdomain and their ghosts, with the bits of one process.
+//!
+//! # What every rank sees
+//! The monitor row is a function of the projectile alone (its state, its contact force, the rocks pressing
+//! on it), so the rank that owns the projectile computes it on its part, whose contact store holds every
+//! pair of the projectile as one process's does, and hands it with the projectile's body to every rank:
+//! every row, the snapshots' timing and the end of the run are one process's bit for bit. The whole world
+//! (snapshots, the state at the end) is gathered from the owners of its bodies and contacts.
+//!
+//! # Limits
+//! - Sleeping is refused (the parts do not carry the sleep state), and so are VTK frames (their schedule
+//!   would need a gather on every rank; not written yet).
+//! - The energy ledger's sums are not distributed: the report's ledger terms are NaN.
+//! - The step counters are those of this rank's part (they include its ghosts' pairs); the largest overlap
+//!   and the steps with overlap warnings are reduced over the ranks (a pair is evaluated, at one
+//!   process's state, on every rank that holds it).
+//! - A step that fails on one rank leaves the others waiting in the next collective: the caller aborts the
+//!   job (`MPI_Abort`) on an error.
+
+use mpi::collective::SystemOperation;
+use mpi::topology::SimpleCommunicator;
+use mpi::traits::*;
+use polydem::dynamics::RigidBody;
+use polydem::math::Real;
+use polydem::scene::Simulation;
+use polydem_mpi::{mpi, DistributedRun};
+
+use super::monitors::{MonitorRow, ProjectileGauge};
+use super::penetration::PenetrationError;
+use super::stepper::{ImpactStepper, RankFacts, StepFacts};
+
+/// This process's rank in `MPI_COMM_WORLD` (MPI initialised by the caller).
+pub fn rank() -> usize {
+    SimpleCommunicator::world().rank() as usize
+}
+
+/// The run split over the ranks, and the whole run as of the last gather.
+pub(crate) struct DistributedStepper {
+    run: DistributedRun,
+    whole: Simulation,
+    /// Σ over the steps of the bodies owned and held as ghosts after each, and the steps.
+    held: (usize, usize, usize),
+}
+
+impl DistributedStepper {
+    /// Splits `sim`'s world (every rank passes the same one) over the ranks.
+    pub fn new(sim: &Simulation) -> Result<Self, PenetrationError> {
+        if sim.params.sleeping.enabled {
+            return Err(PenetrationError::DistributedSleeping);
+        }
+        let run = DistributedRun::new(sim.world.clone(), sim.params)?;
+        Ok(Self {
+            run,
+            whole: sim.clone(),
+            held: (0, 0, 0),
+        })
+    }
+
+    /// This rank's facts so far.
+    pub fn facts(&self) -> RankFacts {
+        let traffic = self.run.traffic();
+        let (owned, ghosts, steps) = self.held;
+        let mean = |n: usize| n as Real / steps.max(1) as Real;
+        RankFacts {
+            rank: self.run.rank(),
+            ranks: SimpleCommunicator::world().size() as usize,
+            cuts: self.run.cuts,
+            mean_owned: mean(owned),
+            mean_ghosts: mean(ghosts),
+            ghost_bytes: traffic.ghosts.bytes,
+            agreement_bytes: traffic.agreements.bytes,
+            cut_bytes: traffic.cuts.bytes,
+            gather_bytes: traffic.gathers.bytes,
+        }
+    }
+
+    /// The whole run at the current state.
+    pub fn into_whole(mut self) -> Result<Simulation, PenetrationError> {
+        self.whole.world = self.run.gather_world()?;
+        Ok(self.whole)
+    }
+}
+
+impl ImpactStepper for DistributedStepper {
+    fn step(&mut self) -> Result<StepFacts, PenetrationError> {
+        let report = self.run.step()?;
+        let (owned, ghosts) = self.run.part_size();
+        self.held = (self.held.0 + owned, self.held.1 + ghosts, self.held.2 + 1);
+        // The deepest overlap and whether any rank warned, over the whole world.
+        let warned = if report.overlap_warnings.is_empty() {
+            0.0
+        } else {
+            1.0
+        };
+        let mine = [report.max_overlap_ratio, warned];
+        let mut all = [0.0; 2];
+        SimpleCommunicator::world().all_reduce_into(
+            &mine[..],
+            &mut all[..],
+            SystemOperation::max(),
+        );
+        Ok(StepFacts {
+            counters: report.counters,
+            max_overlap_ratio: all[0],
+            warned: all[1] != 0.0,
+        })
+    }
+
+    fn projectile(
+        &mut self,
+        gauge: &ProjectileGauge,
+    ) -> Result<(MonitorRow, RigidBody), PenetrationError> {
+        let measured = self.run.from_owner(gauge.index, |part, local| {
+            let on_part = ProjectileGauge {
+                index: local,
+                ..*gauge
+            };
+            (on_part.row(part), *part.body(local))
+        })?;
+        Ok(measured)
+    }
+
+    fn whole(&mut self) -> Result<&Simulation, PenetrationError> {
+        self.whole.world = self.run.gather_world()?;
+        Ok(&self.whole)
+    }
+
+    fn agree(&mut self, requested: bool) -> bool {
+        let mine = u8::from(requested);
+        let mut any = 0u8;
+        SimpleCommunicator::world().all_reduce_into(&mine, &mut any, SystemOperation::max());
+        any != 0
+    }
+}
