@@ -87,23 +87,10 @@ impl ImpactStepper for DistributedStepper {
         let report = self.run.step()?;
         let (owned, ghosts) = self.run.part_size();
         self.held = (self.held.0 + owned, self.held.1 + ghosts, self.held.2 + 1);
-        // The deepest overlap and whether any rank warned, over the whole world.
-        let warned = if report.overlap_warnings.is_empty() {
-            0.0
-        } else {
-            1.0
-        };
-        let mine = [report.max_overlap_ratio, warned];
-        let mut all = [0.0; 2];
-        SimpleCommunicator::world().all_reduce_into(
-            &mine[..],
-            &mut all[..],
-            SystemOperation::max(),
-        );
         Ok(StepFacts {
             counters: report.counters,
-            max_overlap_ratio: all[0],
-            warned: all[1] != 0.0,
+            max_overlap_ratio: report.max_overlap_ratio,
+            warned: !report.overlap_warnings.is_empty(),
         })
     }
 
@@ -124,6 +111,19 @@ impl ImpactStepper for DistributedStepper {
     fn whole(&mut self) -> Result<&Simulation, PenetrationError> {
         self.whole.world = self.run.gather_world()?;
         Ok(&self.whole)
+    }
+
+    /// Reduced once at the end of the run (not at every step: a collective per step costs on a loaded
+    /// machine).
+    fn overlaps(&mut self, max_overlap_ratio: Real, warned: &[bool]) -> (Real, u64) {
+        let world = SimpleCommunicator::world();
+        let mut largest = 0.0;
+        world.all_reduce_into(&max_overlap_ratio, &mut largest, SystemOperation::max());
+        let mine: Vec<u8> = warned.iter().map(|&w| u8::from(w)).collect();
+        let mut any = vec![0u8; mine.len()];
+        world.all_reduce_into(&mine[..], &mut any[..], SystemOperation::max());
+        let steps = any.iter().filter(|&&w| w != 0).count() as u64;
+        (largest, steps)
     }
 
     fn agree(&mut self, requested: bool) -> bool {

@@ -456,7 +456,7 @@ fn check_distributed(
 
 /// Whether this process writes the run's files: every process of a run in one, rank 0 of a run split
 /// over MPI ranks.
-fn writes_files(options: &PenetrationOptions) -> bool {
+pub fn writes_files(options: &PenetrationOptions) -> bool {
     #[cfg(feature = "mpi")]
     if options.distributed {
         return super::distributed::rank() == 0;
@@ -602,7 +602,8 @@ fn run_impact<S: ImpactStepper>(
     mut progress: impl FnMut(&MonitorRow),
 ) -> Result<ImpactRun, PenetrationError> {
     let mut counters = StepCounters::default();
-    let (mut steps, mut warned, mut max_overlap) = (0u64, 0u64, 0.0 as Real);
+    let (mut steps, mut max_overlap) = (0u64, 0.0 as Real);
+    let mut warned_steps = Vec::new();
     let mut snapshots = Vec::new();
     let mut pending: Vec<Real> = options.snapshot_tip_x.clone();
     pending.sort_by(|a, b| b.total_cmp(a));
@@ -618,9 +619,7 @@ fn run_impact<S: ImpactStepper>(
         counters.merge(&facts.counters);
         steps += 1;
         max_overlap = max_overlap.max(facts.max_overlap_ratio);
-        if facts.warned {
-            warned += 1;
-        }
+        warned_steps.push(facts.warned);
         let at = start_step + steps;
         let (row, body) = stepper.projectile(&gauge)?;
         outputs.monitors.push(row);
@@ -641,6 +640,7 @@ fn run_impact<S: ImpactStepper>(
     outputs.monitors.flush()?;
     outputs.others.finish()?;
     let rows = outputs.monitors.into_rows();
+    let (max_overlap, warned) = stepper.overlaps(max_overlap, &warned_steps);
     if !options.snapshot_tip_x.is_empty() {
         let last = rows.last().expect("at least one step");
         snapshots.push(snapshot(&stepper.whole()?.world, last.time, last.tip));

@@ -15,9 +15,9 @@ use polydem::world::{step, StepCounters, StepScratch};
 pub(crate) struct StepFacts {
     /// The step's stage timers and counters.
     pub counters: StepCounters,
-    /// The largest overlap / particle size at the end of the step.
+    /// The largest overlap / particle size at the end of the step (of the pairs this process evaluated).
     pub max_overlap_ratio: Real,
-    /// Whether some contact was deeper than the warning fraction.
+    /// Whether some contact (that this process evaluated) was deeper than the warning fraction.
     pub warned: bool,
 }
 
@@ -35,6 +35,9 @@ pub(crate) trait ImpactStepper {
     /// Whether to stop, given whether this process was asked to: every process of the run takes the
     /// same decision.
     fn agree(&mut self, requested: bool) -> bool;
+    /// The largest overlap ratio of the run and the number of steps with an overlap warning, from this
+    /// process's largest ratio and its flag of each step ([`StepFacts`]).
+    fn overlaps(&mut self, max_overlap_ratio: Real, warned: &[bool]) -> (Real, u64);
 }
 
 /// One rank's facts of a run split over MPI ranks.
@@ -95,5 +98,10 @@ impl ImpactStepper for LocalStepper<'_> {
 
     fn agree(&mut self, requested: bool) -> bool {
         requested
+    }
+
+    fn overlaps(&mut self, max_overlap_ratio: Real, warned: &[bool]) -> (Real, u64) {
+        let steps = warned.iter().filter(|&&w| w).count() as u64;
+        (max_overlap_ratio, steps)
     }
 }
