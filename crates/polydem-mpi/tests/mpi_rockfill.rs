@@ -75,7 +75,7 @@ fn launch() {
     );
     let file =
         std::env::temp_dir().join(format!("polydem_mpi_rockfill_{}.txt", std::process::id()));
-    std::fs::write(&file, expected_text(&expected.world.bodies(), &report.rows))
+    std::fs::write(&file, expected_text(expected.world.bodies(), &report.rows))
         .unwrap_or_else(|e| panic!("writing {}: {e}", file.display()));
 
     let exe = std::env::current_exe().expect("the test binary's path");
