@@ -828,3 +828,49 @@ pub fn check_penetration_steps(
     );
     within(config, "penetration", steps, dt, reason)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A run split over MPI ranks is refused before any work: without MPI in the build, and (with it)
+    /// when it would need what the ranks do not carry.
+    #[test]
+    fn a_distributed_run_is_refused_where_it_cannot_give_one_process_bits() {
+        let config = ExperimentConfig::quick();
+        let distributed = PenetrationOptions {
+            distributed: true,
+            ..Default::default()
+        };
+        let one_process = PenetrationOptions::default();
+        assert!(check_distributed(&config, &one_process).is_ok());
+        let refused = check_distributed(&config, &distributed);
+        if cfg!(not(feature = "mpi")) {
+            assert!(
+                matches!(refused, Err(PenetrationError::NoMpi)),
+                "without the mpi feature: {refused:?}, expected NoMpi"
+            );
+            return;
+        }
+        assert!(refused.is_ok(), "quick.toml split over ranks: {refused:?}");
+        let mut sleeping = config.clone();
+        sleeping.sleeping.penetration = true;
+        let refused = check_distributed(&sleeping, &distributed);
+        assert!(
+            matches!(refused, Err(PenetrationError::DistributedSleeping)),
+            "sleeping.penetration = true: {refused:?}, expected DistributedSleeping"
+        );
+        let frames = PenetrationOptions {
+            files: Some(PenetrationFiles {
+                vtk_every: Some(10),
+                ..PenetrationFiles::monitors_in("unused")
+            }),
+            ..distributed
+        };
+        let refused = check_distributed(&config, &frames);
+        assert!(
+            matches!(refused, Err(PenetrationError::DistributedFrames)),
+            "VTK frames every 10 steps: {refused:?}, expected DistributedFrames"
+        );
+    }
+}
