@@ -8,6 +8,22 @@
 //! every row, the snapshots' timing and the end of the run are one process's bit for bit. The whole world
 //! (snapshots, the state at the end) is gathered from the owners of its bodies and contacts.
 //!
+//! # The world it starts from
+//! A bed read from its checkpoint has its loads evaluated, which [`DistributedRun::new`] refuses; removing
+//! the left and right walls and adding the projectile (`add_projectile`) marks them stale, so the world the
+//! penetration starts from is fresh. One process's first step then evaluates the loads and rebuilds its
+//! broad phase (the body count changed), as every part's first step does (its broad phase is empty), and
+//! the packed contacts' tangential springs go to the parts with the world.
+//!
+//! # A projectile at 1200 m/s
+//! The subdomains are cut again at every broad-phase rebuild, which the projectile forces every few steps
+//! (it travels `impact.travel_per_step` = 2 % of a mean rock size per step in the experiment files, or
+//! less; the skin is 5 %). Between two cuts a body moves at most the skin plus one step's travel (the
+//! rebuild rule lets the two largest moves add up to the skin), so the ghost layer's allowance of 1.5
+//! skins holds while no body travels more than half the skin in a step: up to 1500 m/s with these
+//! values. A faster body stops the run with `HaloExceeded` at the next cut. The parts run
+//! without the time-step check (it reads the state only, so one process's bits do not depend on it).
+//!
 //! # Limits
 //! - Sleeping is refused (the parts do not carry the sleep state), and so are VTK frames (their schedule
 //!   would need a gather on every rank; not written yet).
