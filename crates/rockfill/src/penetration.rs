@@ -853,7 +853,7 @@ mod tests {
             return;
         }
         assert!(refused.is_ok(), "quick.toml split over ranks: {refused:?}");
-        let mut sleeping = config.clone();
+        let mut sleeping = config;
         sleeping.sleeping.penetration = true;
         let refused = check_distributed(&sleeping, &distributed);
         assert!(
