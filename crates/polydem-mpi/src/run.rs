@@ -341,3 +341,48 @@ fn cut(
         at_cut,
     })
 }
+
+/// What a caller reads of the whole run between steps: one body's facts from its owner, the whole world.
+impl DistributedRun {
+    /// `read(part, local)` evaluated on the rank that owns global body `gid` (`local`: the body's index in
+    /// that rank's part world, whose contact store holds every pair of the body, as one process's does),
+    /// handed to every rank bit for bit. One all-gather (counted with the gathers).
+    pub fn from_owner<T: serde::Serialize + serde::de::DeserializeOwned>(
+        &mut self,
+        gid: usize,
+        read: impl FnOnce(&World, usize) -> T,
+    ) -> Result<T, DistributedError> {
+        let part = &self.part;
+        let local = part.ids.binary_search(&gid).ok();
+        let mine = local
+            .filter(|&i| part.owned[i])
+            .map(|i| read(&part.world, i));
+        let all = all_gather(&self.comm, &mine, &mut self.traffic.gathers)?;
+        Ok(all
+            .into_iter()
+            .flatten()
+            .next()
+            .expect("every body is owned once"))
+    }
+
+    /// The whole world at the current step, on every rank: every body's state and loads from its owner,
+    /// every contact entry from the rank that answers for it, the walls and clock. The per-body state and
+    /// the contact store are one process's bit for bit; the energy ledger and the loads' sums (wall
+    /// forces, energy terms) are not distributed: they are this rank's part's.
+    pub fn gather_world(&mut self) -> Result<World, DistributedError> {
+        let mine = (owned_bodies(&self.part), authoritative_contacts(&self.part));
+        let all = all_gather(&self.comm, &mine, &mut self.traffic.gathers)?;
+        let mut whole = self.whole.clone();
+        whole.copy_walls_and_clock(&self.part.world);
+        let mut entries = Vec::new();
+        for (bodies, contacts) in all {
+            for (gid, body, force, torque) in bodies {
+                whole.copy_body_from_owner(gid, &body, &force, &torque);
+            }
+            entries.extend(contacts);
+        }
+        entries.sort_by_key(|entry| entry.0);
+        whole.replace_contacts(entries, self.part.world.contacts().last_touched());
+        Ok(whole)
+    }
+}

@@ -2,6 +2,7 @@
 //!
 //! ```text
 //! polydem rockfill [--config FILE | --full] [--size MM] [--seed N] [--bed DIR] [--out DIR] [--vtk-every N]
+//! mpirun -n P polydem rockfill --mpi [--config FILE | --full] [--bed DIR] [--out DIR]   (feature `mpi`)
 //! polydem rockfill study [--config FILE | --full] --sizes 100,130,175,200,290 --seeds 1,2,3
 //!                        [--section-sizes K] [--reuse-beds] --out DIR
 //! polydem rockfill convergence [--config FILE | --full] [--dt-divisors 1,2,4] [--sections 1.0,1.5,2.0]
@@ -17,6 +18,10 @@
 //! (`bed.pdck`, `bed_info.json`, `bed_*.csv`, when generated), `section.svg` (the paper's Fig. 7 picture)
 //! and `summary.txt` (also printed); with `--vtk-every N`, VTK frames of the penetration (`vtk/`, `*.pvd`),
 //! written by the engine's output as `polydem run` writes them.
+//!
+//! With `--mpi` (a build with the `mpi` feature, launched under `mpirun`) the penetration runs split over
+//! the job's ranks (the `distributed` module), with the bits of one process; rank 0 writes the files and
+//! prints the summary.
 //!
 //! `study` runs the size study ([`super::study`]); `convergence` the time-step and rock-count sequences
 //! ([`super::convergence`]); `sensitivity` the one-at-a-time contact-parameter runs from one bed
@@ -53,6 +58,11 @@ pub struct RockfillArgs {
     /// step index that is a multiple of N (zlib-compressed binary, as `polydem run`).
     #[arg(long, value_name = "N")]
     pub vtk_every: Option<u64>,
+    /// Run the penetration split over the ranks of the MPI job this process is launched in
+    /// (`mpirun -n P polydem rockfill --mpi …`; a build with the `mpi` feature): the same bits as one
+    /// process; rank 0 writes the files and the summary. Without `--bed` every rank packs the same bed.
+    #[arg(long, conflicts_with = "vtk_every")]
+    pub mpi: bool,
 }
 
 /// The sample: the file's mean rock size and seed, or these (for a run from a saved bed, the bed's: the
@@ -241,9 +251,60 @@ pub fn run(args: &RockfillArgs) -> Result<()> {
         ..PenetrationFiles::monitors_in(&args.out)
     };
     let bed = args.bed.as_deref();
+    if args.mpi {
+        return run_mpi(&config, files, bed, &title);
+    }
     let result = run_one_with_files(&config, files, bed, &title, None, &mut progress)?;
     print!("{}", summary(&config, &result));
     Ok(())
+}
+
+/// `--mpi`: the experiment on every rank of the MPI job, its penetration split over them; rank 0
+/// reports. A rank that fails aborts the job (the others would wait for it in the next exchange).
+#[cfg(feature = "mpi")]
+fn run_mpi(
+    config: &ExperimentConfig,
+    files: PenetrationFiles,
+    bed: Option<&std::path::Path>,
+    title: &str,
+) -> Result<()> {
+    use polydem_mpi::mpi::traits::Communicator;
+    let universe = polydem_mpi::mpi::initialize()
+        .context("--mpi: MPI was already initialised in this process")?;
+    let world = universe.world();
+    let root = world.rank() == 0;
+    let mut progress = |stage: &str, text: String| {
+        if root {
+            eprintln!("[{stage}] {text}")
+        }
+    };
+    let options = super::penetration::PenetrationOptions {
+        distributed: true,
+        ..Default::default()
+    };
+    match super::study::run_one_with_options(config, files, options, bed, title, &mut progress) {
+        Ok(result) => {
+            if root {
+                print!("{}", summary(config, &result));
+            }
+            Ok(())
+        }
+        Err(e) => {
+            eprintln!("rank {}: {e}", world.rank());
+            world.abort(1)
+        }
+    }
+}
+
+/// `--mpi` in a build without MPI.
+#[cfg(not(feature = "mpi"))]
+fn run_mpi(
+    _: &ExperimentConfig,
+    _: PenetrationFiles,
+    _: Option<&std::path::Path>,
+    _: &str,
+) -> Result<()> {
+    Err(super::penetration::PenetrationError::NoMpi.into())
 }
 
 fn sensitivity(a: &SensitivityArgs) -> Result<()> {

@@ -17,6 +17,8 @@
 //! - [`bed`]: the packed bed as an engine checkpoint, so that penetration runs start from it;
 //! - [`monitors`]: the projectile's monitor series (`monitors.csv`) as an engine output;
 //! - [`penetration`]: the impact run (velocity, resistance, deflection, disturbed zone) and its files;
+//! - [`stepper`]: who takes the impact's steps: this process, or the ranks of an MPI job
+//!   (`distributed`, feature `mpi`);
 //! - [`experiment`]: generation → packing (or a saved bed) → penetration;
 //! - [`stop`]: the check a front end answers to stop a packing or penetration run between two steps;
 //! - [`cli`]: the `polydem rockfill` subcommand.
@@ -26,6 +28,8 @@ pub mod cli;
 pub mod collapse;
 pub mod config;
 pub mod convergence;
+#[cfg(feature = "mpi")]
+pub mod distributed;
 pub mod experiment;
 pub mod generation;
 pub mod grading;
@@ -39,6 +43,7 @@ pub mod seeds;
 pub mod sensitivity;
 pub mod spatial_order;
 pub mod statistics;
+pub mod stepper;
 pub mod stop;
 pub mod study;
 pub mod summary;

@@ -21,8 +21,9 @@ use polydem::math::{Point, Real, Vector};
 use polydem::scene::Simulation;
 use polydem::world::{ContactKey, World};
 
-/// One row of the monitor time series.
-#[derive(Clone, Copy, Debug, PartialEq)]
+/// One row of the monitor time series (serialisable: a run split over MPI ranks hands it from the rank that
+/// owns the projectile to the others).
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct MonitorRow {
     pub time: Real,
     pub position: Point,
@@ -147,6 +148,17 @@ impl MonitorSeries {
         }
     }
 
+    /// What the rows are measured with.
+    pub fn gauge(&self) -> &ProjectileGauge {
+        &self.gauge
+    }
+
+    /// Appends the row of the state after a step of the run (a run whose world is not at hand in one
+    /// piece computes it where the projectile is, with [`Self::gauge`]).
+    pub fn push(&mut self, row: MonitorRow) {
+        self.rows.push(row);
+    }
+
     /// The rows so far.
     pub fn rows(&self) -> &[MonitorRow] {
         &self.rows
@@ -173,7 +185,7 @@ impl Output for MonitorSeries {
     }
 
     fn write(&mut self, sim: &Simulation, _step: u64) -> io::Result<()> {
-        self.rows.push(self.gauge.row(&sim.world));
+        self.push(self.gauge.row(&sim.world));
         Ok(())
     }
 

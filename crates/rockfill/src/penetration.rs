@@ -30,6 +30,8 @@ use super::packing::{
     rock_time_step, time_step_and_limit, top_wall_height, PackingError, KEPT_WALLS, STEEL,
 };
 use super::projectile::Projectile;
+pub use super::stepper::RankFacts;
+use super::stepper::{ImpactStepper, LocalStepper};
 use super::stop::{self, StopCheck};
 use polydem::dynamics::{Motion, RigidBody, ViscousDamping};
 use polydem::io::output::{Output, OutputSet, Schedule};
@@ -38,9 +40,7 @@ use polydem::io::vtk_frames::VtkFrames;
 use polydem::math::{Point, Pose, Real, Vector};
 use polydem::scene::{RunObserver, Simulation, TimeStepInfo};
 use polydem::shape::Shape;
-use polydem::world::{
-    sleeping, step, StepCounters, StepError, StepParams, StepScratch, World, WorldError,
-};
+use polydem::world::{sleeping, StepCounters, StepError, StepParams, World, WorldError};
 
 /// Why a penetration run failed.
 #[derive(Debug, thiserror::Error)]
@@ -61,6 +61,27 @@ pub enum PenetrationError {
     /// An output file of the run could not be opened or written (the message names it).
     #[error("penetration output: {0}")]
     Output(#[from] std::io::Error),
+    /// [`PenetrationOptions::distributed`] in a build without MPI.
+    #[error(
+        "the penetration was asked to run split over MPI ranks, but this build has no MPI (build polydem-rockfill \
+         with the `mpi` feature and launch it under mpirun)"
+    )]
+    NoMpi,
+    /// A run split over MPI ranks with sleeping on: the ranks' parts do not carry the sleep state.
+    #[error(
+        "a penetration split over MPI ranks cannot put rocks to sleep (sleeping.penetration = true): the ranks' \
+         parts do not carry the sleep state; set it to false"
+    )]
+    DistributedSleeping,
+    /// A run split over MPI ranks asked for VTK frames.
+    #[error(
+        "a penetration split over MPI ranks does not write VTK frames yet; leave out the frames"
+    )]
+    DistributedFrames,
+    /// The run split over MPI ranks failed (the message names the rank).
+    #[cfg(feature = "mpi")]
+    #[error(transparent)]
+    Distributed(#[from] polydem_mpi::DistributedError),
 }
 
 /// Displacement thresholds (in mean sizes) at which the disturbed zone is also measured: the paper's
@@ -100,6 +121,11 @@ pub struct PenetrationOptions {
     pub stop: Option<StopCheck>,
     /// The files the run writes; `None` writes none (the report holds the monitor rows either way).
     pub files: Option<PenetrationFiles>,
+    /// Step the impact split over the ranks of the MPI job this process belongs to (MPI initialised by the
+    /// caller; every rank runs the experiment with the same inputs; rank 0 writes the files). The monitor
+    /// rows and every body's final state are one process's bit for bit; see `distributed` for what is
+    /// not distributed. Needs the `mpi` feature ([`PenetrationError::NoMpi`] without).
+    pub distributed: bool,
 }
 
 /// The files a penetration run writes, through the engine's [`Output`] implementations.
@@ -138,6 +164,7 @@ impl Default for PenetrationOptions {
             start_offset: Vector::zeros(),
             stop: None,
             files: None,
+            distributed: false,
         }
     }
 }
@@ -260,6 +287,8 @@ pub struct PenetrationReport {
     pub counters: StepCounters,
     /// Rock-steps spent asleep over all rock-steps (0 without sleeping).
     pub asleep_fraction: Real,
+    /// This rank's facts, for a run split over MPI ranks ([`PenetrationOptions::distributed`]).
+    pub ranks: Option<RankFacts>,
 }
 
 /// With `sleeping.penetration`, puts every rock to sleep ([`sleeping::put_to_sleep`]). Removes the left and right walls and adds the projectile with its tip `speed × arrival_time` ahead of
@@ -342,6 +371,7 @@ pub fn penetrate_with(
     progress: impl FnMut(&MonitorRow),
 ) -> Result<PenetrationReport, PenetrationError> {
     let start = Instant::now();
+    check_distributed(config, options)?;
     let dt = penetration_time_step(config, world)? / options.dt_divisor;
     // A run stopped after `max_steps` (a benchmark's stretch) is bounded by that.
     if options
@@ -372,21 +402,15 @@ pub fn penetrate_with(
     };
     let outputs = open_outputs(options, world, gauge)?;
     // The run is a `Simulation` (the state every output reads) for its duration; the world goes back
-    // to the caller whatever the outcome.
+    // to the caller whatever the outcome (a run split over MPI ranks that fails gives back the world it
+    // started from).
     let placeholder = World::new(world.gravity(), world.materials().clone(), 0.0);
     let world_in = std::mem::replace(world, placeholder);
     let mut sim = penetration_simulation(config, world_in, projectile, index, time_step, options);
-    let run = run_impact(
-        config,
-        &mut sim,
-        (projectile, index),
-        options,
-        outputs,
-        progress,
-    );
+    let run = step_impact(config, &mut sim, projectile, options, outputs, progress);
     *world = sim.world;
-    let run = run?;
-    Ok(report(
+    let (run, ranks) = run?;
+    let mut report = report(
         config,
         world,
         (projectile, index),
@@ -395,7 +419,94 @@ pub fn penetrate_with(
         dt,
         run,
         start.elapsed(),
-    ))
+    );
+    if let Some(facts) = ranks {
+        // The energy ledger's sums are not distributed.
+        report.ledger_balance_relative = Real::NAN;
+        report.dissipated_damping = Real::NAN;
+        report.dissipated_friction = Real::NAN;
+        report.ranks = Some(facts);
+    }
+    Ok(report)
+}
+
+/// What a run split over MPI ranks cannot do, refused before any work.
+fn check_distributed(
+    config: &ExperimentConfig,
+    options: &PenetrationOptions,
+) -> Result<(), PenetrationError> {
+    if !options.distributed {
+        return Ok(());
+    }
+    if cfg!(not(feature = "mpi")) {
+        return Err(PenetrationError::NoMpi);
+    }
+    if config.sleeping.penetration {
+        return Err(PenetrationError::DistributedSleeping);
+    }
+    if options
+        .files
+        .as_ref()
+        .is_some_and(|f| f.vtk_every.is_some())
+    {
+        return Err(PenetrationError::DistributedFrames);
+    }
+    Ok(())
+}
+
+/// Whether this process writes the run's files: every process of a run in one, rank 0 of a run split
+/// over MPI ranks.
+pub fn writes_files(options: &PenetrationOptions) -> bool {
+    #[cfg(feature = "mpi")]
+    if options.distributed {
+        return super::distributed::rank() == 0;
+    }
+    let _ = options;
+    true
+}
+
+/// Runs the impact in this process or split over the MPI ranks ([`PenetrationOptions::distributed`]);
+/// `sim` ends at the run's last state.
+fn step_impact(
+    config: &ExperimentConfig,
+    sim: &mut Simulation,
+    projectile: &Projectile,
+    options: &PenetrationOptions,
+    outputs: RunOutputs,
+    progress: impl FnMut(&MonitorRow),
+) -> Result<(ImpactRun, Option<RankFacts>), PenetrationError> {
+    let start_step = sim.world.step_index();
+    if !options.distributed {
+        let mut stepper = LocalStepper::new(sim);
+        let run = run_impact(
+            config,
+            &mut stepper,
+            start_step,
+            projectile,
+            options,
+            outputs,
+            progress,
+        )?;
+        return Ok((run, None));
+    }
+    #[cfg(feature = "mpi")]
+    {
+        let mut stepper = super::distributed::DistributedStepper::new(sim)?;
+        let run = run_impact(
+            config,
+            &mut stepper,
+            start_step,
+            projectile,
+            options,
+            outputs,
+            progress,
+        )?;
+        let facts = stepper.facts();
+        *sim = stepper.into_whole()?;
+        Ok((run, Some(facts)))
+    }
+    #[cfg(not(feature = "mpi"))]
+    Err(PenetrationError::NoMpi)
 }
 
 /// The outputs of a run: the monitor series, driven step by step through the [`Output`] trait (the run
@@ -411,7 +522,7 @@ fn open_outputs(
     gauge: ProjectileGauge,
 ) -> Result<RunOutputs, PenetrationError> {
     let start_step = world.step_index();
-    let files = options.files.as_ref();
+    let files = options.files.as_ref().filter(|_| writes_files(options));
     let monitors = MonitorSeries::new(gauge, start_step, files.map(|f| f.dir.join(&f.monitors)));
     let mut others = OutputSet::new();
     if let Some(f) = files {
@@ -479,60 +590,60 @@ struct ImpactRun {
     snapshots: Vec<Snapshot>,
 }
 
-/// Steps `sim` until the projectile exits, stops, or a limit is reached, handing each step to the outputs.
-fn run_impact(
+/// Steps the world until the projectile exits, stops, or a limit is reached, handing each step to the
+/// outputs. The run starts at step `start_step`.
+fn run_impact<S: ImpactStepper>(
     config: &ExperimentConfig,
-    sim: &mut Simulation,
-    (projectile, index): (&Projectile, usize),
+    stepper: &mut S,
+    start_step: u64,
+    projectile: &Projectile,
     options: &PenetrationOptions,
     mut outputs: RunOutputs,
     mut progress: impl FnMut(&MonitorRow),
 ) -> Result<ImpactRun, PenetrationError> {
-    let mut scratch = StepScratch::default();
     let mut counters = StepCounters::default();
-    let (mut steps, mut warned, mut max_overlap) = (0u64, 0u64, 0.0 as Real);
+    let (mut steps, mut max_overlap) = (0u64, 0.0 as Real);
+    let mut warned_steps = Vec::new();
     let mut snapshots = Vec::new();
     let mut pending: Vec<Real> = options.snapshot_tip_x.clone();
     pending.sort_by(|a, b| b.total_cmp(a));
-    let start_step = sim.world.step_index();
+    let gauge = *outputs.monitors.gauge();
     if outputs.others.wants_state(start_step) {
-        outputs.others.observe(sim, start_step)?;
+        outputs.others.observe(stepper.whole()?, start_step)?;
     }
     let outcome = loop {
-        if stop::requested(options.stop.as_ref()) {
+        if options.stop.is_some() && stepper.agree(stop::requested(options.stop.as_ref())) {
             return Err(PenetrationError::Interrupted { steps });
         }
-        let report = step(&sim.params, &mut sim.world, &mut scratch)?;
-        counters.merge(&report.counters);
+        let facts = stepper.step()?;
+        counters.merge(&facts.counters);
         steps += 1;
-        max_overlap = max_overlap.max(report.max_overlap_ratio);
-        if !report.overlap_warnings.is_empty() {
-            warned += 1;
-        }
-        let at = sim.world.step_index();
-        outputs.monitors.write(sim, at)?;
+        max_overlap = max_overlap.max(facts.max_overlap_ratio);
+        warned_steps.push(facts.warned);
+        let at = start_step + steps;
+        let (row, body) = stepper.projectile(&gauge)?;
+        outputs.monitors.push(row);
         if outputs.others.wants_state(at) {
-            outputs.others.observe(sim, at)?;
+            outputs.others.observe(stepper.whole()?, at)?;
         }
-        let row = *outputs.monitors.rows().last().expect("a row per step");
         while pending.last().is_some_and(|&x| row.tip.x >= x) {
             pending.pop();
-            snapshots.push(snapshot(&sim.world, row.time, row.tip));
+            snapshots.push(snapshot(&stepper.whole()?.world, row.time, row.tip));
         }
         if steps.is_multiple_of(100) {
             progress(&row);
         }
-        let body = sim.world.body(index);
-        if let Some(outcome) = end_of_run(config, body, projectile, &row, steps, options) {
+        if let Some(outcome) = end_of_run(config, &body, projectile, &row, steps, options) {
             break outcome;
         }
     };
     outputs.monitors.flush()?;
     outputs.others.finish()?;
     let rows = outputs.monitors.into_rows();
+    let (max_overlap, warned) = stepper.overlaps(max_overlap, &warned_steps);
     if !options.snapshot_tip_x.is_empty() {
         let last = rows.last().expect("at least one step");
-        snapshots.push(snapshot(&sim.world, last.time, last.tip));
+        snapshots.push(snapshot(&stepper.whole()?.world, last.time, last.tip));
     }
     Ok(ImpactRun {
         outcome,
@@ -644,6 +755,7 @@ fn report(
             / (steps as Real * (world.bodies().len() - 1) as Real),
         counters,
         rows,
+        ranks: None,
     }
 }
 
@@ -715,4 +827,50 @@ pub fn check_penetration_steps(
         if dt_bound { "" } else { ")" }
     );
     within(config, "penetration", steps, dt, reason)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A run split over MPI ranks is refused before any work: without MPI in the build, and (with it)
+    /// when it would need what the ranks do not carry.
+    #[test]
+    fn a_distributed_run_is_refused_where_it_cannot_give_one_process_bits() {
+        let config = ExperimentConfig::quick();
+        let distributed = PenetrationOptions {
+            distributed: true,
+            ..Default::default()
+        };
+        let one_process = PenetrationOptions::default();
+        assert!(check_distributed(&config, &one_process).is_ok());
+        let refused = check_distributed(&config, &distributed);
+        if cfg!(not(feature = "mpi")) {
+            assert!(
+                matches!(refused, Err(PenetrationError::NoMpi)),
+                "without the mpi feature: {refused:?}, expected NoMpi"
+            );
+            return;
+        }
+        assert!(refused.is_ok(), "quick.toml split over ranks: {refused:?}");
+        let mut sleeping = config;
+        sleeping.sleeping.penetration = true;
+        let refused = check_distributed(&sleeping, &distributed);
+        assert!(
+            matches!(refused, Err(PenetrationError::DistributedSleeping)),
+            "sleeping.penetration = true: {refused:?}, expected DistributedSleeping"
+        );
+        let frames = PenetrationOptions {
+            files: Some(PenetrationFiles {
+                vtk_every: Some(10),
+                ..PenetrationFiles::monitors_in("unused")
+            }),
+            ..distributed
+        };
+        let refused = check_distributed(&config, &frames);
+        assert!(
+            matches!(refused, Err(PenetrationError::DistributedFrames)),
+            "VTK frames every 10 steps: {refused:?}, expected DistributedFrames"
+        );
+    }
 }

@@ -28,7 +28,7 @@ use std::time::Instant;
 use super::bed::has_checkpoint;
 use super::config::ExperimentConfig;
 use super::experiment::{run_experiment_with, BedSource, ExperimentError, ExperimentResult};
-use super::penetration::{Outcome, PenetrationFiles, PenetrationOptions};
+use super::penetration::{writes_files, Outcome, PenetrationFiles, PenetrationOptions};
 use super::section::{draw_sections, SectionError, SectionPicture};
 use super::stop::StopCheck;
 use polydem::math::Real;
@@ -266,17 +266,39 @@ pub fn run_one_with_files(
     stop: Option<StopCheck>,
     progress: &mut dyn FnMut(&str, String),
 ) -> Result<ExperimentResult, StudyError> {
+    let options = PenetrationOptions {
+        stop,
+        ..PenetrationOptions::default()
+    };
+    run_one_with_options(config, files, options, bed, title, progress)
+}
+
+/// [`run_one_with_files`] with the penetration's other `options` (the files and the section instants are
+/// set here). In a run split over MPI ranks ([`PenetrationOptions::distributed`]) only rank 0 writes: the
+/// bed, the penetration's files, the summary and the picture.
+pub fn run_one_with_options(
+    config: &ExperimentConfig,
+    files: PenetrationFiles,
+    options: PenetrationOptions,
+    bed: Option<&Path>,
+    title: &str,
+    progress: &mut dyn FnMut(&str, String),
+) -> Result<ExperimentResult, StudyError> {
     let dir = &files.dir.clone();
-    std::fs::create_dir_all(dir).map_err(io_error(dir))?;
+    let writes = writes_files(&options);
+    if writes {
+        std::fs::create_dir_all(dir).map_err(io_error(dir))?;
+    }
     let source = match bed {
         Some(b) => BedSource::Load(b),
-        None => BedSource::Generate { save: Some(dir) },
+        None => BedSource::Generate {
+            save: writes.then_some(dir.as_path()),
+        },
     };
     let options = PenetrationOptions {
         snapshot_tip_x: section_instants(config),
-        stop,
         files: Some(files),
-        ..PenetrationOptions::default()
+        ..options
     };
     let mut result = run_experiment_with(config, source, &options, progress).map_err(|source| {
         StudyError::Run {
@@ -285,17 +307,29 @@ pub fn run_one_with_files(
             source,
         }
     })?;
+    if writes {
+        write_run_files(config, &result, dir, title)?;
+    }
+    // The snapshots are only needed for the picture.
+    result.penetration.snapshots.clear();
+    Ok(result)
+}
+
+/// The packing trace (of a generated bed), the summary and the section picture of a run into `dir`.
+fn write_run_files(
+    config: &ExperimentConfig,
+    result: &ExperimentResult,
+    dir: &Path,
+    title: &str,
+) -> Result<(), StudyError> {
     if let Some(p) = &result.packing {
         let path = dir.join("packing_trace.csv");
         super::packing::write_packing_trace(&path, &p.trace).map_err(io_error(&path))?;
     }
-    let text = super::summary::summary(config, &result);
+    let text = super::summary::summary(config, result);
     let path = dir.join("summary.txt");
     std::fs::write(&path, &text).map_err(io_error(&path))?;
-    draw_run_sections(config, &result, &dir.join("section.svg"), title)?;
-    // The snapshots are only needed for the picture.
-    result.penetration.snapshots.clear();
-    Ok(result)
+    draw_run_sections(config, result, &dir.join("section.svg"), title)
 }
 
 /// Draws the section picture of a run made with [`section_instants`] snapshots.

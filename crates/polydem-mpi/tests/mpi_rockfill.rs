@@ -1,0 +1,289 @@
+//! The quick rockfill penetration split over 1, 2, 3 and 4 MPI ranks gives the bits of one process
+//! without MPI: every body's final state and every monitor row.
+//!
+//! Run by `cargo test`, this binary first runs the quick penetration (`scenes/rockfill/quick.toml` from the
+//! saved bed `reference/rockfill/quick_bed/`, a fixed number of impact steps) in this process without
+//! MPI, writes the bits of its final bodies and monitor rows to a file, then launches itself under
+//! `mpirun -n P` (MPICH's `mpirun.mpich`, or `$POLYDEM_MPIRUN`; oversubscribed on a small machine) for each
+//! P. Each launched copy runs the same penetration with `PenetrationOptions::distributed`, and rank 0
+//! compares FNV-1a hashes of the positions, velocities, orientations and angular velocities of every body,
+//! and every monitor row word for word, with the file. A mismatch names P and the first body or row that
+//! differs, and aborts every rank.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+use std::time::Instant;
+
+use polydem::dynamics::RigidBody;
+use polydem_mpi::mpi::traits::*;
+use polydem_rockfill::config::ExperimentConfig;
+use polydem_rockfill::experiment::{run_experiment_with, BedSource, ExperimentResult};
+use polydem_rockfill::penetration::{MonitorRow, Outcome, PenetrationOptions};
+
+/// Impact steps: the tip reaches the bed's face at step 103 (0.6 m at 5.8 mm per step) and five rocks press
+/// on it by step 180; the projectile's travel rebuilds the broad phase (and the subdomains are cut again)
+/// every third step. Each step of a run oversubscribed on a small machine waits for every rank in a few
+/// collectives, so the steps are kept to what shows all of this.
+const STEPS: u64 = 200;
+const RANKS: [usize; 4] = [1, 2, 3, 4];
+
+fn main() {
+    match std::env::var("POLYDEM_MPI_EXPECTED") {
+        Ok(expected) => child(Path::new(&expected)),
+        Err(_) => launch(),
+    }
+}
+
+fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../..")
+}
+
+/// The quick penetration, in one process or split over the ranks.
+fn penetrate(distributed: bool) -> ExperimentResult {
+    let config = ExperimentConfig::load(&root().join("scenes/rockfill/quick.toml"))
+        .expect("scenes/rockfill/quick.toml loads");
+    let options = PenetrationOptions {
+        max_steps: Some(STEPS),
+        distributed,
+        ..Default::default()
+    };
+    let bed = root().join("reference/rockfill/quick_bed");
+    run_experiment_with(&config, BedSource::Load(&bed), &options, &mut |_, _| {})
+        .unwrap_or_else(|e| panic!("the quick penetration (distributed: {distributed}): {e}"))
+}
+
+fn launch() {
+    let start = Instant::now();
+    let expected = penetrate(false);
+    let report = &expected.penetration;
+    let contacts = report.rows.last().map_or(0, |r| r.contacts);
+    assert_eq!(
+        (report.outcome, report.steps),
+        (Outcome::StepLimit, STEPS),
+        "the quick penetration must stop at the step limit"
+    );
+    assert!(
+        contacts >= 2,
+        "after {STEPS} steps the projectile must be among the rocks: {contacts} rocks press on it, expected at \
+         least 2"
+    );
+    println!(
+        "one process, no MPI: {STEPS} steps in {:.1} s, {contacts} rocks on the projectile, {} broad-phase \
+         rebuilds",
+        start.elapsed().as_secs_f64(),
+        report.counters.broad_rebuilds
+    );
+    let file =
+        std::env::temp_dir().join(format!("polydem_mpi_rockfill_{}.txt", std::process::id()));
+    std::fs::write(&file, expected_text(expected.world.bodies(), &report.rows))
+        .unwrap_or_else(|e| panic!("writing {}: {e}", file.display()));
+
+    let exe = std::env::current_exe().expect("the test binary's path");
+    let mpirun = std::env::var("POLYDEM_MPIRUN").unwrap_or_else(|_| "mpirun.mpich".to_owned());
+    let mut failures = Vec::new();
+    for ranks in RANKS {
+        let start = Instant::now();
+        let status = Command::new(&mpirun)
+            .args(["-n", &ranks.to_string()])
+            .arg(&exe)
+            .env("POLYDEM_MPI_EXPECTED", &file)
+            .status()
+            .unwrap_or_else(|e| panic!("{mpirun} could not be started: {e}"));
+        println!(
+            "rockfill quick, {ranks} ranks: {status} in {:.1} s",
+            start.elapsed().as_secs_f64()
+        );
+        if !status.success() {
+            failures.push(format!("rockfill quick on {ranks} ranks: {status}"));
+        }
+    }
+    let _ = std::fs::remove_file(&file);
+    assert!(
+        failures.is_empty(),
+        "distributed runs that failed: {failures:?}"
+    );
+}
+
+fn child(expected: &Path) {
+    let universe = polydem_mpi::mpi::initialize().expect("MPI initialised once");
+    let comm = universe.world();
+    let start = Instant::now();
+    let result = penetrate(true);
+    let elapsed = start.elapsed().as_secs_f64();
+    let report = &result.penetration;
+    let facts = report.ranks.expect("a distributed run reports its ranks");
+    let per_step = |bytes: u64| bytes as f64 / STEPS as f64;
+    println!(
+        "rank {}/{}: {:.1} owned, {:.1} ghosts on average, {} cuts, {elapsed:.2} s; sent per step: ghosts {:.0} B, \
+         agreements {:.0} B, cuts {:.0} B, gathers {:.0} B",
+        facts.rank,
+        facts.ranks,
+        facts.mean_owned,
+        facts.mean_ghosts,
+        facts.cuts,
+        per_step(facts.ghost_bytes),
+        per_step(facts.agreement_bytes),
+        per_step(facts.cut_bytes),
+        per_step(facts.gather_bytes),
+    );
+    if comm.rank() == 0 {
+        let text = std::fs::read_to_string(expected)
+            .unwrap_or_else(|e| panic!("reading {}: {e}", expected.display()));
+        let (bodies, rows) = parse_expected(&text);
+        let ranks = comm.size();
+        if let Err(message) = compare(&bodies, result.world.bodies(), &rows, &report.rows) {
+            eprintln!("rockfill quick on {ranks} ranks after {STEPS} steps: {message}");
+            comm.abort(1);
+        }
+        println!(
+            "rockfill quick on {ranks} ranks after {STEPS} steps: the same bits as one process ({} bodies, {} \
+             monitor rows)",
+            bodies.len(),
+            rows.len()
+        );
+    }
+}
+
+/// One hashed quantity of a body, as its numbers.
+type Quantity = fn(&RigidBody) -> Vec<f64>;
+
+const QUANTITIES: [(&str, Quantity); 4] = [
+    ("positions", |b| b.position.coords.iter().copied().collect()),
+    ("velocities", |b| b.velocity.iter().copied().collect()),
+    ("orientations", |b| {
+        b.orientation.coords.iter().copied().collect()
+    }),
+    ("angular velocities", |b| {
+        b.angular_velocity().iter().copied().collect()
+    }),
+];
+
+/// The bodies (as their hashed quantities, in order) and the rows (as their words) of one process.
+type Expected = (Vec<Vec<u64>>, Vec<Vec<u64>>);
+
+/// One line per body (the bits of its four quantities), then one per row (the bits of its words).
+fn expected_text(bodies: &[RigidBody], rows: &[MonitorRow]) -> String {
+    let line = |words: Vec<u64>| {
+        let hex: Vec<String> = words.iter().map(|w| format!("{w:016x}")).collect();
+        hex.join(" ")
+    };
+    let mut text = String::new();
+    for body in bodies {
+        text += &format!("body {}\n", line(body_words(body)));
+    }
+    for row in rows {
+        text += &format!("row {}\n", line(row_words(row)));
+    }
+    text
+}
+
+fn parse_expected(text: &str) -> Expected {
+    let (mut bodies, mut rows) = (Vec::new(), Vec::new());
+    for line in text.lines() {
+        let (kind, words) = line.split_once(' ').expect("a kind and words");
+        let words: Vec<u64> = words
+            .split(' ')
+            .map(|w| u64::from_str_radix(w, 16).expect("hex words"))
+            .collect();
+        match kind {
+            "body" => bodies.push(words),
+            _ => rows.push(words),
+        }
+    }
+    (bodies, rows)
+}
+
+fn body_words(body: &RigidBody) -> Vec<u64> {
+    QUANTITIES
+        .iter()
+        .flat_map(|(_, of)| of(body))
+        .map(f64::to_bits)
+        .collect()
+}
+
+/// Every number of a monitor row, bit for bit (the count of touching rocks as an integer).
+fn row_words(row: &MonitorRow) -> Vec<u64> {
+    let mut numbers = vec![row.time];
+    numbers.extend(row.position.coords.iter());
+    numbers.extend(row.tip.coords.iter());
+    numbers.extend(row.velocity.iter());
+    numbers.extend(row.force.iter());
+    numbers.extend([
+        row.axial_force,
+        row.velocity_deflection,
+        row.axis_deflection,
+    ]);
+    let mut words: Vec<u64> = numbers.into_iter().map(f64::to_bits).collect();
+    words.push(row.contacts as u64);
+    words
+}
+
+/// The first difference between one process's bodies and rows and the distributed run's, if any.
+fn compare(
+    bodies: &[Vec<u64>],
+    got: &[RigidBody],
+    rows: &[Vec<u64>],
+    got_rows: &[MonitorRow],
+) -> Result<(), String> {
+    if got.len() != bodies.len() || got_rows.len() != rows.len() {
+        return Err(format!(
+            "{} bodies and {} rows, one process {} and {}",
+            got.len(),
+            got_rows.len(),
+            bodies.len(),
+            rows.len()
+        ));
+    }
+    let got_words: Vec<Vec<u64>> = got.iter().map(body_words).collect();
+    let mut offset = 0;
+    for (name, of) in QUANTITIES {
+        let width = of(&got[0]).len();
+        let slice = |w: &[Vec<u64>]| -> Vec<Vec<u64>> {
+            w.iter()
+                .map(|b| b[offset..offset + width].to_vec())
+                .collect()
+        };
+        let (expected, measured) = (slice(bodies), slice(&got_words));
+        let (h_expected, h_got) = (hash(&expected), hash(&measured));
+        if h_expected != h_got {
+            let i = (0..expected.len())
+                .find(|&i| expected[i] != measured[i])
+                .expect("different hashes of different words");
+            return Err(format!(
+                "{name} hash {h_got:#018x}, one process {h_expected:#018x}; first at body {i}: {:?} against {:?}",
+                of(&got[i]),
+                expected[i].iter().map(|&w| f64::from_bits(w)).collect::<Vec<_>>()
+            ));
+        }
+        offset += width;
+    }
+    for (k, (expected, row)) in rows.iter().zip(got_rows).enumerate() {
+        if *expected != row_words(row) {
+            let (numbers, contacts) = expected.split_at(expected.len() - 1);
+            let numbers: Vec<f64> = numbers.iter().map(|&w| f64::from_bits(w)).collect();
+            return Err(format!(
+                "monitor row {k} (after step {}): {:?} and {} contacts, one process {numbers:?} and {} contacts \
+                 (time, position, tip, velocity, force, axial force, deflections)",
+                k + 1,
+                &row_words(row)[..numbers.len()]
+                    .iter()
+                    .map(|&w| f64::from_bits(w))
+                    .collect::<Vec<_>>(),
+                row.contacts,
+                contacts[0]
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// 64-bit FNV-1a over the little-endian bytes of the words, in order.
+fn hash(words: &[Vec<u64>]) -> u64 {
+    let mut h: u64 = 0xcbf29ce484222325;
+    for x in words.iter().flatten() {
+        for byte in x.to_le_bytes() {
+            h = (h ^ byte as u64).wrapping_mul(0x100000001b3);
+        }
+    }
+    h
+}
