@@ -30,5 +30,5 @@ cargo test --release -p polydem-mpi --features mpi
 # `mpirun -n P polydem run`: outputs, restarts across rank counts, a failing rank.
 cargo test --release -p polydem-cli --features mpi --test cli_mpi
 # The workspace clippy stage builds without the features; the MPI code is linted here.
-cargo clippy --release -p polydem-mpi -p polydem-cli --features polydem-mpi/mpi,polydem-cli/mpi \
+cargo clippy --release -p polydem-mpi -p polydem-cli -p polydem-rockfill --features polydem-mpi/mpi,polydem-cli/mpi \
     --all-targets -- -D warnings
