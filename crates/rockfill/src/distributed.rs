@@ -43,7 +43,7 @@ use polydem::scene::Simulation;
 use polydem_mpi::{mpi, DistributedRun};
 
 use super::monitors::{MonitorRow, ProjectileGauge};
-use super::penetration::PenetrationError;
+use super::penetration_error::PenetrationError;
 use super::stepper::{ImpactStepper, RankFacts, StepFacts};
 
 /// This process's rank in `MPI_COMM_WORLD` (MPI initialised by the caller).

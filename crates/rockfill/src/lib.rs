@@ -37,6 +37,7 @@ pub mod limits;
 pub mod monitors;
 pub mod packing;
 pub mod penetration;
+mod penetration_error;
 pub mod projectile;
 pub mod section;
 pub mod seeds;

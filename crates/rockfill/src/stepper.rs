@@ -4,7 +4,7 @@
 //! body after it, and the whole state when a snapshot or an output needs it.
 
 use super::monitors::{MonitorRow, ProjectileGauge};
-use super::penetration::PenetrationError;
+use super::penetration_error::PenetrationError;
 use polydem::dynamics::RigidBody;
 use polydem::math::Real;
 use polydem::scene::Simulation;
