@@ -12,7 +12,8 @@ use polydem::shape::Shape;
 use polydem::world::World;
 use polydem_rockfill::config::ExperimentConfig;
 use polydem_rockfill::experiment::generate_sample;
-use polydem_rockfill::packing::{body_for, loose_world, pack, packing_time_step, set_rock_density};
+use polydem_rockfill::packing::{body_for, loose_world, packing_time_step, set_rock_density};
+use polydem_rockfill::packing_run::pack;
 use polydem_rockfill::penetration::penetration_time_step;
 use support::small;
 

@@ -4,7 +4,8 @@
 
 use polydem::shape::Shape;
 use polydem_rockfill::experiment::{generate_sample, run_experiment, BedSource};
-use polydem_rockfill::packing::{load_bed, loose_world, pack, save_bed, KEPT_WALLS};
+use polydem_rockfill::packing::{load_bed, loose_world, save_bed, KEPT_WALLS};
+use polydem_rockfill::packing_run::pack;
 use polydem_rockfill::penetration::Outcome;
 
 #[path = "support/rockfill_small.rs"]

@@ -9,9 +9,10 @@ use polydem::math::{Real, Vector};
 use polydem_rockfill::config::{DepositionDamping, ExperimentConfig};
 use polydem_rockfill::experiment::generate_sample;
 use polydem_rockfill::packing::{
-    apply_local_damping, local_damping, loose_world, pack, packing_time_step, rock_time_step,
+    apply_local_damping, local_damping, loose_world, packing_time_step, rock_time_step,
     time_step_and_limit, PACKING_LIMIT_FRACTION,
 };
+use polydem_rockfill::packing_run::pack;
 use polydem_rockfill::penetration::penetration_time_step;
 use support::small;
 

@@ -10,9 +10,8 @@ use super::collapse::{collapse, CollapseParams};
 use super::config::ExperimentConfig;
 use super::generation::{generate, GenerationError, GenerationParams, Sample};
 use super::limits::{check_rock_count, LimitError};
-use super::packing::{
-    empty_world, load_bed, loose_world, pack_with_stop, save_bed, PackingError, PackingReport,
-};
+use super::packing::{empty_world, load_bed, loose_world, save_bed, PackingError, PackingReport};
+use super::packing_run::pack_with_stop;
 use super::penetration::{
     add_projectile, check_penetration_steps, penetrate_with, MonitorRow, PenetrationError,
     PenetrationOptions, PenetrationReport,

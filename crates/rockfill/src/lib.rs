@@ -36,6 +36,7 @@ pub mod grading;
 pub mod limits;
 pub mod monitors;
 pub mod packing;
+pub mod packing_run;
 pub mod penetration;
 mod penetration_error;
 pub mod projectile;

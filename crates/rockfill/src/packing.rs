@@ -1,5 +1,6 @@
 //! Packing (paper section 4.1, Fig. 4): the loose Voronoi sample falls under gravity into a box container,
 //! is compacted by the top wall moving down to the layer height, and is held; the packed bed is saved.
+//! The run itself is [`crate::packing_run`]; this module holds the world, its time step and the bed files.
 //!
 //! # Container
 //! Plane walls (half-spaces) at the layer's faces: floor z = 0, sides y = 0 and y = W, top (starts at the
@@ -62,20 +63,17 @@
 use std::io::Write;
 use std::path::Path;
 use std::sync::Arc;
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 use super::collapse::CollapseReport;
-use super::config::{ConfigError, DepositionDamping, ExperimentConfig};
+use super::config::{ConfigError, ExperimentConfig};
 use super::grading::Rock;
-use super::limits::{check_packing_steps, LimitError};
-use super::stop::{self, StopCheck};
-use polydem::dynamics::{BodyError, PrincipalInertia, RigidBody, ViscousDamping};
+use super::limits::LimitError;
+use polydem::dynamics::{BodyError, PrincipalInertia, RigidBody};
 use polydem::math::{Point, Pose, Real, Rotation, Vector};
 use polydem::scene::time_step::{contact_time_and_limit, PairEstimate};
 use polydem::shape::{ConvexPolyhedron, Plane, Shape, ShapeError};
-use polydem::world::{
-    step, MaterialTable, StepCounters, StepError, StepParams, StepScratch, Wall, World, WorldError,
-};
+use polydem::world::{MaterialTable, StepCounters, StepError, Wall, World, WorldError};
 
 /// Material ids of the experiment's world.
 pub const ROCK: u32 = 0;
@@ -107,7 +105,7 @@ pub enum PackingError {
     BedFile { path: String, message: String },
     #[error(transparent)]
     Limit(#[from] LimitError),
-    /// The run's [`StopCheck`] asked it to stop (before a step: the world is at a step boundary).
+    /// The run's [`super::stop::StopCheck`] asked it to stop (before a step: the world is at a step boundary).
     #[error("packing interrupted at t = {time} s")]
     Interrupted { time: Real },
 }
@@ -464,280 +462,6 @@ pub fn bed_overlap(world: &World, size: Real) -> [Real; 2] {
     let max = depths.iter().copied().fold(0.0, Real::max);
     let mean = depths.iter().sum::<Real>() / depths.len() as Real;
     [max / size, mean / size]
-}
-
-/// Deposition, compaction and hold (see the module docs). `progress` is called every few hundred steps
-/// with (stage, simulated time, bed top).
-pub fn pack(
-    config: &ExperimentConfig,
-    world: &mut World,
-    progress: impl FnMut(&str, Real, Real),
-) -> Result<PackingReport, PackingError> {
-    pack_with_stop(config, world, None, progress)
-}
-
-/// [`pack`] that asks `stop` before each step whether to end there ([`PackingError::Interrupted`]).
-pub fn pack_with_stop(
-    config: &ExperimentConfig,
-    world: &mut World,
-    stop: Option<&StopCheck>,
-    mut progress: impl FnMut(&str, Real, Real),
-) -> Result<PackingReport, PackingError> {
-    let start = Instant::now();
-    let p = &config.packing;
-    let scale = p.packing_density_scale.unwrap_or(1.0);
-    if p.packing_density_scale.is_some() {
-        // Before the first step: the ledger has no initial energy yet, nothing to book.
-        set_rock_density(world, config.rock.density * scale)?;
-    }
-    let (dt, contact_time) = packing_time_step(config, world)?;
-    check_packing_steps(config, dt)?;
-    let mut params = StepParams::new(dt);
-    let local_alpha = match p.deposition_damping {
-        Some(DepositionDamping::Local) => p.local_damping,
-        _ => None,
-    };
-    params.damping = match local_alpha {
-        Some(_) => ViscousDamping::None,
-        None => ViscousDamping::MassProportional(p.viscous_rate),
-    };
-    if let Some(v0) = p.drop_speed {
-        for i in 0..world.body_count() {
-            if world.body(i).is_dynamic() {
-                world.set_body_velocity(i, Vector::new(0.0, 0.0, -v0))?;
-            }
-        }
-    }
-    params.sleeping = config.sleeping.params(config.sleeping.packing);
-    let mut scratch = StepScratch::default();
-    let mut report = PackingReport {
-        rocks: world.bodies().len(),
-        dt,
-        contact_time,
-        density_scale: scale,
-        ..Default::default()
-    };
-    let initial_top = top_wall_height(world);
-    let potential0: Real = world
-        .bodies()
-        .iter()
-        .map(|b| b.mass * 9.81 * b.position.z)
-        .sum();
-    // Energy scale of the settle criterion: Σ m g d̄ (at the masses of the moment: scaled or true).
-    let lift_energy = |world: &World| -> Real {
-        world
-            .bodies()
-            .iter()
-            .filter(|b| b.is_dynamic())
-            .map(|b| b.mass * 9.81 * config.rock.mean_size)
-            .sum()
-    };
-    const DEPOSITION: usize = 0;
-    const COMPACTION: usize = 1;
-    const HOLD: usize = 2;
-    const RESTORE: usize = 3;
-    let mut run = |world: &mut World,
-                   report: &mut PackingReport,
-                   stage: usize,
-                   dt: Real|
-     -> Result<(), PackingError> {
-        if stop::requested(stop) {
-            return Err(PackingError::Interrupted { time: world.time() });
-        }
-        params.dt = dt;
-        let r = step(&params, world, &mut scratch)?;
-        if let Some(alpha) = local_alpha {
-            let removed = apply_local_damping(world, alpha, dt);
-            world.record_viscous_dissipation(removed);
-        }
-        report.max_overlap_ratio = report.max_overlap_ratio.max(r.max_overlap_ratio);
-        report.counters[stage].merge(&r.counters);
-        Ok(())
-    };
-    let sample = |world: &World, stage: usize, step: u64| -> PackingSample {
-        let e = world.energy();
-        let kinetic = e.translational_kinetic + e.rotational_kinetic;
-        PackingSample {
-            stage,
-            step,
-            time: world.time(),
-            max_speed: max_speed(world),
-            kinetic_energy: kinetic,
-            kinetic_fraction: kinetic / lift_energy(world),
-            bed_top: bed_top(world),
-            top_wall: top_wall_height(world),
-            wall_force: world
-                .loads()
-                .wall_forces()
-                .get(TOP_WALL)
-                .map_or(0.0, |f| f.z),
-        }
-    };
-    // 1. Deposition.
-    let min_time = match p.collapse_gap {
-        // The free fall over the gaps stacked under the top rock (see the module docs).
-        Some(gap) => (2.0 * (bed_top(world) / config.rock.mean_size) * gap * config.rock.mean_size
-            / 9.81)
-            .sqrt(),
-        // The fall of the generation height from the drop speed v0: (√(v0² + 2 g h) − v0) / g.
-        None => {
-            let v0 = p.drop_speed.unwrap_or(0.0);
-            ((v0 * v0 + 2.0 * 9.81 * initial_top).sqrt() - v0) / 9.81
-        }
-    };
-    let check_every = TRACE_EVERY;
-    loop {
-        run(world, &mut report, DEPOSITION, dt)?;
-        report.deposition_steps += 1;
-        let t = world.time();
-        if report.deposition_steps.is_multiple_of(check_every) {
-            let row = sample(world, DEPOSITION, report.deposition_steps);
-            report.trace.push(row);
-            progress("deposition", t, row.bed_top);
-            let calm = row.max_speed < p.settle_speed
-                && p.settle_kinetic_fraction
-                    .is_none_or(|f| row.kinetic_fraction < f);
-            if (t >= min_time && calm) || t >= p.max_deposition_time {
-                break;
-            }
-        }
-    }
-    report.deposition_time = world.time();
-    report.ledger_balance_relative[0] = world.energy().balance / potential0;
-    report.deposited_top = bed_top(world);
-    // 2. Compaction.
-    let target = config.layer.height;
-    let t0 = world.time();
-    if report.deposited_top > target {
-        // Place the wall on the bed (a translation along its normal, before it touches anything).
-        let lift = report.deposited_top - initial_top;
-        let mut translation = world.walls()[TOP_WALL].pose.translation.vector;
-        translation.z += lift;
-        world.set_wall_translation(TOP_WALL, translation)?;
-        // The cap scales with the weights (density scaling, see the module docs).
-        let force_cap = scale * p.compaction_pressure * config.layer.length * config.layer.width;
-        let mut stalled_since: Option<Real> = None;
-        while top_wall_height(world) > target {
-            // Servo: full speed on a loose bed, slowing to a stop as the wall force nears the cap.
-            let force = world
-                .loads()
-                .wall_forces()
-                .get(TOP_WALL)
-                .map_or(0.0, |f| f.z);
-            let fraction = (1.0 - force / force_cap).clamp(0.0, 1.0);
-            world.set_wall_velocity(
-                TOP_WALL,
-                Vector::new(0.0, 0.0, -p.compaction_speed * fraction),
-            )?;
-            run(world, &mut report, COMPACTION, dt)?;
-            report.compaction_steps += 1;
-            if report.compaction_steps.is_multiple_of(check_every) {
-                report
-                    .trace
-                    .push(sample(world, COMPACTION, report.compaction_steps));
-                progress("compaction", world.time(), top_wall_height(world));
-            }
-            if fraction < STALL_FRACTION {
-                let since = *stalled_since.get_or_insert(world.time());
-                if world.time() - since > p.hold_time {
-                    report.compaction_stalled = true;
-                    break;
-                }
-            } else {
-                stalled_since = None;
-            }
-        }
-        world.set_wall_velocity(TOP_WALL, Vector::zeros())?;
-    }
-    report.compaction_time = world.time() - t0;
-    report.ledger_balance_relative[1] = world.energy().balance / potential0;
-    // 3. Hold.
-    let hold_end = world.time() + p.hold_time;
-    while world.time() < hold_end {
-        run(world, &mut report, HOLD, dt)?;
-        report.hold_steps += 1;
-        if report.hold_steps.is_multiple_of(check_every) {
-            report.trace.push(sample(world, HOLD, report.hold_steps));
-            progress("hold", world.time(), bed_top(world));
-        }
-    }
-    report.bed_overlap_after_hold = bed_overlap(world, config.rock.mean_size);
-    // 4. Restore the true density (density scaling only): a geometric ramp of the density from s ρ to ρ over
-    // the first half of `restore_time`, then the true density for the second half (see the module docs).
-    if p.packing_density_scale.is_some() {
-        let wall_force = |world: &World| {
-            world
-                .loads()
-                .wall_forces()
-                .get(TOP_WALL)
-                .map_or(0.0, |f| f.z)
-        };
-        let force0 = wall_force(world);
-        let restore_time = p.restore_time.unwrap_or(0.0);
-        let (t0, top0) = (world.time(), top_wall_height(world));
-        let mut sigma = scale;
-        loop {
-            let tau = ((world.time() - t0) / (0.5 * restore_time)).min(1.0);
-            let next = if tau >= 1.0 {
-                1.0
-            } else {
-                scale.powf(1.0 - tau)
-            };
-            if next != sigma {
-                // Exactly ρ at the end (the bits of an unscaled bed), s^(1−τ) ρ on the way.
-                let density = if next == 1.0 {
-                    config.rock.density
-                } else {
-                    config.rock.density * next
-                };
-                let changed = set_rock_density(world, density)?;
-                if world.ledger().initial_total().is_some() {
-                    world.record_external_work(changed);
-                }
-                sigma = next;
-            }
-            if world.time() >= t0 + restore_time {
-                break;
-            }
-            let (dt_now, _) = packing_time_step(config, world)?;
-            // Servo: back off at up to the compaction speed while the wall pushes harder than F σ/s.
-            let target = force0 * sigma / scale;
-            let force = wall_force(world);
-            let excess = if target > 0.0 {
-                (force / target - 1.0).clamp(0.0, 1.0)
-            } else {
-                0.0
-            };
-            world
-                .set_wall_velocity(TOP_WALL, Vector::new(0.0, 0.0, p.compaction_speed * excess))?;
-            run(world, &mut report, RESTORE, dt_now)?;
-            report.restore_steps += 1;
-            if report.restore_steps.is_multiple_of(check_every) {
-                report
-                    .trace
-                    .push(sample(world, RESTORE, report.restore_steps));
-                progress("restore", world.time(), top_wall_height(world));
-            }
-        }
-        world.set_wall_velocity(TOP_WALL, Vector::zeros())?;
-        report.restore_dt = packing_time_step(config, world)?.0;
-        report.restore_wall_rise = top_wall_height(world) - top0;
-        report.restore_wall_force = [force0, wall_force(world)];
-    }
-    report.bed_overlap_final = bed_overlap(world, config.rock.mean_size);
-    report.final_top = bed_top(world);
-    report.top_wall = top_wall_height(world);
-    let volume: Real = (0..world.bodies().len())
-        .map(|i| match world.shape(i) {
-            Shape::Polyhedron(s) => s.mass_properties().volume,
-            _ => 0.0,
-        })
-        .sum();
-    report.solid_fraction = volume / (config.layer.length * config.layer.width * report.final_top);
-    report.final_max_speed = max_speed(world);
-    report.ledger_balance_relative[2] = world.energy().balance / potential0;
-    report.wall_time = start.elapsed();
-    Ok(report)
 }
 
 /// Cundall's local (non-viscous) damping of one vector quantity over a step: every component of `value`
