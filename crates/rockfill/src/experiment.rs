@@ -6,9 +6,10 @@ use std::time::Duration;
 use super::bed::{
     has_checkpoint, load_bed_checkpoint, load_bed_info, save_bed_checkpoint, BedError, BedInfo,
 };
-use super::collapse::{collapse, CollapseParams};
+use super::collapse::{collapse, CollapseParams, CollapseReport};
 use super::config::ExperimentConfig;
 use super::generation::{generate, GenerationError, GenerationParams, Sample};
+use super::grading::Rock;
 use super::limits::{check_rock_count, LimitError};
 use super::packing::{empty_world, load_bed, loose_world, save_bed, PackingError, PackingReport};
 use super::packing_run::pack_with_stop;
@@ -212,118 +213,15 @@ pub fn run_experiment_with(
     progress: Progress,
 ) -> Result<ExperimentResult, ExperimentError> {
     let projectile = Projectile::new(config.projectile)?;
-    let (mut world, generation, packing, bed_info, from_checkpoint) = match bed {
-        BedSource::Load(dir) => {
-            let info = load_bed_info(dir)?;
-            check_bed_size(config, dir, info.as_ref())?;
-            let mut checkpoint = has_checkpoint(dir);
-            let mut world = if checkpoint {
-                match load_bed_checkpoint(dir) {
-                    Ok(world) => world,
-                    // A checkpoint of another format version (written by another build): the CSV files of
-                    // the same bed are version-free.
-                    Err(BedError::Checkpoint(CheckpointError::UnsupportedVersion {
-                        found,
-                        supported,
-                    })) if dir.join("bed_rocks.csv").is_file() => {
-                        progress(
-                            "bed",
-                            format!(
-                                "checkpoint format {found} is not this build's ({supported}): reading the CSV bed"
-                            ),
-                        );
-                        checkpoint = false;
-                        load_bed(config, dir)?
-                    }
-                    Err(e) => return Err(e.into()),
-                }
-            } else {
-                load_bed(config, dir)?
-            };
-            if checkpoint {
-                apply_experiment_laws(config, dir, &mut world, &mut *progress)?;
-            }
-            progress(
-                "bed",
-                format!(
-                    "{} bodies from {} ({})",
-                    world.bodies().len(),
-                    dir.display(),
-                    if checkpoint { "checkpoint" } else { "CSV" }
-                ),
-            );
-            (world, None, None, info, checkpoint)
-        }
-        BedSource::Generate { save } => {
-            check_limits_before_generation(config)?;
-            let start = std::time::Instant::now();
-            let sample = generate_sample(config)?;
-            let (requested_mean, var) = sample.sizes.bin_mean_and_variance();
-            let generation = GenerationSummary {
-                seeds: sample.seeds,
-                rocks: sample.rocks.len(),
-                dropped_small_cells: sample.grading.dropped_small_cells,
-                cell_radius: sample.cell_radius,
-                statistics: sample_statistics(&sample.rocks),
-                requested_mean,
-                requested_std: var.sqrt(),
-                wall_time: start.elapsed(),
-            };
-            progress(
-                "generation",
-                format!(
-                    "{} seeds, {} rocks ({} cells too small), {:.2} s",
-                    generation.seeds,
-                    generation.rocks,
-                    generation.dropped_small_cells,
-                    generation.wall_time.as_secs_f64()
-                ),
-            );
-            let top = config.layer.height * config.packing.generation_height_factor;
-            let mut rocks = sample.rocks;
-            let collapsed = config.packing.collapse_gap.map(|gap| {
-                let report = collapse(
-                    &mut rocks,
-                    &CollapseParams::new(
-                        config.layer.length,
-                        config.layer.width,
-                        config.rock.mean_size,
-                        gap,
-                    ),
-                );
-                progress(
-                    "collapse",
-                    format!(
-                        "top {:.3} m -> {:.3} m, mean descent {:.3} m, {} moves, {} held by three, {} distance queries, {:.2} s",
-                        report.top_before,
-                        report.top_after,
-                        report.mean_descent,
-                        report.moves,
-                        report.held_by_three,
-                        report.queries,
-                        report.wall_time.as_secs_f64()
-                    ),
-                );
-                report
-            });
-            let mut world = loose_world(config, &rocks, top)?;
-            let stop = options.stop.as_ref();
-            let mut packing = pack_with_stop(config, &mut world, stop, |stage, t, h| {
-                progress(stage, format!("t = {t:.3} s, height {h:.3} m"))
-            })?;
-            packing.collapse = collapsed;
-            let info = BedInfo::new(
-                config.rock.mean_size,
-                config.rock.seed,
-                generation.wall_time,
-                &packing,
-            );
-            if let Some(dir) = save {
-                save_bed(&world, dir)?;
-                save_bed_checkpoint(&world, &packing, &info, dir)?;
-            }
-            (world, Some(generation), Some(packing), Some(info), false)
-        }
+    let PreparedBed {
+        mut world,
+        generation,
+        packing,
+        info: bed_info,
+        from_checkpoint,
+    } = match bed {
+        BedSource::Load(dir) => loaded_bed(config, dir, &mut *progress)?,
+        BedSource::Generate { save } => generated_bed(config, save, options, &mut *progress)?,
     };
     let index = add_projectile(config, &mut world, &projectile)?;
     if options.start_offset != polydem::math::Vector::zeros() {
@@ -360,4 +258,161 @@ pub fn run_experiment_with(
         penetration,
         world,
     })
+}
+
+/// The bed the penetration starts from, and how it came to be.
+struct PreparedBed {
+    world: World,
+    generation: Option<GenerationSummary>,
+    packing: Option<PackingReport>,
+    info: Option<BedInfo>,
+    from_checkpoint: bool,
+}
+
+/// A bed saved earlier in `dir`: its checkpoint (with the experiment's laws applied) when it has one of this
+/// build's format, else its CSV files.
+fn loaded_bed(
+    config: &ExperimentConfig,
+    dir: &Path,
+    progress: Progress,
+) -> Result<PreparedBed, ExperimentError> {
+    let info = load_bed_info(dir)?;
+    check_bed_size(config, dir, info.as_ref())?;
+    let (mut world, checkpoint) = if has_checkpoint(dir) {
+        match load_bed_checkpoint(dir) {
+            Ok(world) => (world, true),
+            // A checkpoint of another format version (written by another build): the CSV files of
+            // the same bed are version-free.
+            Err(BedError::Checkpoint(CheckpointError::UnsupportedVersion { found, supported }))
+                if dir.join("bed_rocks.csv").is_file() =>
+            {
+                progress(
+                    "bed",
+                    format!(
+                        "checkpoint format {found} is not this build's ({supported}): reading the CSV bed"
+                    ),
+                );
+                (load_bed(config, dir)?, false)
+            }
+            Err(e) => return Err(e.into()),
+        }
+    } else {
+        (load_bed(config, dir)?, false)
+    };
+    if checkpoint {
+        apply_experiment_laws(config, dir, &mut world, &mut *progress)?;
+    }
+    progress(
+        "bed",
+        format!(
+            "{} bodies from {} ({})",
+            world.bodies().len(),
+            dir.display(),
+            if checkpoint { "checkpoint" } else { "CSV" }
+        ),
+    );
+    Ok(PreparedBed {
+        world,
+        generation: None,
+        packing: None,
+        info,
+        from_checkpoint: checkpoint,
+    })
+}
+
+/// A bed generated, pre-collapsed when asked, packed, and saved into `save` when given.
+fn generated_bed(
+    config: &ExperimentConfig,
+    save: Option<&Path>,
+    options: &PenetrationOptions,
+    progress: Progress,
+) -> Result<PreparedBed, ExperimentError> {
+    check_limits_before_generation(config)?;
+    let start = std::time::Instant::now();
+    let sample = generate_sample(config)?;
+    let generation = generation_summary(&sample, start);
+    progress(
+        "generation",
+        format!(
+            "{} seeds, {} rocks ({} cells too small), {:.2} s",
+            generation.seeds,
+            generation.rocks,
+            generation.dropped_small_cells,
+            generation.wall_time.as_secs_f64()
+        ),
+    );
+    let top = config.layer.height * config.packing.generation_height_factor;
+    let mut rocks = sample.rocks;
+    let collapsed = config
+        .packing
+        .collapse_gap
+        .map(|gap| collapse_rocks(config, &mut rocks, gap, &mut *progress));
+    let mut world = loose_world(config, &rocks, top)?;
+    let stop = options.stop.as_ref();
+    let mut packing = pack_with_stop(config, &mut world, stop, |stage, t, h| {
+        progress(stage, format!("t = {t:.3} s, height {h:.3} m"))
+    })?;
+    packing.collapse = collapsed;
+    let info = BedInfo::new(
+        config.rock.mean_size,
+        config.rock.seed,
+        generation.wall_time,
+        &packing,
+    );
+    if let Some(dir) = save {
+        save_bed(&world, dir)?;
+        save_bed_checkpoint(&world, &packing, &info, dir)?;
+    }
+    Ok(PreparedBed {
+        world,
+        generation: Some(generation),
+        packing: Some(packing),
+        info: Some(info),
+        from_checkpoint: false,
+    })
+}
+
+/// What generation made of `sample`, begun at `start`.
+fn generation_summary(sample: &Sample, start: std::time::Instant) -> GenerationSummary {
+    let (requested_mean, var) = sample.sizes.bin_mean_and_variance();
+    GenerationSummary {
+        seeds: sample.seeds,
+        rocks: sample.rocks.len(),
+        dropped_small_cells: sample.grading.dropped_small_cells,
+        cell_radius: sample.cell_radius,
+        statistics: sample_statistics(&sample.rocks),
+        requested_mean,
+        requested_std: var.sqrt(),
+        wall_time: start.elapsed(),
+    }
+}
+
+/// Moves every rock straight down until it nearly touches (gap `gap` mean sizes; see [`super::collapse`]).
+fn collapse_rocks(
+    config: &ExperimentConfig,
+    rocks: &mut [Rock],
+    gap: Real,
+    progress: Progress,
+) -> CollapseReport {
+    let params = CollapseParams::new(
+        config.layer.length,
+        config.layer.width,
+        config.rock.mean_size,
+        gap,
+    );
+    let report = collapse(rocks, &params);
+    progress(
+        "collapse",
+        format!(
+            "top {:.3} m -> {:.3} m, mean descent {:.3} m, {} moves, {} held by three, {} distance queries, {:.2} s",
+            report.top_before,
+            report.top_after,
+            report.mean_descent,
+            report.moves,
+            report.held_by_three,
+            report.queries,
+            report.wall_time.as_secs_f64()
+        ),
+    );
+    report
 }
