@@ -46,7 +46,7 @@ use std::path::{Path, PathBuf};
 use crate::dynamics::RigidBody;
 use crate::scene::Simulation;
 use crate::shape::Shape;
-use crate::world::ContactKey;
+use crate::world::{ContactKey, World};
 
 /// The first eight bytes of every checkpoint.
 pub const MAGIC: [u8; 8] = *b"PDEMCKPT";
@@ -312,50 +312,14 @@ fn check_body_state(body: &RigidBody) -> Result<(), String> {
 fn check_consistency(sim: &Simulation) -> Result<(), String> {
     let w = &sim.world;
     let n = w.bodies().len();
-    let lengths = [
-        ("shape_of", w.shape_indices().len()),
-        ("material_of", w.body_materials().len()),
-        ("radii", w.radii().len()),
-        ("names", w.names().len()),
-        ("frames", sim.frames.len()),
-    ];
-    for (what, len) in lengths {
-        if len != n {
-            return Err(format!("{n} bodies but {len} entries in {what}"));
-        }
-    }
+    check_lengths(sim)?;
     for (k, shape) in w.shapes().iter().enumerate() {
         if let Shape::Polyhedron(p) = shape {
             p.check_structure().map_err(|e| format!("shape {k}: {e}"))?;
         }
     }
     for i in 0..n {
-        let name = &w.names()[i];
-        match w.shapes().get(w.shape_indices()[i] as usize) {
-            None => {
-                return Err(format!(
-                    "body {i} ('{name}'): shape {} of {}",
-                    w.shape_indices()[i],
-                    w.shapes().len()
-                ))
-            }
-            Some(Shape::Plane(_)) => return Err(format!("body {i} ('{name}'): a plane shape")),
-            Some(_) => {}
-        }
-        if w.body_materials()[i] as usize >= w.materials().len() {
-            return Err(format!(
-                "body {i} ('{name}'): material {} of {}",
-                w.body_materials()[i],
-                w.materials().len()
-            ));
-        }
-        if !(w.radii()[i].is_finite() && w.radii()[i] >= 0.0) {
-            return Err(format!(
-                "body {i} ('{name}'): bounding radius {}",
-                w.radii()[i]
-            ));
-        }
-        check_body_state(&w.bodies()[i]).map_err(|what| format!("body {i} ('{name}'): {what}"))?;
+        check_body(w, i)?;
     }
     if !(w.time().is_finite() && sim.params.dt.is_finite() && sim.params.dt > 0.0) {
         return Err(format!(
@@ -377,6 +341,74 @@ fn check_consistency(sim: &Simulation) -> Result<(), String> {
     if let Some(&t) = sim.tracked.iter().find(|&&t| t >= n) {
         return Err(format!("tracked body {t} of {n}"));
     }
+    check_loads(w)?;
+    check_contacts(w)?;
+    if let Some(p) = w
+        .broad_phase()
+        .pairs()
+        .iter()
+        .find(|&&(i, j)| !(i < j && (j as usize) < n))
+    {
+        return Err(format!("broad-phase pair {p:?} out of range"));
+    }
+    if sim.output_every == 0 {
+        return Err("output interval of 0 steps".into());
+    }
+    Ok(())
+}
+
+/// Every per-body table has one entry per body.
+fn check_lengths(sim: &Simulation) -> Result<(), String> {
+    let w = &sim.world;
+    let n = w.bodies().len();
+    let lengths = [
+        ("shape_of", w.shape_indices().len()),
+        ("material_of", w.body_materials().len()),
+        ("radii", w.radii().len()),
+        ("names", w.names().len()),
+        ("frames", sim.frames.len()),
+    ];
+    for (what, len) in lengths {
+        if len != n {
+            return Err(format!("{n} bodies but {len} entries in {what}"));
+        }
+    }
+    Ok(())
+}
+
+/// Body `i`'s shape and material exist, its shape is not a plane, its radius and state are valid.
+fn check_body(w: &World, i: usize) -> Result<(), String> {
+    let name = &w.names()[i];
+    match w.shapes().get(w.shape_indices()[i] as usize) {
+        None => {
+            return Err(format!(
+                "body {i} ('{name}'): shape {} of {}",
+                w.shape_indices()[i],
+                w.shapes().len()
+            ))
+        }
+        Some(Shape::Plane(_)) => return Err(format!("body {i} ('{name}'): a plane shape")),
+        Some(_) => {}
+    }
+    if w.body_materials()[i] as usize >= w.materials().len() {
+        return Err(format!(
+            "body {i} ('{name}'): material {} of {}",
+            w.body_materials()[i],
+            w.materials().len()
+        ));
+    }
+    if !(w.radii()[i].is_finite() && w.radii()[i] >= 0.0) {
+        return Err(format!(
+            "body {i} ('{name}'): bounding radius {}",
+            w.radii()[i]
+        ));
+    }
+    check_body_state(&w.bodies()[i]).map_err(|what| format!("body {i} ('{name}'): {what}"))
+}
+
+/// Current loads, when stored, cover every body and wall.
+fn check_loads(w: &World) -> Result<(), String> {
+    let n = w.bodies().len();
     if w.loads().is_current()
         && (w.loads().forces().len() != n
             || w.loads().torques().len() != n
@@ -390,6 +422,12 @@ fn check_consistency(sim: &Simulation) -> Result<(), String> {
             w.walls().len()
         ));
     }
+    Ok(())
+}
+
+/// The contact store has a state per key, its keys strictly sorted and naming existing bodies and walls.
+fn check_contacts(w: &World) -> Result<(), String> {
+    let n = w.bodies().len();
     let keys = w.contacts().keys();
     if keys.len() != w.contacts().states().len() {
         return Err(format!(
@@ -407,17 +445,6 @@ fn check_consistency(sim: &Simulation) -> Result<(), String> {
     };
     if let Some(k) = keys.iter().find(|k| !key_ok(k)) {
         return Err(format!("contact store key {k:?} out of range"));
-    }
-    if let Some(p) = w
-        .broad_phase()
-        .pairs()
-        .iter()
-        .find(|&&(i, j)| !(i < j && (j as usize) < n))
-    {
-        return Err(format!("broad-phase pair {p:?} out of range"));
-    }
-    if sim.output_every == 0 {
-        return Err("output interval of 0 steps".into());
     }
     Ok(())
 }
