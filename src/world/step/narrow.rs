@@ -3,9 +3,10 @@
 
 use crate::contact::contact_polyhedron_plane::plane_polytope_depth;
 use crate::contact::{
-    contact_plane_sphere, contact_sphere_sphere, query_with, ContactError, QueryCounters, WallDepth,
+    contact_plane_sphere, contact_sphere_sphere, query_with, ContactError, ContactTolerances,
+    QueryCounters, WallDepth,
 };
-use crate::math::Real;
+use crate::math::{Pose, Real};
 use crate::shape::Shape;
 
 use super::super::contact_store::{ContactKey, ContactState};
@@ -206,95 +207,133 @@ fn narrow_phase(
     state: &mut ContactState,
     worker: &mut Worker,
 ) -> Result<(), ContactError> {
-    let tol = &params.tolerances;
-    let (pose_a, shape_a, pose_b, shape_b);
-    let wall_shape;
     match key {
         ContactKey::Body { a, b } => {
-            let (a, b) = (a as usize, b as usize);
-            shape_a = world.shape(a);
-            shape_b = world.shape(b);
-            let (xa, xb) = (&world.bodies[a].position, &world.bodies[b].position);
-            if params.skips.bounding_spheres {
-                if let Some(g) = skips::reject_by_bounding_spheres(
-                    xa,
-                    world.radii[a],
-                    xb,
-                    world.radii[b],
-                    shape_a
-                        .length_scale()
-                        .unwrap_or(0.0)
-                        .max(shape_b.length_scale().unwrap_or(0.0)),
-                    tol,
-                    &mut worker.query,
-                ) {
-                    state.geometry = g;
-                    return Ok(());
-                }
-            }
-            if let (Shape::Sphere(sa), Shape::Sphere(sb)) = (shape_a, shape_b) {
-                worker.query.sphere_sphere += 1;
-                state.geometry = contact_sphere_sphere(xa, sa.radius(), xb, sb.radius(), tol);
-                worker.query.record(&state.geometry);
-                return Ok(());
-            }
-            pose_a = world.pose(a);
-            pose_b = world.pose(b);
-            if let Some((pa, pb)) = skips::polyhedra(shape_a, shape_b) {
-                if skips::polyhedron_pair(
-                    &params.skips,
-                    (&pose_a, pa),
-                    (&pose_b, pb),
-                    tol,
-                    state,
-                    &mut worker.epa,
-                    &mut worker.query,
-                ) {
-                    return Ok(());
-                }
-            }
+            body_pair(params, world, (a as usize, b as usize), state, worker)
         }
         ContactKey::Wall { body, wall } => {
-            let wall = &world.walls[wall as usize];
-            let body = body as usize;
-            if params.skips.bounding_spheres {
-                // The wall list has a skin: a body listed may still be beyond its radius from the plane.
-                let x = &world.bodies[body].position;
-                if let Some(g) = skips::reject_wall_by_bounding_sphere(
-                    wall.signed_distance(x),
-                    &wall.normal_world(),
-                    x,
-                    world.radii[body],
-                    &mut worker.query,
-                ) {
-                    state.geometry = g;
-                    return Ok(());
-                }
-            }
-            if let Shape::Sphere(s) = world.shape(body) {
-                worker.query.sphere_plane += 1;
-                state.geometry = contact_plane_sphere(
-                    &wall.pose,
-                    wall.plane.normal(),
-                    wall.plane.offset(),
-                    &world.bodies[body].position,
-                    s.radius(),
-                    tol,
-                );
-                worker.query.record(&state.geometry);
-                return Ok(());
-            }
-            wall_shape = Shape::Plane(wall.plane);
-            pose_a = wall.pose;
-            shape_a = &wall_shape;
-            pose_b = world.pose(body);
-            shape_b = world.shape(body);
+            wall_pair(params, world, body as usize, wall as usize, state, worker)
         }
     }
+}
+
+/// [`narrow_phase`] for bodies `a` < `b`: the bounding-sphere rejection, the sphere–sphere closed form,
+/// the polyhedral skips, then the general query.
+#[inline]
+fn body_pair(
+    params: &StepParams,
+    world: &World,
+    (a, b): (usize, usize),
+    state: &mut ContactState,
+    worker: &mut Worker,
+) -> Result<(), ContactError> {
+    let tol = &params.tolerances;
+    let (shape_a, shape_b) = (world.shape(a), world.shape(b));
+    let (xa, xb) = (&world.bodies[a].position, &world.bodies[b].position);
+    if params.skips.bounding_spheres {
+        if let Some(g) = skips::reject_by_bounding_spheres(
+            xa,
+            world.radii[a],
+            xb,
+            world.radii[b],
+            shape_a
+                .length_scale()
+                .unwrap_or(0.0)
+                .max(shape_b.length_scale().unwrap_or(0.0)),
+            tol,
+            &mut worker.query,
+        ) {
+            state.geometry = g;
+            return Ok(());
+        }
+    }
+    if let (Shape::Sphere(sa), Shape::Sphere(sb)) = (shape_a, shape_b) {
+        worker.query.sphere_sphere += 1;
+        state.geometry = contact_sphere_sphere(xa, sa.radius(), xb, sb.radius(), tol);
+        worker.query.record(&state.geometry);
+        return Ok(());
+    }
+    let (pose_a, pose_b) = (world.pose(a), world.pose(b));
+    if let Some((pa, pb)) = skips::polyhedra(shape_a, shape_b) {
+        if skips::polyhedron_pair(
+            &params.skips,
+            (&pose_a, pa),
+            (&pose_b, pb),
+            tol,
+            state,
+            &mut worker.epa,
+            &mut worker.query,
+        ) {
+            return Ok(());
+        }
+    }
+    general_query(tol, (&pose_a, shape_a), (&pose_b, shape_b), state, worker)
+}
+
+/// [`narrow_phase`] for a body and a wall: the bounding-sphere rejection, the plane–sphere closed form,
+/// then the general query with the wall's plane as shape A.
+#[inline]
+fn wall_pair(
+    params: &StepParams,
+    world: &World,
+    body: usize,
+    wall: usize,
+    state: &mut ContactState,
+    worker: &mut Worker,
+) -> Result<(), ContactError> {
+    let tol = &params.tolerances;
+    let wall = &world.walls[wall];
+    if params.skips.bounding_spheres {
+        // The wall list has a skin: a body listed may still be beyond its radius from the plane.
+        let x = &world.bodies[body].position;
+        if let Some(g) = skips::reject_wall_by_bounding_sphere(
+            wall.signed_distance(x),
+            &wall.normal_world(),
+            x,
+            world.radii[body],
+            &mut worker.query,
+        ) {
+            state.geometry = g;
+            return Ok(());
+        }
+    }
+    if let Shape::Sphere(s) = world.shape(body) {
+        worker.query.sphere_plane += 1;
+        state.geometry = contact_plane_sphere(
+            &wall.pose,
+            wall.plane.normal(),
+            wall.plane.offset(),
+            &world.bodies[body].position,
+            s.radius(),
+            tol,
+        );
+        worker.query.record(&state.geometry);
+        return Ok(());
+    }
+    let wall_shape = Shape::Plane(wall.plane);
+    let body_pose = world.pose(body);
+    general_query(
+        tol,
+        (&wall.pose, &wall_shape),
+        (&body_pose, world.shape(body)),
+        state,
+        worker,
+    )
+}
+
+/// The dispatcher's query of shapes A and B at their poses, with the pair's cache.
+#[inline]
+fn general_query(
+    tol: &ContactTolerances,
+    (pose_a, shape_a): (&Pose, &Shape),
+    (pose_b, shape_b): (&Pose, &Shape),
+    state: &mut ContactState,
+    worker: &mut Worker,
+) -> Result<(), ContactError> {
     state.geometry = query_with(
-        &pose_a,
+        pose_a,
         shape_a,
-        &pose_b,
+        pose_b,
         shape_b,
         tol,
         &mut state.cache,
