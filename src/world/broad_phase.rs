@@ -347,12 +347,28 @@ impl BroadPhase {
         if centres.len() < 2 {
             return;
         }
-        let half_skin = 0.5 * self.skin;
         let profile_grid = clock.serial_start();
         let mut grid = std::mem::take(&mut self.grid);
-        self.shape_grid(&mut grid, centres, radii);
+        self.bin_bodies(&mut grid, centres, radii);
+        clock.serial_end(Section::SerialGrid, profile_grid);
+        let mut pairs = std::mem::take(&mut self.pairs);
+        let search = PairSearch {
+            grid: &grid,
+            body_cells: &self.body_cells,
+            centres,
+            radii,
+            skin: self.skin,
+        };
+        search.run(&mut pairs, clock);
+        self.pairs = pairs;
+        self.grid = grid;
+        debug_assert!(self.pairs.windows(2).all(|w| w[0] < w[1]));
+    }
 
-        // Cell ranges of every body's inflated box.
+    /// Shapes `grid` over the bodies and enters each body in the cells of its box inflated by half the skin.
+    fn bin_bodies(&mut self, grid: &mut Grid, centres: &[Point], radii: &[Real]) {
+        let half_skin = 0.5 * self.skin;
+        self.shape_grid(grid, centres, radii);
         self.body_cells.clear();
         let cells_of = |(c, &r): (&Point, &Real)| {
             // Widened by a relative 1e-9 so that rounding can never drop a pair the sphere test would keep:
@@ -369,85 +385,6 @@ impl BroadPhase {
                 .extend(centres.iter().zip(radii).map(cells_of));
         }
         grid.bin(&self.body_cells, |body| body as u32);
-
-        clock.serial_end(Section::SerialGrid, profile_grid);
-
-        // Each pair is examined in the first cell of the overlap of both ranges only. Bodies are independent
-        // here: large scenes search in parallel chunks of bodies, concatenated in body order (the same list
-        // for any chunking).
-        // Each body's pairs are sorted as found (a few per body), so the lists concatenated in body order
-        // are sorted: no sort of the whole list.
-        let search = |i: usize, out: &mut Vec<Pair>| {
-            let found_before = out.len();
-            let range_i = &self.body_cells[i];
-            grid.for_each_cell(range_i, |c, bodies| {
-                for &j in bodies {
-                    let j_usize = j as usize;
-                    if j_usize <= i {
-                        continue;
-                    }
-                    let range_j = &self.body_cells[j_usize];
-                    let first_common = [
-                        range_i.lo[0].max(range_j.lo[0]),
-                        range_i.lo[1].max(range_j.lo[1]),
-                        range_i.lo[2].max(range_j.lo[2]),
-                    ];
-                    if first_common != c {
-                        continue;
-                    }
-                    if spheres_within(
-                        centres[i],
-                        radii[i],
-                        centres[j_usize],
-                        radii[j_usize],
-                        self.skin,
-                    ) {
-                        out.push((i as u32, j));
-                    }
-                }
-            });
-            out[found_before..].sort_unstable();
-        };
-        let n = centres.len();
-        if n >= PARALLEL_SEARCH_MIN_BODIES && rayon::current_num_threads() > 1 {
-            use rayon::prelude::*;
-            // Chunks of bodies handed out one at a time (see `parallel::for_each_chunked`): the bodies
-            // of a dense region have more pairs to test.
-            let chunk =
-                n.div_ceil(rayon::current_num_threads() * super::parallel::CHUNKS_PER_THREAD);
-            let found: Vec<Vec<Pair>> = clock.region(Section::BroadSearch, true, || {
-                (0..n.div_ceil(chunk))
-                    .into_par_iter()
-                    .with_max_len(1)
-                    .map(|k| {
-                        let _timer = region_profile::chunk();
-                        let mut out = Vec::new();
-                        for i in k * chunk..((k + 1) * chunk).min(n) {
-                            search(i, &mut out);
-                        }
-                        out
-                    })
-                    .collect()
-            });
-            let mut pairs = std::mem::take(&mut self.pairs);
-            for part in found {
-                pairs.extend_from_slice(&part);
-            }
-            self.pairs = pairs;
-        } else {
-            let mut pairs = std::mem::take(&mut self.pairs);
-            // Parallel from PARALLEL_SEARCH_MIN_BODIES on a pool of several threads: not serial time.
-            let on_pool = n >= PARALLEL_SEARCH_MIN_BODIES;
-            clock.region(Section::BroadSearch, on_pool, || {
-                let _timer = region_profile::chunk();
-                for i in 0..n {
-                    search(i, &mut pairs);
-                }
-            });
-            self.pairs = pairs;
-        }
-        self.grid = grid;
-        debug_assert!(self.pairs.windows(2).all(|w| w[0] < w[1]));
     }
 
     /// Shapes `grid` over the inflated boxes of all bodies, with the median inflated diameter as cell size
@@ -474,6 +411,92 @@ impl BroadPhase {
         };
         // A sparse, spread-out scene grows its cells rather than allocating a huge empty grid.
         grid.shape(lo, hi, cell, MAX_CELLS, Oversize::GrowCells);
+    }
+}
+
+/// The pair search of a rebuild over bodies binned in `grid`.
+struct PairSearch<'a> {
+    grid: &'a Grid,
+    body_cells: &'a [CellRange],
+    centres: &'a [Point],
+    radii: &'a [Real],
+    skin: Real,
+}
+
+impl PairSearch<'_> {
+    /// Appends every pair within the skin to `pairs`, sorted. Bodies are independent here: large scenes
+    /// search in parallel chunks of bodies, concatenated in body order (the same list for any chunking).
+    fn run(&self, pairs: &mut Vec<Pair>, clock: &mut StageClock) {
+        let n = self.centres.len();
+        if n >= PARALLEL_SEARCH_MIN_BODIES && rayon::current_num_threads() > 1 {
+            use rayon::prelude::*;
+            // Chunks of bodies handed out one at a time (see `parallel::for_each_chunked`): the bodies
+            // of a dense region have more pairs to test.
+            let chunk =
+                n.div_ceil(rayon::current_num_threads() * super::parallel::CHUNKS_PER_THREAD);
+            let found: Vec<Vec<Pair>> = clock.region(Section::BroadSearch, true, || {
+                (0..n.div_ceil(chunk))
+                    .into_par_iter()
+                    .with_max_len(1)
+                    .map(|k| {
+                        let _timer = region_profile::chunk();
+                        let mut out = Vec::new();
+                        for i in k * chunk..((k + 1) * chunk).min(n) {
+                            self.body(i, &mut out);
+                        }
+                        out
+                    })
+                    .collect()
+            });
+            for part in found {
+                pairs.extend_from_slice(&part);
+            }
+        } else {
+            // Parallel from PARALLEL_SEARCH_MIN_BODIES on a pool of several threads: not serial time.
+            let on_pool = n >= PARALLEL_SEARCH_MIN_BODIES;
+            clock.region(Section::BroadSearch, on_pool, || {
+                let _timer = region_profile::chunk();
+                for i in 0..n {
+                    self.body(i, pairs);
+                }
+            });
+        }
+    }
+
+    /// Body `i`'s pairs (i, j > i), each examined in the first cell of the overlap of both cell ranges
+    /// only, and sorted as found (a few per body): the lists concatenated in body order are sorted, with
+    /// no sort of the whole list.
+    #[inline]
+    fn body(&self, i: usize, out: &mut Vec<Pair>) {
+        let found_before = out.len();
+        let range_i = &self.body_cells[i];
+        self.grid.for_each_cell(range_i, |c, bodies| {
+            for &j in bodies {
+                let j_usize = j as usize;
+                if j_usize <= i {
+                    continue;
+                }
+                let range_j = &self.body_cells[j_usize];
+                let first_common = [
+                    range_i.lo[0].max(range_j.lo[0]),
+                    range_i.lo[1].max(range_j.lo[1]),
+                    range_i.lo[2].max(range_j.lo[2]),
+                ];
+                if first_common != c {
+                    continue;
+                }
+                if spheres_within(
+                    self.centres[i],
+                    self.radii[i],
+                    self.centres[j_usize],
+                    self.radii[j_usize],
+                    self.skin,
+                ) {
+                    out.push((i as u32, j));
+                }
+            }
+        });
+        out[found_before..].sort_unstable();
     }
 }
 
