@@ -303,127 +303,34 @@ impl ExperimentConfig {
     }
 
     fn check(&self, path: &str) -> Result<(), ConfigError> {
-        let positive = [
-            ("rock.density", self.rock.density),
-            ("rock.mean_size", self.rock.mean_size),
-            ("layer.length", self.layer.length),
-            ("layer.width", self.layer.width),
-            ("layer.height", self.layer.height),
-            (
-                "packing.generation_height_factor",
-                self.packing.generation_height_factor,
-            ),
-            ("packing.steps_per_contact", self.packing.steps_per_contact),
-            ("packing.settle_speed", self.packing.settle_speed),
-            (
-                "packing.max_deposition_time",
-                self.packing.max_deposition_time,
-            ),
-            ("packing.compaction_speed", self.packing.compaction_speed),
-            (
-                "packing.compaction_pressure",
-                self.packing.compaction_pressure,
-            ),
-            ("impact.speed", self.impact.speed),
-            ("impact.max_time", self.impact.max_time),
-            ("impact.travel_per_step", self.impact.travel_per_step),
-            (
-                "impact.disturbed_threshold",
-                self.impact.disturbed_threshold,
-            ),
-        ];
-        let non_negative = [
-            ("packing.viscous_rate", self.packing.viscous_rate),
-            ("packing.hold_time", self.packing.hold_time),
-            ("impact.arrival_time", self.impact.arrival_time),
-            ("sleeping.rest_speed", self.sleeping.rest_speed),
-            ("sleeping.rest_force", self.sleeping.rest_force),
-        ];
-        for (field, value) in [
-            ("packing.collapse_gap", self.packing.collapse_gap),
-            (
-                "packing.settle_kinetic_fraction",
-                self.packing.settle_kinetic_fraction,
-            ),
-            ("packing.local_damping", self.packing.local_damping),
-        ] {
-            if let Some(v) = value {
-                if !(v.is_finite() && v > 0.0 && v < 1.0) {
-                    return Err(ConfigError::Invalid {
-                        path: path.to_owned(),
-                        field,
-                        value: v,
-                        reason: "must lie strictly between 0 and 1",
-                    });
-                }
-            }
-        }
-        for (field, value) in [
-            (
-                "packing.packing_steps_per_contact",
-                self.packing.packing_steps_per_contact,
-            ),
-            ("packing.drop_speed", self.packing.drop_speed),
-            (
-                "packing.packing_density_scale",
-                self.packing.packing_density_scale,
-            ),
-            ("packing.restore_time", self.packing.restore_time),
-        ] {
-            if let Some(v) = value {
-                if !(v.is_finite() && v > 0.0) {
-                    return Err(ConfigError::Invalid {
-                        path: path.to_owned(),
-                        field,
-                        value: v,
-                        reason: "must be finite and positive",
-                    });
-                }
-            }
-        }
-        if self.packing.deposition_damping == Some(DepositionDamping::Local)
-            && self.packing.local_damping.is_none()
-        {
-            return Err(ConfigError::Invalid {
-                path: path.to_owned(),
-                field: "packing.local_damping",
-                value: Real::NAN,
-                reason: "must be given when deposition_damping = \"local\"",
-            });
-        }
-        if self.packing.packing_density_scale.is_some() && self.packing.restore_time.is_none() {
-            return Err(ConfigError::Invalid {
-                path: path.to_owned(),
-                field: "packing.restore_time",
-                value: Real::NAN,
-                reason: "must be given with packing_density_scale",
-            });
-        }
-        if !(self.sleeping.wake_contact_fraction.is_finite()
-            && self.sleeping.wake_contact_fraction >= 0.0)
-        {
-            return Err(ConfigError::Invalid {
-                path: path.to_owned(),
-                field: "sleeping.wake_contact_fraction",
-                value: self.sleeping.wake_contact_fraction,
-                reason: "must be finite and non-negative",
-            });
-        }
         let invalid = |field, value, reason| ConfigError::Invalid {
             path: path.to_owned(),
             field,
             value,
             reason,
         };
-        for (field, value) in positive {
-            if !(value.is_finite() && value > 0.0) {
-                return Err(invalid(field, value, "must be finite and positive"));
-            }
+        let fraction = |v: Real| v.is_finite() && v > 0.0 && v < 1.0;
+        let positive = |v: Real| v.is_finite() && v > 0.0;
+        let non_negative = |v: Real| v.is_finite() && v >= 0.0;
+        if let Some((field, v)) = first_bad(&self.optional_fractions(), fraction) {
+            return Err(invalid(field, v, "must lie strictly between 0 and 1"));
         }
-        for (field, value) in non_negative {
-            if !(value.is_finite() && value >= 0.0) {
-                return Err(invalid(field, value, "must be finite and non-negative"));
-            }
+        if let Some((field, v)) = first_bad(&self.optional_positives(), positive) {
+            return Err(invalid(field, v, "must be finite and positive"));
+        }
+        if let Some((field, reason)) = self.missing_companion() {
+            return Err(invalid(field, Real::NAN, reason));
+        }
+        let wake = self.sleeping.wake_contact_fraction;
+        if !non_negative(wake) {
+            let field = "sleeping.wake_contact_fraction";
+            return Err(invalid(field, wake, "must be finite and non-negative"));
+        }
+        if let Some((field, v)) = first_bad(&self.positives().map(some), positive) {
+            return Err(invalid(field, v, "must be finite and positive"));
+        }
+        if let Some((field, v)) = first_bad(&self.non_negatives().map(some), non_negative) {
+            return Err(invalid(field, v, "must be finite and non-negative"));
         }
         if self.limits.max_rocks == 0 || self.limits.max_steps == 0 {
             return Err(invalid(
@@ -441,6 +348,84 @@ impl ExperimentConfig {
         }
         self.contact_models()?;
         Ok(())
+    }
+
+    /// The fields that must be finite and positive.
+    fn positives(&self) -> [(&'static str, Real); 15] {
+        let (r, l, p, i) = (&self.rock, &self.layer, &self.packing, &self.impact);
+        [
+            ("rock.density", r.density),
+            ("rock.mean_size", r.mean_size),
+            ("layer.length", l.length),
+            ("layer.width", l.width),
+            ("layer.height", l.height),
+            (
+                "packing.generation_height_factor",
+                p.generation_height_factor,
+            ),
+            ("packing.steps_per_contact", p.steps_per_contact),
+            ("packing.settle_speed", p.settle_speed),
+            ("packing.max_deposition_time", p.max_deposition_time),
+            ("packing.compaction_speed", p.compaction_speed),
+            ("packing.compaction_pressure", p.compaction_pressure),
+            ("impact.speed", i.speed),
+            ("impact.max_time", i.max_time),
+            ("impact.travel_per_step", i.travel_per_step),
+            ("impact.disturbed_threshold", i.disturbed_threshold),
+        ]
+    }
+
+    /// The fields that must be finite and non-negative.
+    fn non_negatives(&self) -> [(&'static str, Real); 5] {
+        [
+            ("packing.viscous_rate", self.packing.viscous_rate),
+            ("packing.hold_time", self.packing.hold_time),
+            ("impact.arrival_time", self.impact.arrival_time),
+            ("sleeping.rest_speed", self.sleeping.rest_speed),
+            ("sleeping.rest_force", self.sleeping.rest_force),
+        ]
+    }
+
+    /// The optional fields that, when given, must lie strictly between 0 and 1.
+    fn optional_fractions(&self) -> [(&'static str, Option<Real>); 3] {
+        let p = &self.packing;
+        [
+            ("packing.collapse_gap", p.collapse_gap),
+            ("packing.settle_kinetic_fraction", p.settle_kinetic_fraction),
+            ("packing.local_damping", p.local_damping),
+        ]
+    }
+
+    /// The optional fields that, when given, must be finite and positive.
+    fn optional_positives(&self) -> [(&'static str, Option<Real>); 4] {
+        let p = &self.packing;
+        [
+            (
+                "packing.packing_steps_per_contact",
+                p.packing_steps_per_contact,
+            ),
+            ("packing.drop_speed", p.drop_speed),
+            ("packing.packing_density_scale", p.packing_density_scale),
+            ("packing.restore_time", p.restore_time),
+        ]
+    }
+
+    /// An optional field another one requires, when it is missing: (the field, why).
+    fn missing_companion(&self) -> Option<(&'static str, &'static str)> {
+        let p = &self.packing;
+        if p.deposition_damping == Some(DepositionDamping::Local) && p.local_damping.is_none() {
+            return Some((
+                "packing.local_damping",
+                "must be given when deposition_damping = \"local\"",
+            ));
+        }
+        if p.packing_density_scale.is_some() && p.restore_time.is_none() {
+            return Some((
+                "packing.restore_time",
+                "must be given with packing_density_scale",
+            ));
+        }
+        None
     }
 
     /// Table 1 as the engine's laws (see the module docs).
@@ -461,6 +446,21 @@ impl ExperimentConfig {
             },
         })
     }
+}
+
+/// The first field whose value is given and fails `ok`.
+fn first_bad(
+    fields: &[(&'static str, Option<Real>)],
+    ok: impl Fn(Real) -> bool,
+) -> Option<(&'static str, Real)> {
+    fields
+        .iter()
+        .find_map(|&(field, value)| value.filter(|&v| !ok(v)).map(|v| (field, v)))
+}
+
+/// A required field as a given optional one.
+fn some((field, value): (&'static str, Real)) -> (&'static str, Option<Real>) {
+    (field, Some(value))
 }
 
 #[cfg(test)]
@@ -501,5 +501,78 @@ mod tests {
             ExperimentConfig::parse(&bad, "x"),
             Err(ConfigError::Invalid { .. })
         ));
+    }
+
+    /// The field `check` names for one bad value of each kind, and its reason.
+    #[test]
+    fn each_kind_of_bad_value_names_its_field() {
+        type Edit = fn(&mut ExperimentConfig);
+        let cases: [(Edit, &str, &str); 9] = [
+            (
+                |c| c.packing.collapse_gap = Some(1.0),
+                "packing.collapse_gap",
+                "strictly between 0 and 1",
+            ),
+            (
+                |c| c.packing.drop_speed = Some(0.0),
+                "packing.drop_speed",
+                "finite and positive",
+            ),
+            (
+                |c| {
+                    c.packing.deposition_damping = Some(DepositionDamping::Local);
+                    c.packing.local_damping = None;
+                },
+                "packing.local_damping",
+                "must be given",
+            ),
+            (
+                |c| {
+                    c.packing.packing_density_scale = Some(4.0);
+                    c.packing.restore_time = None;
+                },
+                "packing.restore_time",
+                "must be given",
+            ),
+            (
+                |c| c.sleeping.wake_contact_fraction = -1.0,
+                "sleeping.wake_contact_fraction",
+                "non-negative",
+            ),
+            (
+                |c| c.impact.travel_per_step = Real::NAN,
+                "impact.travel_per_step",
+                "finite and positive",
+            ),
+            (
+                |c| c.packing.hold_time = -0.1,
+                "packing.hold_time",
+                "non-negative",
+            ),
+            (
+                |c| c.limits.max_steps = 0,
+                "limits.max_rocks / limits.max_steps",
+                "at least 1",
+            ),
+            (
+                |c| c.packing.generation_height_factor = 0.5,
+                "packing.generation_height_factor",
+                "at least 1",
+            ),
+        ];
+        for (edit, expected_field, expected_reason) in cases {
+            let mut config = ExperimentConfig::quick();
+            edit(&mut config);
+            match config.check("x") {
+                Err(ConfigError::Invalid { field, reason, .. }) => {
+                    assert_eq!(field, expected_field, "reason: {reason}");
+                    assert!(
+                        reason.contains(expected_reason),
+                        "{field}: reason '{reason}', expected it to say '{expected_reason}'"
+                    );
+                }
+                other => panic!("{expected_field}: expected Invalid, got {other:?}"),
+            }
+        }
     }
 }
