@@ -197,23 +197,169 @@ impl Grid {
     }
 }
 
-/// The first blocker of rock `i` moving along `v` by at most `limit`: (distance, normal from the rock to the
-/// blocker), or `None` if the whole move is free.
-#[allow(clippy::too_many_arguments)]
-fn first_blocker(
-    i: usize,
+/// The rocks being moved, with their boxes binned in a grid over the container, and the report.
+struct Pile<'a> {
+    rocks: &'a mut [Rock],
+    boxes: Vec<Aabb>,
+    grid: Grid,
+    params: &'a CollapseParams,
+    /// Per rock, the last visit that looked at it (a rock in several cells is tested once per visit).
+    stamp: Vec<u64>,
+    visit: u64,
+    candidates: Vec<usize>,
+    report: CollapseReport,
+}
+
+impl<'a> Pile<'a> {
+    /// The rocks' boxes in a grid over the container, cells of the largest horizontal box extent.
+    fn new(rocks: &'a mut [Rock], params: &'a CollapseParams) -> Self {
+        let boxes: Vec<Aabb> = rocks.iter().map(|r| r.shape.aabb(&r.pose)).collect();
+        let mut cell: Real = 0.0;
+        for b in &boxes {
+            cell = cell.max(b.maxs.x - b.mins.x).max(b.maxs.y - b.mins.y);
+        }
+        let cell = cell.max(params.gap).max(Real::MIN_POSITIVE);
+        let nx = ((params.length / cell).floor() as usize + 1).max(1);
+        let ny = ((params.width / cell).floor() as usize + 1).max(1);
+        let mut grid = Grid {
+            lo: (0.0, 0.0),
+            cell,
+            nx,
+            ny,
+            cells: vec![Vec::new(); nx * ny],
+        };
+        for (i, b) in boxes.iter().enumerate() {
+            grid.insert(i, b);
+        }
+        let report = CollapseReport {
+            rocks: rocks.len(),
+            ..Default::default()
+        };
+        Self {
+            stamp: vec![u64::MAX; rocks.len()],
+            rocks,
+            boxes,
+            grid,
+            params,
+            visit: 0,
+            candidates: Vec::new(),
+            report,
+        }
+    }
+
+    /// Moves rock `i` down, then sliding on up to two blockers, until three hold it, a move is capped
+    /// short of a contact, the way down is too flat, or [`MAX_MOVES`] moves are made.
+    fn settle(&mut self, i: usize) {
+        let box0 = self.boxes[i];
+        let mut normals: Vec<Vector> = Vec::with_capacity(3);
+        for _ in 0..MAX_MOVES {
+            let Some(v) = next_direction(&mut normals) else {
+                break;
+            };
+            let limit = if normals.is_empty() {
+                Real::INFINITY
+            } else {
+                self.params.max_slide
+            };
+            self.visit += 1;
+            self.report.moves += 1;
+            let hit = self.first_blocker(i, &v, limit);
+            let s = hit.map_or(limit, |(s, _)| s);
+            if s.is_finite() && s > 0.0 {
+                self.rocks[i].pose.translation.vector += v * s;
+                self.boxes[i].mins += v * s;
+                self.boxes[i].maxs += v * s;
+            }
+            match hit {
+                Some((_, n)) if n != Vector::zeros() => {
+                    normals.push(n);
+                    if normals.len() == 3 {
+                        self.report.held_by_three += 1;
+                        break;
+                    }
+                }
+                // An advance capped short of a contact: stop here (safe).
+                Some(_) => break,
+                // A free slide: drop straight down again.
+                None => normals.clear(),
+            }
+        }
+        if self.boxes[i] != box0 {
+            self.grid.remove(i, &box0);
+            self.grid.insert(i, &self.boxes[i]);
+        }
+    }
+
+    /// The first blocker of rock `i` moving along `v` by at most `limit`: (distance, normal from the rock
+    /// to the blocker), or `None` if the whole move is free.
+    fn first_blocker(&mut self, i: usize, v: &Vector, limit: Real) -> Option<(Real, Vector)> {
+        let bi = self.boxes[i];
+        let (mut best, mut reach) = wall_blocker(&bi, v, limit, self.params);
+        self.gather_candidates(i, &swept_box(&bi, &(v * reach), self.params.gap));
+        // Nearest along the move first (by box centre), so that the first blockers shorten the reach.
+        let centre = |b: &Aabb| (b.mins.coords + b.maxs.coords) * 0.5;
+        let ci = centre(&bi);
+        let boxes = &self.boxes;
+        self.candidates.sort_by(|&a, &b| {
+            let da = (centre(&boxes[a]) - ci).dot(v);
+            let db = (centre(&boxes[b]) - ci).dot(v);
+            da.total_cmp(&db)
+        });
+        for &j in &self.candidates {
+            // Box test against the move still allowed.
+            if !swept_box(&bi, &(v * reach), self.params.gap).intersects(&self.boxes[j]) {
+                continue;
+            }
+            self.report.pairs += 1;
+            let rock = &self.rocks[i];
+            let hit = move_until_contact(
+                rock,
+                &rock.pose,
+                v,
+                &self.rocks[j],
+                self.params,
+                reach,
+                &mut self.report,
+            );
+            if let Some((s, n)) = hit {
+                if s < reach || best.is_none() {
+                    reach = s;
+                    best = Some((s, n));
+                }
+            }
+        }
+        best
+    }
+
+    /// The rocks other than `i` whose boxes meet `swept`, into `candidates`.
+    fn gather_candidates(&mut self, i: usize, swept: &Aabb) {
+        self.candidates.clear();
+        let grid = &self.grid;
+        let (x0, x1, y0, y1) = grid.range(swept);
+        for gx in x0..=x1 {
+            for gy in y0..=y1 {
+                for &j in &grid.cells[gx * grid.ny + gy] {
+                    let j = j as usize;
+                    if j != i && self.stamp[j] != self.visit {
+                        self.stamp[j] = self.visit;
+                        if swept.intersects(&self.boxes[j]) {
+                            self.candidates.push(j);
+                        }
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// The floor or side wall that box `bi` moving along `v` meets first within `limit` (stopping at the pair
+/// gap from it): (Some((distance, normal towards the wall)), distance), or (None, `limit`).
+fn wall_blocker(
+    bi: &Aabb,
     v: &Vector,
     limit: Real,
-    rocks: &[Rock],
-    boxes: &[Aabb],
-    grid: &Grid,
     params: &CollapseParams,
-    stamp: &mut [u64],
-    visit: u64,
-    candidates: &mut Vec<usize>,
-    report: &mut CollapseReport,
-) -> Option<(Real, Vector)> {
-    let bi = boxes[i];
+) -> (Option<(Real, Vector)>, Real) {
     let mut best: Option<(Real, Vector)> = None;
     let mut reach = limit;
     // Floor and side walls: (gap, rate at which the move closes it, normal towards the wall).
@@ -234,181 +380,73 @@ fn first_blocker(
             }
         }
     }
-    // Rocks whose boxes meet the box swept along the move (grown by the gap).
-    let mut swept = bi;
-    let end = v * reach;
+    (best, reach)
+}
+
+/// Box `bi` swept by `end` and grown by `gap` on every side.
+fn swept_box(bi: &Aabb, end: &Vector, gap: Real) -> Aabb {
+    let mut swept = *bi;
     for k in 0..3 {
-        swept.mins[k] = bi.mins[k].min(bi.mins[k] + end[k]) - params.gap;
-        swept.maxs[k] = bi.maxs[k].max(bi.maxs[k] + end[k]) + params.gap;
+        swept.mins[k] = bi.mins[k].min(bi.mins[k] + end[k]) - gap;
+        swept.maxs[k] = bi.maxs[k].max(bi.maxs[k] + end[k]) + gap;
     }
-    candidates.clear();
-    let (x0, x1, y0, y1) = grid.range(&swept);
-    for gx in x0..=x1 {
-        for gy in y0..=y1 {
-            for &j in &grid.cells[gx * grid.ny + gy] {
-                let j = j as usize;
-                if j != i && stamp[j] != visit {
-                    stamp[j] = visit;
-                    if swept.intersects(&boxes[j]) {
-                        candidates.push(j);
-                    }
+    swept
+}
+
+/// The next move's direction for a rock held by `normals` (none: straight down; one: down its face; two:
+/// along their crease, or down the second face when that leaves the first), or `None` when the way down
+/// is too flat. Drops the first blocker when the rock slides off it.
+fn next_direction(normals: &mut Vec<Vector>) -> Option<Vector> {
+    let down = -Vector::z();
+    let v = match *normals.as_slice() {
+        [] => down,
+        [n1] => down - n1 * down.dot(&n1),
+        [n1, n2] => {
+            let along2 = down - n2 * down.dot(&n2);
+            if along2.dot(&n1) <= 0.0 {
+                // Sliding on the second blocker alone leaves the first one.
+                normals.remove(0);
+                along2
+            } else {
+                let c = n1.cross(&n2);
+                if c.z > 0.0 {
+                    -c
+                } else {
+                    c
                 }
             }
         }
+        _ => return None,
+    };
+    let v = v.try_normalize(1e-12)?;
+    if -v.z < MIN_DESCENT {
+        None
+    } else {
+        Some(v)
     }
-    // Nearest along the move first (by box centre), so that the first blockers shorten the reach.
-    let centre = |b: &Aabb| (b.mins.coords + b.maxs.coords) * 0.5;
-    let ci = centre(&bi);
-    candidates.sort_by(|&a, &b| {
-        let da = (centre(&boxes[a]) - ci).dot(v);
-        let db = (centre(&boxes[b]) - ci).dot(v);
-        da.total_cmp(&db)
-    });
-    for &j in candidates.iter() {
-        // Box test against the move still allowed.
-        let end = v * reach;
-        let mut swept = bi;
-        for k in 0..3 {
-            swept.mins[k] = bi.mins[k].min(bi.mins[k] + end[k]) - params.gap;
-            swept.maxs[k] = bi.maxs[k].max(bi.maxs[k] + end[k]) + params.gap;
-        }
-        if !swept.intersects(&boxes[j]) {
-            continue;
-        }
-        report.pairs += 1;
-        if let Some((s, n)) = move_until_contact(
-            &rocks[i],
-            &rocks[i].pose,
-            v,
-            &rocks[j],
-            params,
-            reach,
-            report,
-        ) {
-            if s < reach || best.is_none() {
-                reach = s;
-                best = Some((s, n));
-            }
-        }
-    }
-    best
 }
 
 /// Moves the rocks (see the module docs); returns what it did.
 pub fn collapse(rocks: &mut [Rock], params: &CollapseParams) -> CollapseReport {
     let start = Instant::now();
-    let mut report = CollapseReport {
-        rocks: rocks.len(),
-        ..Default::default()
-    };
     if rocks.is_empty() {
-        return report;
+        return CollapseReport::default();
     }
-    let mut boxes: Vec<Aabb> = rocks.iter().map(|r| r.shape.aabb(&r.pose)).collect();
-    report.top_before = boxes
-        .iter()
-        .map(|b| b.maxs.z)
-        .fold(Real::NEG_INFINITY, Real::max);
     let z_before: Vec<Real> = rocks.iter().map(|r| r.pose.translation.vector.z).collect();
-    // Grid over the container, cells of the largest horizontal box extent.
-    let mut cell: Real = 0.0;
-    for b in &boxes {
-        cell = cell.max(b.maxs.x - b.mins.x).max(b.maxs.y - b.mins.y);
-    }
-    let cell = cell.max(params.gap).max(Real::MIN_POSITIVE);
-    let nx = ((params.length / cell).floor() as usize + 1).max(1);
-    let ny = ((params.width / cell).floor() as usize + 1).max(1);
-    let mut grid = Grid {
-        lo: (0.0, 0.0),
-        cell,
-        nx,
-        ny,
-        cells: vec![Vec::new(); nx * ny],
-    };
-    for (i, b) in boxes.iter().enumerate() {
-        grid.insert(i, b);
-    }
-    let mut order: Vec<usize> = (0..rocks.len()).collect();
+    let mut pile = Pile::new(rocks, params);
+    pile.report.top_before = highest_top(&pile.boxes);
+    let mut order: Vec<usize> = (0..pile.rocks.len()).collect();
+    let boxes = &pile.boxes;
     order.sort_by(|&i, &j| boxes[i].mins.z.total_cmp(&boxes[j].mins.z).then(i.cmp(&j)));
-    let mut stamp = vec![u64::MAX; rocks.len()];
-    let mut visit: u64 = 0;
-    let mut candidates: Vec<usize> = Vec::new();
-    let down = -Vector::z();
-    for &i in &order {
-        let box0 = boxes[i];
-        let mut normals: Vec<Vector> = Vec::with_capacity(3);
-        for _ in 0..MAX_MOVES {
-            let v = match *normals.as_slice() {
-                [] => down,
-                [n1] => down - n1 * down.dot(&n1),
-                [n1, n2] => {
-                    let along2 = down - n2 * down.dot(&n2);
-                    if along2.dot(&n1) <= 0.0 {
-                        // Sliding on the second blocker alone leaves the first one.
-                        normals.remove(0);
-                        along2
-                    } else {
-                        let c = n1.cross(&n2);
-                        if c.z > 0.0 {
-                            -c
-                        } else {
-                            c
-                        }
-                    }
-                }
-                _ => break,
-            };
-            let Some(v) = v.try_normalize(1e-12) else {
-                break;
-            };
-            if -v.z < MIN_DESCENT {
-                break;
-            }
-            let limit = if normals.is_empty() {
-                Real::INFINITY
-            } else {
-                params.max_slide
-            };
-            visit += 1;
-            report.moves += 1;
-            let hit = first_blocker(
-                i,
-                &v,
-                limit,
-                rocks,
-                &boxes,
-                &grid,
-                params,
-                &mut stamp,
-                visit,
-                &mut candidates,
-                &mut report,
-            );
-            let s = hit.map_or(limit, |(s, _)| s);
-            if s.is_finite() && s > 0.0 {
-                rocks[i].pose.translation.vector += v * s;
-                boxes[i].mins += v * s;
-                boxes[i].maxs += v * s;
-            }
-            match hit {
-                Some((_, n)) if n != Vector::zeros() => {
-                    normals.push(n);
-                    if normals.len() == 3 {
-                        report.held_by_three += 1;
-                        break;
-                    }
-                }
-                // An advance capped short of a contact: stop here (safe).
-                Some(_) => break,
-                // A free slide: drop straight down again.
-                None => normals.clear(),
-            }
-        }
-        if boxes[i] != box0 {
-            grid.remove(i, &box0);
-            grid.insert(i, &boxes[i]);
-        }
+    for i in order {
+        pile.settle(i);
     }
+    let Pile {
+        rocks,
+        boxes,
+        mut report,
+        ..
+    } = pile;
     let mut total_descent = 0.0;
     for (r, z0) in rocks.iter().zip(&z_before) {
         let d = z0 - r.pose.translation.vector.z;
@@ -416,10 +454,15 @@ pub fn collapse(rocks: &mut [Rock], params: &CollapseParams) -> CollapseReport {
         report.max_descent = report.max_descent.max(d);
     }
     report.mean_descent = total_descent / rocks.len() as Real;
-    report.top_after = boxes
-        .iter()
-        .map(|b| b.maxs.z)
-        .fold(Real::NEG_INFINITY, Real::max);
+    report.top_after = highest_top(&boxes);
     report.wall_time = start.elapsed();
     report
+}
+
+/// The highest top of `boxes` (m).
+fn highest_top(boxes: &[Aabb]) -> Real {
+    boxes
+        .iter()
+        .map(|b| b.maxs.z)
+        .fold(Real::NEG_INFINITY, Real::max)
 }
