@@ -21,7 +21,7 @@ use plotters::prelude::*;
 
 use super::config::ExperimentConfig;
 use super::experiment::{run_experiment_with, BedSource};
-use super::penetration::{PenetrationFiles, PenetrationOptions};
+use super::penetration::{PenetrationFiles, PenetrationOptions, PenetrationReport};
 use super::study::{has_bed, run_one, StudyError};
 use polydem::math::Real;
 
@@ -165,6 +165,20 @@ pub fn run_convergence(
     params: &ConvergenceParams,
     progress: &mut dyn FnMut(String),
 ) -> Result<ConvergenceResult, StudyError> {
+    check_params(params)?;
+    std::fs::create_dir_all(&params.out).map_err(io_error(&params.out))?;
+    let mut result = ConvergenceResult::default();
+    if !params.dt_divisors.is_empty() {
+        time_step_sequence(params, &mut result, progress)?;
+    }
+    for &w in &params.sections {
+        section_run(params, w, &mut result, progress)?;
+    }
+    Ok(result)
+}
+
+/// Refuses divisors and sections that are not finite and positive.
+fn check_params(params: &ConvergenceParams) -> Result<(), StudyError> {
     if params
         .dt_divisors
         .iter()
@@ -181,89 +195,107 @@ pub fn run_convergence(
             params.sections
         )));
     }
-    std::fs::create_dir_all(&params.out).map_err(io_error(&params.out))?;
-    let mut result = ConvergenceResult::default();
+    Ok(())
+}
+
+/// The time-step sequence: one bed (given, or generated and packed into `out/bed`), penetrated at each
+/// divisor of the experiment's Δt; the outputs rewritten after each run.
+fn time_step_sequence(
+    params: &ConvergenceParams,
+    result: &mut ConvergenceResult,
+    progress: &mut dyn FnMut(String),
+) -> Result<(), StudyError> {
     let mut quiet = |_: &str, _: String| {};
-    if !params.dt_divisors.is_empty() {
-        let bed_dir = match &params.bed {
-            Some(dir) => dir.clone(),
-            None => {
-                let dir = params.out.join("bed");
-                progress(format!(
-                    "time step: generating and packing the bed into {}",
-                    dir.display()
-                ));
-                let reuse = has_bed(&dir).then_some(dir.as_path());
-                run_one(&params.base, &dir, reuse, "convergence bed", &mut quiet)?;
-                dir
-            }
-        };
-        for &k in &params.dt_divisors {
-            let options = PenetrationOptions {
-                dt_divisor: k,
-                files: Some(PenetrationFiles {
-                    monitors: format!("monitors_dt_div{k}.csv"),
-                    ..PenetrationFiles::monitors_in(&params.out)
-                }),
-                ..PenetrationOptions::default()
-            };
-            let r = run_experiment_with(
-                &params.base,
-                BedSource::Load(&bed_dir),
-                &options,
-                &mut quiet,
-            )
-            .map_err(|source| StudyError::Run {
-                size_mm: params.base.rock.mean_size * 1e3,
-                seed: params.base.rock.seed,
-                source,
-            })?;
-            let p = &r.penetration;
+    let bed_dir = match &params.bed {
+        Some(dir) => dir.clone(),
+        None => {
+            let dir = params.out.join("bed");
             progress(format!(
-                "time step Δt/{k} = {:.3e} s: {} steps, {:.1} s, residual {:.2} m/s, deflection {:.3}° / {:.3}°",
-                p.dt,
-                p.steps,
-                p.wall_time.as_secs_f64(),
-                p.residual_speed,
-                p.final_velocity_deflection,
-                p.final_axis_deflection
+                "time step: generating and packing the bed into {}",
+                dir.display()
             ));
-            result.rows.push(ConvergenceRow {
-                sequence: Sequence::TimeStep,
-                parameter: k,
-                dt: p.dt,
-                rocks: p.rocks,
-                steps: p.steps,
-                run_s: p.wall_time.as_secs_f64(),
-                residual_speed: p.residual_speed,
-                velocity_deflection: p.final_velocity_deflection,
-                axis_deflection: p.final_axis_deflection,
-                exited: p.outcome == super::penetration::Outcome::Exited,
-            });
-            write_outputs(params, &result)?;
+            let reuse = has_bed(&dir).then_some(dir.as_path());
+            run_one(&params.base, &dir, reuse, "convergence bed", &mut quiet)?;
+            dir
         }
-    }
-    for &w in &params.sections {
-        let mut config = params.base;
-        config.layer.width = w;
-        config.layer.height = w;
-        let dir = params.out.join(format!("section_{w}m"));
-        let title = format!("cross-section {w} m × {w} m");
-        let reuse = has_bed(&dir).then_some(dir.as_path());
-        let r = run_one(&config, &dir, reuse, &title, &mut quiet)?;
+    };
+    for &k in &params.dt_divisors {
+        let options = PenetrationOptions {
+            dt_divisor: k,
+            files: Some(PenetrationFiles {
+                monitors: format!("monitors_dt_div{k}.csv"),
+                ..PenetrationFiles::monitors_in(&params.out)
+            }),
+            ..PenetrationOptions::default()
+        };
+        let r = run_experiment_with(
+            &params.base,
+            BedSource::Load(&bed_dir),
+            &options,
+            &mut quiet,
+        )
+        .map_err(|source| StudyError::Run {
+            size_mm: params.base.rock.mean_size * 1e3,
+            seed: params.base.rock.seed,
+            source,
+        })?;
         let p = &r.penetration;
-        let run_s = r
-            .bed
-            .as_ref()
-            .map_or(Real::NAN, |b| b.generation_s + b.packing_s)
-            + p.wall_time.as_secs_f64();
         progress(format!(
-            "cross-section {w} m: {} rocks, {:.1} s, residual {:.2} m/s, deflection {:.3}° / {:.3}°",
-            p.rocks, run_s, p.residual_speed, p.final_velocity_deflection, p.final_axis_deflection
+            "time step Δt/{k} = {:.3e} s: {} steps, {:.1} s, residual {:.2} m/s, deflection {:.3}° / {:.3}°",
+            p.dt,
+            p.steps,
+            p.wall_time.as_secs_f64(),
+            p.residual_speed,
+            p.final_velocity_deflection,
+            p.final_axis_deflection
         ));
-        result.rows.push(ConvergenceRow {
-            sequence: Sequence::CrossSection,
-            parameter: w,
+        let run_s = p.wall_time.as_secs_f64();
+        result
+            .rows
+            .push(ConvergenceRow::of(Sequence::TimeStep, k, p, run_s));
+        write_outputs(params, result)?;
+    }
+    Ok(())
+}
+
+/// One run of the cross-section sequence: a layer `w` × `w` generated, packed and penetrated (its bed
+/// kept in `out/section_<w>m` and reused when there); the outputs rewritten after it.
+fn section_run(
+    params: &ConvergenceParams,
+    w: Real,
+    result: &mut ConvergenceResult,
+    progress: &mut dyn FnMut(String),
+) -> Result<(), StudyError> {
+    let mut quiet = |_: &str, _: String| {};
+    let mut config = params.base;
+    config.layer.width = w;
+    config.layer.height = w;
+    let dir = params.out.join(format!("section_{w}m"));
+    let title = format!("cross-section {w} m × {w} m");
+    let reuse = has_bed(&dir).then_some(dir.as_path());
+    let r = run_one(&config, &dir, reuse, &title, &mut quiet)?;
+    let p = &r.penetration;
+    let run_s = r
+        .bed
+        .as_ref()
+        .map_or(Real::NAN, |b| b.generation_s + b.packing_s)
+        + p.wall_time.as_secs_f64();
+    progress(format!(
+        "cross-section {w} m: {} rocks, {:.1} s, residual {:.2} m/s, deflection {:.3}° / {:.3}°",
+        p.rocks, run_s, p.residual_speed, p.final_velocity_deflection, p.final_axis_deflection
+    ));
+    result
+        .rows
+        .push(ConvergenceRow::of(Sequence::CrossSection, w, p, run_s));
+    write_outputs(params, result)
+}
+
+impl ConvergenceRow {
+    /// The row of a run of `sequence` at `parameter` that took `run_s` seconds.
+    fn of(sequence: Sequence, parameter: Real, p: &PenetrationReport, run_s: f64) -> Self {
+        Self {
+            sequence,
+            parameter,
             dt: p.dt,
             rocks: p.rocks,
             steps: p.steps,
@@ -272,10 +304,8 @@ pub fn run_convergence(
             velocity_deflection: p.final_velocity_deflection,
             axis_deflection: p.final_axis_deflection,
             exited: p.outcome == super::penetration::Outcome::Exited,
-        });
-        write_outputs(params, &result)?;
+        }
     }
-    Ok(result)
 }
 
 fn write_outputs(params: &ConvergenceParams, result: &ConvergenceResult) -> Result<(), StudyError> {
