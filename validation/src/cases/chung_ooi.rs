@@ -178,99 +178,21 @@ impl Case for ChungOoi {
 
 /// Tests 1 and 2: elastic normal impacts, sphere on sphere and sphere on wall, against Hertz theory.
 fn hertz_impacts(ctx: &mut CaseContext, inp: &Inputs) -> Result<(), SuiteError> {
-    // Tests 1 and 2: Hertz theory.
     let mut hertz_rows = Vec::new();
-    let mut hertz_check = |ctx: &mut CaseContext,
-                           test: &str,
-                           m: &Material,
-                           run: &Impact,
-                           theory: (Real, Real, Real)|
-     -> Result<(), SuiteError> {
-        let tag = format!("{test}_{}", m.name);
-        for (quantity, unit, measured, expected) in [
-            ("peak_force", "N", run.peak_force, theory.0),
-            ("peak_overlap", "m", run.peak_overlap, theory.1),
-            ("contact_duration", "s", run.duration, theory.2),
-        ] {
-            let error = (measured - expected).abs() / expected;
-            ctx.check(
-                &format!("{tag}_{quantity}_rel_error"),
-                error,
-                Target::at_most(inp.hertz_tol),
-                "1",
-            );
-            hertz_rows.push(vec![
-                test.to_string(),
-                m.name.to_string(),
-                format!("{quantity} ({unit})"),
-                CaseContext::fmt(measured),
-                CaseContext::fmt(expected),
-                CaseContext::fmt(error),
-            ]);
-        }
-        Ok(())
-    };
     for m in [
         inp.material("glass", "t1_glass")?,
         inp.material("limestone", "t1_limestone")?,
     ] {
-        let (radius, speed) = (inp.r("t1_radius")?, inp.r("t1_speed")?);
-        let pair = SpherePair {
-            material_a: elastic(&m).map_err(chung_ooi_error)?,
-            material_b: elastic(&m).map_err(chung_ooi_error)?,
-            radius_a: radius,
-            radius_b: Some(radius),
-            restitution: 1.0,
-            friction: 0.0,
-        };
-        let model = hertz_mindlin(&pair).map_err(|e| chung_ooi_error(e.to_string()))?;
-        let a = sphere(&m, radius, Point::origin(), Vector::new(0.0, 0.0, speed));
-        let b = sphere(
-            &m,
-            radius,
-            Point::new(0.0, 0.0, 2.0 * radius * (1.0 + 1e-4)),
-            Vector::new(0.0, 0.0, -speed),
-        );
-        let m_star = 0.5 * a.mass;
-        let approach = 2.0 * speed;
-        let dt = model.normal.elastic_contact_time(m_star, approach) / inp.p.steps_per_contact;
-        let run = impact(
-            &model,
-            a,
-            b,
-            m_star,
-            dt,
-            (50.0 * inp.p.steps_per_contact) as usize,
-            |a, b| sphere_sphere(radius, radius, a, b),
-        );
-        let e_star = effective_young_modulus(&pair.material_a, &pair.material_b);
-        let theory = hertz_theory(e_star, effective(radius, Some(radius)), m_star, approach);
-        hertz_check(ctx, "test1", &m, &run, theory)?;
+        let (run, theory) = sphere_on_sphere(inp, &m)?;
+        hertz_check(ctx, inp, ("test1", &m), &run, theory, &mut hertz_rows);
         ctx.progress().inc(1);
     }
     for m in [
         inp.material("aluminium_alloy", "t2_al")?,
         inp.material("magnesium_alloy", "t2_mg")?,
     ] {
-        let (radius, speed) = (inp.r("t2_radius")?, inp.r("t2_speed")?);
-        let wall = wall_material(&m, inp.factor);
-        let (run, m_star) = wall_impact(
-            &m,
-            &wall,
-            radius,
-            speed,
-            0.0,
-            1.0,
-            0.0,
-            inp.p.steps_per_contact,
-        )
-        .map_err(chung_ooi_error)?;
-        let e_star = effective_young_modulus(
-            &elastic(&wall).map_err(chung_ooi_error)?,
-            &elastic(&m).map_err(chung_ooi_error)?,
-        );
-        let theory = hertz_theory(e_star, radius, m_star, speed);
-        hertz_check(ctx, "test2", &m, &run, theory)?;
+        let (run, theory) = sphere_on_wall(inp, &m)?;
+        hertz_check(ctx, inp, ("test2", &m), &run, theory, &mut hertz_rows);
         ctx.progress().inc(1);
     }
 
@@ -293,6 +215,101 @@ fn hertz_impacts(ctx: &mut CaseContext, inp: &Inputs) -> Result<(), SuiteError> 
         &hertz_rows,
     )?;
     Ok(())
+}
+
+/// Checks the peak force, peak overlap and contact duration of `run` against Hertz theory `theory` (in that
+/// order) for `test` on material `m`, and adds their rows.
+fn hertz_check(
+    ctx: &mut CaseContext,
+    inp: &Inputs,
+    (test, m): (&str, &Material),
+    run: &Impact,
+    theory: (Real, Real, Real),
+    rows: &mut Vec<Vec<String>>,
+) {
+    let tag = format!("{test}_{}", m.name);
+    for (quantity, unit, measured, expected) in [
+        ("peak_force", "N", run.peak_force, theory.0),
+        ("peak_overlap", "m", run.peak_overlap, theory.1),
+        ("contact_duration", "s", run.duration, theory.2),
+    ] {
+        let error = (measured - expected).abs() / expected;
+        ctx.check(
+            &format!("{tag}_{quantity}_rel_error"),
+            error,
+            Target::at_most(inp.hertz_tol),
+            "1",
+        );
+        rows.push(vec![
+            test.to_string(),
+            m.name.to_string(),
+            format!("{quantity} ({unit})"),
+            CaseContext::fmt(measured),
+            CaseContext::fmt(expected),
+            CaseContext::fmt(error),
+        ]);
+    }
+}
+
+/// Test 1: two equal spheres of `m` meeting head on; the run and Hertz theory (F_max, δ_max, t_c).
+fn sphere_on_sphere(
+    inp: &Inputs,
+    m: &Material,
+) -> Result<(Impact, (Real, Real, Real)), SuiteError> {
+    let (radius, speed) = (inp.r("t1_radius")?, inp.r("t1_speed")?);
+    let pair = SpherePair {
+        material_a: elastic(m).map_err(chung_ooi_error)?,
+        material_b: elastic(m).map_err(chung_ooi_error)?,
+        radius_a: radius,
+        radius_b: Some(radius),
+        restitution: 1.0,
+        friction: 0.0,
+    };
+    let model = hertz_mindlin(&pair).map_err(|e| chung_ooi_error(e.to_string()))?;
+    let a = sphere(m, radius, Point::origin(), Vector::new(0.0, 0.0, speed));
+    let b = sphere(
+        m,
+        radius,
+        Point::new(0.0, 0.0, 2.0 * radius * (1.0 + 1e-4)),
+        Vector::new(0.0, 0.0, -speed),
+    );
+    let m_star = 0.5 * a.mass;
+    let approach = 2.0 * speed;
+    let dt = model.normal.elastic_contact_time(m_star, approach) / inp.p.steps_per_contact;
+    let run = impact(
+        &model,
+        a,
+        b,
+        m_star,
+        dt,
+        (50.0 * inp.p.steps_per_contact) as usize,
+        |a, b| sphere_sphere(radius, radius, a, b),
+    );
+    let e_star = effective_young_modulus(&pair.material_a, &pair.material_b);
+    let theory = hertz_theory(e_star, effective(radius, Some(radius)), m_star, approach);
+    Ok((run, theory))
+}
+
+/// Test 2: a sphere of `m` on its wall; the run and Hertz theory (F_max, δ_max, t_c).
+fn sphere_on_wall(inp: &Inputs, m: &Material) -> Result<(Impact, (Real, Real, Real)), SuiteError> {
+    let (radius, speed) = (inp.r("t2_radius")?, inp.r("t2_speed")?);
+    let wall = wall_material(m, inp.factor);
+    let (run, m_star) = wall_impact(
+        m,
+        &wall,
+        radius,
+        speed,
+        0.0,
+        1.0,
+        0.0,
+        inp.p.steps_per_contact,
+    )
+    .map_err(chung_ooi_error)?;
+    let e_star = effective_young_modulus(
+        &elastic(&wall).map_err(chung_ooi_error)?,
+        &elastic(m).map_err(chung_ooi_error)?,
+    );
+    Ok((run, hertz_theory(e_star, radius, m_star, speed)))
 }
 
 /// Test 3: output against input restitution, sphere on wall.
@@ -369,83 +386,98 @@ fn restitution_impacts(ctx: &mut CaseContext, inp: &Inputs) -> Result<(), SuiteE
     Ok(())
 }
 
+/// One oblique impact of test 4, ours beside the rigid-body solution.
+struct Oblique {
+    angle: Real,
+    /// The rigid-body solution's regime: gross sliding (else rolling at exit).
+    sliding: bool,
+    /// In gross sliding beyond the margin: checked.
+    checked: bool,
+    /// v_t'/v_t, ours and rigid.
+    vt_ratio: [Real; 2],
+    /// ω' (rad/s), ours and rigid.
+    spin: [Real; 2],
+    /// Relative errors of v_t' and ω'.
+    errors: [Real; 2],
+}
+
 /// Test 4: oblique impacts against the rigid-body solution with Coulomb friction.
 fn oblique_impacts(ctx: &mut CaseContext, inp: &Inputs) -> Result<(), SuiteError> {
     let margin = inp.margin;
-    let (radius, speed) = (inp.r("t34_radius")?, inp.r("t34_speed")?);
-    // Test 4: oblique impacts.
-    let m = inp.material("aluminium_oxide", "t34_alox")?;
-    let wall = wall_material(&m, inp.factor);
     let (mu, e) = (inp.r("t4_friction")?, inp.r("t4_restitution")?);
     let threshold = 3.5 * mu * (1.0 + e);
-    let mut oblique_rows = Vec::new();
-    let (mut et_ours, mut et_theory, mut w_ours, mut w_theory) =
-        (Vec::new(), Vec::new(), Vec::new(), Vec::new());
-    let (mut worst_vt, mut worst_spin, mut checked): (Real, Real, usize) = (0.0, 0.0, 0);
+    let mut impacts = Vec::new();
     for &angle in &inp.p.angles_deg {
-        let theta = angle.to_radians();
-        let (v_n, v_t) = (speed * theta.cos(), speed * theta.sin());
-        let (run, _) = wall_impact(&m, &wall, radius, v_n, v_t, e, mu, inp.p.steps_per_contact)
-            .map_err(chung_ooi_error)?;
-        let (vt_after, spin) = (run.b.velocity.x, run.b.angular_velocity().y);
-        let sliding = theta.tan() >= threshold;
-        let (vt_rigid, spin_rigid) = if sliding {
-            (
-                v_t - mu * (1.0 + e) * v_n,
-                2.5 * mu * (1.0 + e) * v_n / radius,
-            )
-        } else {
-            (5.0 / 7.0 * v_t, 5.0 / 7.0 * v_t / radius)
-        };
-        let checked_here = theta.tan() >= margin * threshold;
-        let (err_vt, err_spin) = (
-            (vt_after - vt_rigid).abs() / vt_rigid.abs(),
-            (spin - spin_rigid).abs() / spin_rigid.abs(),
-        );
-        if checked_here {
-            worst_vt = worst_vt.max(err_vt);
-            worst_spin = worst_spin.max(err_spin);
-            checked += 1;
-        }
-        oblique_rows.push(vec![
-            format!("{angle}"),
-            if sliding {
-                "gross sliding"
-            } else {
-                "rolling at exit (rigid)"
-            }
-            .into(),
-            if checked_here { "yes" } else { "no" }.into(),
-            format!("{:.5}", vt_after / v_t),
-            format!("{:.5}", vt_rigid / v_t),
-            format!("{spin:.3}"),
-            format!("{spin_rigid:.3}"),
-        ]);
-        et_ours.push((angle, vt_after / v_t));
-        et_theory.push((angle, vt_rigid / v_t));
-        w_ours.push((angle, spin));
-        w_theory.push((angle, spin_rigid));
+        impacts.push(oblique_impact(inp, angle, threshold)?);
         ctx.progress().inc(1);
     }
-    if checked == 0 {
+    let checked: Vec<&Oblique> = impacts.iter().filter(|o| o.checked).collect();
+    if checked.is_empty() {
         return Err(chung_ooi_error(format!(
             "no incident angle of {:?} is in gross sliding (tan θ ≥ {margin} × {threshold:.4})",
             inp.p.angles_deg
         )));
     }
+    let worst = |k: usize| checked.iter().map(|o| o.errors[k]).fold(0.0, Real::max);
     ctx.check(
         "test4_gross_sliding_tangential_velocity_rel_error_max",
-        worst_vt,
+        worst(0),
         Target::at_most(inp.sliding_tol),
         "1",
     );
     ctx.check(
         "test4_gross_sliding_spin_rel_error_max",
-        worst_spin,
+        worst(1),
         Target::at_most(inp.sliding_tol),
         "1",
     );
+    report_oblique(ctx, inp, &impacts, threshold, checked.len())
+}
 
+/// The aluminium oxide sphere on its wall at `angle` degrees from the normal, with the rigid-body
+/// solution (gross sliding from tan θ ≥ `threshold`).
+fn oblique_impact(inp: &Inputs, angle: Real, threshold: Real) -> Result<Oblique, SuiteError> {
+    let (radius, speed) = (inp.r("t34_radius")?, inp.r("t34_speed")?);
+    let m = inp.material("aluminium_oxide", "t34_alox")?;
+    let wall = wall_material(&m, inp.factor);
+    let (mu, e) = (inp.r("t4_friction")?, inp.r("t4_restitution")?);
+    let theta = angle.to_radians();
+    let (v_n, v_t) = (speed * theta.cos(), speed * theta.sin());
+    let (run, _) = wall_impact(&m, &wall, radius, v_n, v_t, e, mu, inp.p.steps_per_contact)
+        .map_err(chung_ooi_error)?;
+    let (vt_after, spin) = (run.b.velocity.x, run.b.angular_velocity().y);
+    let sliding = theta.tan() >= threshold;
+    let (vt_rigid, spin_rigid) = if sliding {
+        (
+            v_t - mu * (1.0 + e) * v_n,
+            2.5 * mu * (1.0 + e) * v_n / radius,
+        )
+    } else {
+        (5.0 / 7.0 * v_t, 5.0 / 7.0 * v_t / radius)
+    };
+    Ok(Oblique {
+        angle,
+        sliding,
+        checked: theta.tan() >= inp.margin * threshold,
+        vt_ratio: [vt_after / v_t, vt_rigid / v_t],
+        spin: [spin, spin_rigid],
+        errors: [
+            (vt_after - vt_rigid).abs() / vt_rigid.abs(),
+            (spin - spin_rigid).abs() / spin_rigid.abs(),
+        ],
+    })
+}
+
+/// Test 4's section: the text, the table and the two plots.
+fn report_oblique(
+    ctx: &mut CaseContext,
+    inp: &Inputs,
+    impacts: &[Oblique],
+    threshold: Real,
+    checked: usize,
+) -> Result<(), SuiteError> {
+    let (margin, speed) = (inp.margin, inp.r("t34_speed")?);
+    let (mu, e) = (inp.r("t4_friction")?, inp.r("t4_restitution")?);
     ctx.section("Test 4: oblique impacts against the rigid-body solution");
     ctx.text(&format!(
         "Aluminium oxide sphere, resultant speed {speed} m/s, μ = {mu}, e = {e}. Rigid-body impulse solution \
@@ -456,6 +488,25 @@ fn oblique_impacts(ctx: &mut CaseContext, inp: &Inputs) -> Result<(), SuiteError
          sliding branch is checked for tan θ ≥ {margin} × {threshold:.4} ({checked} angles).",
         threshold.atan().to_degrees()
     ));
+    let rows: Vec<Vec<String>> = impacts
+        .iter()
+        .map(|o| {
+            vec![
+                format!("{}", o.angle),
+                if o.sliding {
+                    "gross sliding"
+                } else {
+                    "rolling at exit (rigid)"
+                }
+                .into(),
+                if o.checked { "yes" } else { "no" }.into(),
+                format!("{:.5}", o.vt_ratio[0]),
+                format!("{:.5}", o.vt_ratio[1]),
+                format!("{:.3}", o.spin[0]),
+                format!("{:.3}", o.spin[1]),
+            ]
+        })
+        .collect();
     ctx.table(
         Some("oblique"),
         &[
@@ -467,8 +518,23 @@ fn oblique_impacts(ctx: &mut CaseContext, inp: &Inputs) -> Result<(), SuiteError
             "ω' ours (rad/s)",
             "ω' rigid (rad/s)",
         ],
-        &oblique_rows,
+        &rows,
     )?;
+    let series = |pick: fn(&Oblique) -> [Real; 2]| -> Vec<Series> {
+        let points = |k: usize| impacts.iter().map(|o| (o.angle, pick(o)[k])).collect();
+        vec![
+            Series {
+                label: "polydem (Hertz–Mindlin)".into(),
+                style: SeriesStyle::Points,
+                points: points(0),
+            },
+            Series {
+                label: "rigid-body solution".into(),
+                style: SeriesStyle::Line,
+                points: points(1),
+            },
+        ]
+    };
     ctx.plot(&Plot {
         name: "test4_tangential_restitution".into(),
         title: "Test 4: tangential coefficient of restitution".into(),
@@ -476,18 +542,7 @@ fn oblique_impacts(ctx: &mut CaseContext, inp: &Inputs) -> Result<(), SuiteError
         y_label: "v_t'/v_t (1)".into(),
         x_log: false,
         y_log: false,
-        series: vec![
-            Series {
-                label: "polydem (Hertz–Mindlin)".into(),
-                style: SeriesStyle::Points,
-                points: et_ours,
-            },
-            Series {
-                label: "rigid-body solution".into(),
-                style: SeriesStyle::Line,
-                points: et_theory,
-            },
-        ],
+        series: series(|o| o.vt_ratio),
         caption: "Below the sliding threshold the Mindlin spring's compliance lowers v_t'/v_t under 5/7 (Maw et al.)."
             .into(),
     })?;
@@ -498,18 +553,7 @@ fn oblique_impacts(ctx: &mut CaseContext, inp: &Inputs) -> Result<(), SuiteError
         y_label: "ω' (rad/s)".into(),
         x_log: false,
         y_log: false,
-        series: vec![
-            Series {
-                label: "polydem (Hertz–Mindlin)".into(),
-                style: SeriesStyle::Points,
-                points: w_ours,
-            },
-            Series {
-                label: "rigid-body solution".into(),
-                style: SeriesStyle::Line,
-                points: w_theory,
-            },
-        ],
+        series: series(|o| o.spin),
         caption: "Spin about the axis n × t (the rolling sense).".into(),
     })?;
     Ok(())
