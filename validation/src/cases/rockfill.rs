@@ -11,7 +11,9 @@
 
 use polydem::math::Real;
 use polydem_rockfill::config::ExperimentConfig;
-use polydem_rockfill::convergence::{run_convergence, ConvergenceParams, Sequence};
+use polydem_rockfill::convergence::{
+    run_convergence, ConvergenceParams, ConvergenceResult, ConvergenceRow, Sequence,
+};
 use polydem_rockfill::experiment::ExperimentResult;
 use polydem_rockfill::penetration::{MonitorRow, Outcome};
 use polydem_rockfill::study::run_one;
@@ -354,21 +356,7 @@ fn time_step_convergence(
             "m/s",
         );
     }
-    let mut trows = Vec::new();
-    for (k, r) in seq.iter().enumerate() {
-        let d = if k == 0 { None } else { Some(diffs[k - 1]) };
-        trows.push(vec![
-            format!("{}", r.parameter),
-            CaseContext::fmt(r.dt),
-            format!("{}", r.steps),
-            format!("{:.1}", r.run_s),
-            format!("{:.3}", r.residual_speed),
-            format!("{:.3}", r.velocity_deflection),
-            format!("{:.3}", r.axis_deflection),
-            d.map_or("–".into(), |d| format!("{:.3}", d[0])),
-            d.map_or("–".into(), |d| format!("{:.3}", d[2])),
-        ]);
-    }
+    let trows = time_step_rows(&seq, &diffs);
     // Judged against the spread over perturbed initial states (see `rockfill_dt_spread`).
     let spread_params = SpreadParams {
         size_fraction: p.perturbation_size_fraction,
@@ -389,6 +377,40 @@ fn time_step_convergence(
             &mut spread_rows,
         )?;
     }
+    report_time_step(ctx, p, seed, spread_params.tolerance, &trows, &spread_rows)?;
+    work_precision_plot(ctx, &conv, &seq)
+}
+
+/// The time-step table's rows: k, Δt, steps, run time, the results and their changes from the previous k.
+fn time_step_rows(seq: &[&ConvergenceRow], diffs: &[[Real; 3]]) -> Vec<Vec<String>> {
+    let mut trows = Vec::new();
+    for (k, r) in seq.iter().enumerate() {
+        let d = if k == 0 { None } else { Some(diffs[k - 1]) };
+        trows.push(vec![
+            format!("{}", r.parameter),
+            CaseContext::fmt(r.dt),
+            format!("{}", r.steps),
+            format!("{:.1}", r.run_s),
+            format!("{:.3}", r.residual_speed),
+            format!("{:.3}", r.velocity_deflection),
+            format!("{:.3}", r.axis_deflection),
+            d.map_or("–".into(), |d| format!("{:.3}", d[0])),
+            d.map_or("–".into(), |d| format!("{:.3}", d[2])),
+        ]);
+    }
+    trows
+}
+
+/// The time-step section's text and its two tables.
+fn report_time_step(
+    ctx: &mut CaseContext,
+    p: &Params,
+    seed: u64,
+    tolerance: Real,
+    trows: &[Vec<String>],
+    spread_rows: &[Vec<String>],
+) -> Result<(), SuiteError> {
+    let coarse = p.coarse_dt_divisor;
     ctx.section("Time-step convergence of the penetration run");
     ctx.text(&format!(
         "Seed {seed}'s packed bed (engine checkpoint, so every run starts from the same state bit for bit), \
@@ -397,7 +419,7 @@ fn time_step_convergence(
          halving it changes the result by at most {tol} of the result's range over {n} runs at Δt/k \
          whose aim is displaced by {frac} rock sizes around the flight axis. The shipped Δt (k = 1) \
          must pass; the coarse step k = {coarse} must be flagged, which shows the check can fail.",
-        tol = spread_params.tolerance,
+        tol = tolerance,
         n = p.perturbations,
         frac = p.perturbation_size_fraction,
     ));
@@ -414,7 +436,7 @@ fn time_step_convergence(
             "|Δ residual| to previous (m/s)",
             "|Δ axis deflection| to previous (°)",
         ],
-        &trows,
+        trows,
     )?;
     ctx.table(
         Some("time_step_spread"),
@@ -426,8 +448,17 @@ fn time_step_convergence(
             "change / range",
             "verdict",
         ],
-        &spread_rows,
+        spread_rows,
     )?;
+    Ok(())
+}
+
+/// Run time against the change of the result from the smallest Δt, log–log.
+fn work_precision_plot(
+    ctx: &mut CaseContext,
+    conv: &ConvergenceResult,
+    seq: &[&ConvergenceRow],
+) -> Result<(), SuiteError> {
     let point = |q: usize| -> Vec<(Real, Real)> {
         seq.iter()
             .map(|r| (r.run_s, conv.change(r)[q]))
