@@ -17,6 +17,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 use std::time::{Duration, Instant};
 
+use polydem_mpi::launch;
 use serde_json::Value;
 
 const EXE: &str = env!("CARGO_BIN_EXE_polydem");
@@ -39,12 +40,7 @@ fn out_dir(case: &str) -> PathBuf {
 /// `polydem run ARGS` on `ranks` ranks (`None`: without `mpirun`); panics with the output on failure.
 fn polydem(ranks: Option<usize>, args: &[&str]) -> Output {
     let mut command = match ranks {
-        Some(n) => {
-            let mpirun = std::env::var("POLYDEM_MPIRUN").unwrap_or_else(|_| "mpirun.mpich".into());
-            let mut c = Command::new(mpirun);
-            c.args(["-n", &n.to_string(), EXE]);
-            c
-        }
+        Some(n) => launch::command(n, EXE),
         None => Command::new(EXE),
     };
     let start = Instant::now();
@@ -434,10 +430,9 @@ fn a_rank_that_fails_stops_every_rank_with_its_message() {
     let blocker = out_dir("blocker");
     std::fs::write(&blocker, "a file").expect("a file in the temporary directory");
     let out = blocker.join("out");
-    let mpirun = std::env::var("POLYDEM_MPIRUN").unwrap_or_else(|_| "mpirun.mpich".into());
     let start = Instant::now();
-    let output = Command::new(mpirun)
-        .args(["-n", "3", EXE, "run"])
+    let output = launch::command(3, EXE)
+        .arg("run")
         .arg(scene("settling_box"))
         .arg("--out")
         .arg(&out)

@@ -67,6 +67,7 @@
 
 pub mod decomposition;
 pub mod error;
+pub mod launch;
 pub mod plan;
 pub mod scaling;
 

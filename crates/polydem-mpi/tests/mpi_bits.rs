@@ -8,12 +8,12 @@
 //! differs, and aborts every rank.
 
 use std::path::PathBuf;
-use std::process::Command;
 use std::time::Instant;
 
 use polydem::dynamics::RigidBody;
 use polydem::scene::load_scene;
 use polydem::world::{step, StepScratch};
+use polydem_mpi::launch::launch_each;
 use polydem_mpi::mpi::traits::*;
 use polydem_mpi::DistributedRun;
 
@@ -31,25 +31,11 @@ fn main() {
 
 fn launch() {
     let exe = std::env::current_exe().expect("the test binary's path");
-    let mpirun = std::env::var("POLYDEM_MPIRUN").unwrap_or_else(|_| "mpirun.mpich".to_owned());
     let mut failures = Vec::new();
     for (case, _) in CASES {
-        for ranks in RANKS {
-            let start = Instant::now();
-            let status = Command::new(&mpirun)
-                .args(["-n", &ranks.to_string()])
-                .arg(&exe)
-                .env("POLYDEM_MPI_CASE", case)
-                .status()
-                .unwrap_or_else(|e| panic!("{mpirun} could not be started: {e}"));
-            println!(
-                "{case}, {ranks} ranks: {status} in {:.1} s",
-                start.elapsed().as_secs_f64()
-            );
-            if !status.success() {
-                failures.push(format!("{case} on {ranks} ranks: {status}"));
-            }
-        }
+        failures.extend(launch_each(case, &RANKS, &exe, |c| {
+            c.env("POLYDEM_MPI_CASE", case);
+        }));
     }
     assert!(
         failures.is_empty(),

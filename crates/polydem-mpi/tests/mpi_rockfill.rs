@@ -11,10 +11,10 @@
 //! differs, and aborts every rank.
 
 use std::path::{Path, PathBuf};
-use std::process::Command;
 use std::time::Instant;
 
 use polydem::dynamics::RigidBody;
+use polydem_mpi::launch::launch_each;
 use polydem_mpi::mpi::traits::*;
 use polydem_rockfill::config::ExperimentConfig;
 use polydem_rockfill::experiment::{run_experiment_with, BedSource, ExperimentResult};
@@ -79,24 +79,9 @@ fn launch() {
         .unwrap_or_else(|e| panic!("writing {}: {e}", file.display()));
 
     let exe = std::env::current_exe().expect("the test binary's path");
-    let mpirun = std::env::var("POLYDEM_MPIRUN").unwrap_or_else(|_| "mpirun.mpich".to_owned());
-    let mut failures = Vec::new();
-    for ranks in RANKS {
-        let start = Instant::now();
-        let status = Command::new(&mpirun)
-            .args(["-n", &ranks.to_string()])
-            .arg(&exe)
-            .env("POLYDEM_MPI_EXPECTED", &file)
-            .status()
-            .unwrap_or_else(|e| panic!("{mpirun} could not be started: {e}"));
-        println!(
-            "rockfill quick, {ranks} ranks: {status} in {:.1} s",
-            start.elapsed().as_secs_f64()
-        );
-        if !status.success() {
-            failures.push(format!("rockfill quick on {ranks} ranks: {status}"));
-        }
-    }
+    let failures = launch_each("rockfill quick", &RANKS, &exe, |c| {
+        c.env("POLYDEM_MPI_EXPECTED", &file);
+    });
     let _ = std::fs::remove_file(&file);
     assert!(
         failures.is_empty(),

@@ -8,7 +8,6 @@
 //! third (the world fixed).
 
 use std::path::Path;
-use std::process::Command;
 use std::time::Instant;
 
 use polydem::math::Point;
@@ -61,11 +60,10 @@ pub fn configurations() -> Vec<(SceneKind, usize, Lattice, u64)> {
     list
 }
 
-fn launch(mpirun: &str, ranks: usize, args: &[String]) -> Result<(), Error> {
+fn launch(ranks: usize, args: &[String]) -> Result<(), Error> {
     let exe = std::env::current_exe()?;
-    let status = Command::new(mpirun)
-        .args(["-n", &ranks.to_string()])
-        .arg(&exe)
+    let mpirun = polydem_mpi::launch::mpirun();
+    let status = polydem_mpi::launch::command(ranks, &exe)
         .args(args)
         .env("RAYON_NUM_THREADS", "1")
         .status()
@@ -84,7 +82,6 @@ pub fn drive(out: &Path, repeats: usize) -> Result<(), Error> {
     if csv.exists() {
         std::fs::remove_file(&csv).map_err(|e| format!("{}: {e}", csv.display()))?;
     }
-    let mpirun = std::env::var("POLYDEM_MPIRUN").unwrap_or_else(|_| "mpirun.mpich".to_owned());
     let start = Instant::now();
     let mut run = 0u32;
     for _ in 0..repeats {
@@ -109,15 +106,11 @@ pub fn drive(out: &Path, repeats: usize) -> Result<(), Error> {
             ]
             .map(str::to_owned)
             .to_vec();
-            launch(&mpirun, ranks, &args)?;
+            launch(ranks, &args)?;
         }
     }
     let pingpong = dir.join("pingpong.csv").display().to_string();
-    launch(
-        &mpirun,
-        2,
-        &["pingpong".to_owned(), "--csv".to_owned(), pingpong],
-    )?;
+    launch(2, &["pingpong".to_owned(), "--csv".to_owned(), pingpong])?;
     time_plan(&dir.join("plan.csv"))?;
     println!("measured in {:.0} s", start.elapsed().as_secs_f64());
     crate::report::write(out)
