@@ -248,31 +248,8 @@ impl Plot {
     }
 
     fn render(&self, out: &mut String) -> Result<(), String> {
-        let data: Vec<Vec<(f64, f64)>> = self
-            .series
-            .iter()
-            .map(|s| {
-                s.points
-                    .iter()
-                    .filter_map(|(x, y)| {
-                        Some((transform(*x, self.x_log)?, transform(*y, self.y_log)?))
-                    })
-                    .collect()
-            })
-            .collect();
-        let all = data.iter().flatten();
-        let (mut x0, mut x1, mut y0, mut y1) = (
-            f64::INFINITY,
-            f64::NEG_INFINITY,
-            f64::INFINITY,
-            f64::NEG_INFINITY,
-        );
-        for (x, y) in all {
-            x0 = x0.min(*x);
-            x1 = x1.max(*x);
-            y0 = y0.min(*y);
-            y1 = y1.max(*y);
-        }
+        let data = self.transformed();
+        let (x0, x1, y0, y1) = bounds(&data);
         // A run index or a count on x: one tick per whole number (up to 20), none in between.
         let whole_x = !self.x_log && data.iter().flatten().all(|(x, _)| x.fract() == 0.0);
         let x_ticks = if whole_x && x1 - x0 <= 20.0 {
@@ -282,72 +259,103 @@ impl Plot {
         };
         let (x0, x1) = padded_range(x0, x1, self.x_log);
         let (y0, y1) = padded_range(y0, y1, self.y_log);
-        {
-            let root = SVGBackend::with_string(out, (900, 600)).into_drawing_area();
-            root.fill(&WHITE).map_err(|e| e.to_string())?;
-            let mut chart = ChartBuilder::on(&root)
-                .caption(&self.title, ("sans-serif", 22))
-                .margin(16)
-                .x_label_area_size(50)
-                .y_label_area_size(80)
-                .build_cartesian_2d(x0..x1, y0..y1)
-                .map_err(|e| e.to_string())?;
-            let (xl, yl) = (self.x_log, self.y_log);
-            let x_fmt = move |v: &f64| axis_label(*v, xl);
-            let y_fmt = move |v: &f64| axis_label(*v, yl);
-            chart
-                .configure_mesh()
-                .x_desc(self.x_label.as_str())
-                .y_desc(self.y_label.as_str())
-                .axis_desc_style(("sans-serif", 16))
-                .label_style(("sans-serif", 13))
-                .x_labels(x_ticks)
-                .x_label_formatter(&x_fmt)
-                .y_label_formatter(&y_fmt)
-                .light_line_style(RGBColor(235, 235, 235))
-                .draw()
-                .map_err(|e| e.to_string())?;
-            for (i, (s, pts)) in self.series.iter().zip(&data).enumerate() {
-                let color = COLORS[i % COLORS.len()];
-                if s.style == SeriesStyle::Marker {
-                    draw_markers(&mut chart, i, color, pts, &s.label)?;
-                    continue;
-                }
-                let marker_style = color.mix(0.6).filled();
-                let line_style = color.stroke_width(2);
-                let anno = match s.style {
-                    SeriesStyle::Points => chart
-                        .draw_series(pts.iter().map(|p| Circle::new(*p, 2, marker_style)))
-                        .map_err(|e| e.to_string())?,
-                    SeriesStyle::Line => chart
-                        .draw_series(LineSeries::new(pts.iter().copied(), line_style))
-                        .map_err(|e| e.to_string())?,
-                    SeriesStyle::Marker => unreachable!("drawn by draw_markers"),
-                    SeriesStyle::LinePoints => {
-                        chart
-                            .draw_series(LineSeries::new(pts.iter().copied(), line_style))
-                            .map_err(|e| e.to_string())?;
-                        chart
-                            .draw_series(pts.iter().map(|p| Circle::new(*p, 4, color.filled())))
-                            .map_err(|e| e.to_string())?
-                    }
-                };
-                anno.label(s.label.as_str()).legend(move |(x, y)| {
-                    Rectangle::new([(x, y - 4), (x + 16, y + 4)], color.filled())
-                });
-            }
-            chart
-                .configure_series_labels()
-                .background_style(WHITE.mix(0.85))
-                .border_style(BLACK)
-                .label_font(("sans-serif", 14))
-                .position(legend_corner(&data, (x0, x1), (y0, y1)))
-                .draw()
-                .map_err(|e| e.to_string())?;
-            root.present().map_err(|e| e.to_string())?;
+        let root = SVGBackend::with_string(out, (900, 600)).into_drawing_area();
+        root.fill(&WHITE).map_err(|e| e.to_string())?;
+        let mut chart = ChartBuilder::on(&root)
+            .caption(&self.title, ("sans-serif", 22))
+            .margin(16)
+            .x_label_area_size(50)
+            .y_label_area_size(80)
+            .build_cartesian_2d(x0..x1, y0..y1)
+            .map_err(|e| e.to_string())?;
+        let (xl, yl) = (self.x_log, self.y_log);
+        let x_fmt = move |v: &f64| axis_label(*v, xl);
+        let y_fmt = move |v: &f64| axis_label(*v, yl);
+        chart
+            .configure_mesh()
+            .x_desc(self.x_label.as_str())
+            .y_desc(self.y_label.as_str())
+            .axis_desc_style(("sans-serif", 16))
+            .label_style(("sans-serif", 13))
+            .x_labels(x_ticks)
+            .x_label_formatter(&x_fmt)
+            .y_label_formatter(&y_fmt)
+            .light_line_style(RGBColor(235, 235, 235))
+            .draw()
+            .map_err(|e| e.to_string())?;
+        for (i, (s, pts)) in self.series.iter().zip(&data).enumerate() {
+            draw_series(&mut chart, i, s, pts)?;
         }
-        Ok(())
+        chart
+            .configure_series_labels()
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK)
+            .label_font(("sans-serif", 14))
+            .position(legend_corner(&data, (x0, x1), (y0, y1)))
+            .draw()
+            .map_err(|e| e.to_string())?;
+        root.present().map_err(|e| e.to_string())
     }
+
+    /// Each series' points on the axes' scales (log10 where an axis is logarithmic); points a log axis
+    /// cannot show are left out.
+    fn transformed(&self) -> Vec<Vec<(f64, f64)>> {
+        self.series
+            .iter()
+            .map(|s| {
+                s.points
+                    .iter()
+                    .filter_map(|(x, y)| {
+                        Some((transform(*x, self.x_log)?, transform(*y, self.y_log)?))
+                    })
+                    .collect()
+            })
+            .collect()
+    }
+}
+
+/// The smallest and largest x and y of every point of `data`: (x0, x1, y0, y1).
+fn bounds(data: &[Vec<(f64, f64)>]) -> (f64, f64, f64, f64) {
+    let (mut x0, mut x1, mut y0, mut y1) = (
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+    );
+    for (x, y) in data.iter().flatten() {
+        x0 = x0.min(*x);
+        x1 = x1.max(*x);
+        y0 = y0.min(*y);
+        y1 = y1.max(*y);
+    }
+    (x0, x1, y0, y1)
+}
+
+/// Draws series `i` (`s`, at the transformed points `pts`) in its style and colour, with its legend entry.
+fn draw_series(chart: &mut Chart, i: usize, s: &Series, pts: &[(f64, f64)]) -> Result<(), String> {
+    let color = COLORS[i % COLORS.len()];
+    let marker_style = color.mix(0.6).filled();
+    let line_style = color.stroke_width(2);
+    let anno = match s.style {
+        SeriesStyle::Marker => return draw_markers(chart, i, color, pts, &s.label),
+        SeriesStyle::Points => chart
+            .draw_series(pts.iter().map(|p| Circle::new(*p, 2, marker_style)))
+            .map_err(|e| e.to_string())?,
+        SeriesStyle::Line => chart
+            .draw_series(LineSeries::new(pts.iter().copied(), line_style))
+            .map_err(|e| e.to_string())?,
+        SeriesStyle::LinePoints => {
+            chart
+                .draw_series(LineSeries::new(pts.iter().copied(), line_style))
+                .map_err(|e| e.to_string())?;
+            chart
+                .draw_series(pts.iter().map(|p| Circle::new(*p, 4, color.filled())))
+                .map_err(|e| e.to_string())?
+        }
+    };
+    anno.label(s.label.as_str())
+        .legend(move |(x, y)| Rectangle::new([(x, y - 4), (x + 16, y + 4)], color.filled()));
+    Ok(())
 }
 
 #[cfg(test)]

@@ -137,25 +137,37 @@ pub fn write_report(
     write_rows(&summary_path, &SUMMARY_HEADER, &summary)?;
 
     let runs_path = out.join("runs.csv");
-    let new_runs: Vec<Vec<String>> = reports
-        .iter()
-        .map(|r| {
-            vec![
-                r.case.clone(),
-                r.title.clone(),
-                r.profile.name().to_string(),
-                r.passed().to_string(),
-                r.checks.len().to_string(),
-                format!("{:.1}", r.wall_s),
-                prov.commit.clone(),
-                prov.date.clone(),
-                r.error.clone().unwrap_or_default(),
-            ]
-        })
-        .collect();
+    let new_runs: Vec<Vec<String>> = reports.iter().map(|r| run_row(r, prov)).collect();
     let runs = merge(read_rows(&runs_path, RUNS_HEADER.len())?, new_runs, &ran);
     write_rows(&runs_path, &RUNS_HEADER, &runs)?;
 
+    let index = index_page(reports, prov, &runs, &summary);
+    let path = out.join("index.md");
+    std::fs::write(&path, index).map_err(SuiteError::io(&path))
+}
+
+/// The `runs.csv` row of one case's run.
+fn run_row(r: &CaseReport, prov: &Provenance) -> Vec<String> {
+    vec![
+        r.case.clone(),
+        r.title.clone(),
+        r.profile.name().to_string(),
+        r.passed().to_string(),
+        r.checks.len().to_string(),
+        format!("{:.1}", r.wall_s),
+        prov.commit.clone(),
+        prov.date.clone(),
+        r.error.clone().unwrap_or_default(),
+    ]
+}
+
+/// `index.md`: the last run's provenance, every case's last run (`runs`), the failing rows of `summary`.
+fn index_page(
+    reports: &[CaseReport],
+    prov: &Provenance,
+    runs: &[Vec<String>],
+    summary: &[Vec<String>],
+) -> String {
     let mut index = String::new();
     let _ = writeln!(index, "# polydem validation report\n");
     let _ = writeln!(
@@ -175,6 +187,7 @@ pub fn write_report(
         "| profile | {} |",
         profiles.first().copied().unwrap_or("-")
     );
+    let ran: Vec<&str> = reports.iter().map(|r| r.case.as_str()).collect();
     let _ = writeln!(index, "| cases run | {} |\n", ran.join(", "));
     let _ = writeln!(index, "## Cases\n");
     let _ = writeln!(
@@ -182,25 +195,8 @@ pub fn write_report(
         "| case | title | checks passed | status | wall time (s) | profile | commit | date |"
     );
     let _ = writeln!(index, "|---|---|---|---|---|---|---|---|");
-    for r in &runs {
-        let (passed, total) = (&r[3], &r[4]);
-        let status = if !r[8].is_empty() {
-            "**ERROR**"
-        } else if passed == total {
-            "pass"
-        } else {
-            "**FAIL**"
-        };
-        let _ = writeln!(
-            index,
-            "| [{c}]({c}.md) | {title} | {passed}/{total} | {status} | {wall} | {profile} | `{commit}` | {date} |",
-            c = r[0],
-            title = r[1],
-            wall = r[5],
-            profile = r[2],
-            commit = r[6],
-            date = r[7]
-        );
+    for r in runs {
+        let _ = writeln!(index, "{}", index_row(r));
     }
     let failed: Vec<&Vec<String>> = summary.iter().filter(|r| r[5] != "true").collect();
     if !failed.is_empty() {
@@ -216,8 +212,28 @@ pub fn write_report(
             );
         }
     }
-    let path = out.join("index.md");
-    std::fs::write(&path, index).map_err(SuiteError::io(&path))
+    index
+}
+
+/// The index table's row of one `runs.csv` row.
+fn index_row(r: &[String]) -> String {
+    let (passed, total) = (&r[3], &r[4]);
+    let status = if !r[8].is_empty() {
+        "**ERROR**"
+    } else if passed == total {
+        "pass"
+    } else {
+        "**FAIL**"
+    };
+    format!(
+        "| [{c}]({c}.md) | {title} | {passed}/{total} | {status} | {wall} | {profile} | `{commit}` | {date} |",
+        c = r[0],
+        title = r[1],
+        wall = r[5],
+        profile = r[2],
+        commit = r[6],
+        date = r[7]
+    )
 }
 
 /// The wall time of the last recorded run of `case` with `profile`, from `<out>/runs.csv`.
