@@ -200,21 +200,10 @@ impl VtkWriter {
         let encoding = encoding.into();
         encoding.check()?;
         std::fs::create_dir_all(out_dir.join("vtk"))?;
-        let has =
-            |pred: fn(&Shape) -> bool| (0..world.bodies().len()).any(|i| pred(world.shape(i)));
-        let mut series = Vec::new();
-        if has(|s| matches!(s, Shape::Polyhedron(_))) {
-            series.push((SeriesKind::Polyhedra, Vec::new()));
-        }
-        if has(|s| matches!(s, Shape::Sphere(_))) {
-            series.push((SeriesKind::Spheres, Vec::new()));
-        }
-        if !world.walls().is_empty() {
-            series.push((SeriesKind::Walls, Vec::new()));
-        }
-        if has(|s| surface_body(s).is_some()) {
-            series.push((SeriesKind::Surfaces, Vec::new()));
-        }
+        let series = series_kinds(world)
+            .into_iter()
+            .map(|kind| (kind, Vec::new()))
+            .collect();
         Ok(Self {
             out_dir: out_dir.to_owned(),
             encoding,
@@ -236,21 +225,7 @@ impl VtkWriter {
     ) -> io::Result<Self> {
         let mut writer = Self::new(out_dir, world, encoding)?;
         for (kind, entries) in &mut writer.series {
-            let pvd = out_dir.join(format!("{}.pvd", kind.name()));
-            let text = match std::fs::read_to_string(&pvd) {
-                Ok(text) => text,
-                Err(e) if e.kind() == io::ErrorKind::NotFound => continue,
-                Err(e) => return Err(io::Error::new(e.kind(), format!("{}: {e}", pvd.display()))),
-            };
-            let earlier = read_pvd(&text).map_err(|(line, what)| {
-                io::Error::new(
-                    io::ErrorKind::InvalidData,
-                    format!("{}:{line}: {what}", pvd.display()),
-                )
-            })?;
-            entries.extend(earlier.into_iter().filter(|(_, file)| {
-                frame_step(kind.name(), file).is_some_and(|step| step < world.step_index())
-            }));
+            *entries = earlier_entries(out_dir, *kind, world.step_index())?;
         }
         Ok(writer)
     }
@@ -286,18 +261,69 @@ impl VtkWriter {
             self.bytes_written += text.len() as u64;
             entries.retain(|(_, f)| *f != relative);
             entries.push((world.time(), relative));
-            // Replaced whole (written aside, then renamed), so a reader or a restart never sees half of it.
-            let pvd = self.out_dir.join(format!("{}.pvd", kind.name()));
-            let partial = self.out_dir.join(format!("{}.pvd.partial", kind.name()));
-            let mut out = io::BufWriter::new(std::fs::File::create(&partial)?);
-            write_pvd(&mut out, entries)?;
-            out.flush()?;
-            drop(out);
-            std::fs::rename(&partial, &pvd)?;
+            replace_pvd(&self.out_dir, *kind, entries)?;
         }
         self.frames_written += 1;
         Ok(())
     }
+}
+
+/// The series a run of `world` writes: polyhedra, spheres, walls and other bounded surfaces, those the
+/// world has.
+pub fn series_kinds(world: &World) -> Vec<SeriesKind> {
+    let has = |pred: fn(&Shape) -> bool| (0..world.bodies().len()).any(|i| pred(world.shape(i)));
+    let mut series = Vec::new();
+    if has(|s| matches!(s, Shape::Polyhedron(_))) {
+        series.push(SeriesKind::Polyhedra);
+    }
+    if has(|s| matches!(s, Shape::Sphere(_))) {
+        series.push(SeriesKind::Spheres);
+    }
+    if !world.walls().is_empty() {
+        series.push(SeriesKind::Walls);
+    }
+    if has(|s| surface_body(s).is_some()) {
+        series.push(SeriesKind::Surfaces);
+    }
+    series
+}
+
+/// The entries of `out_dir/<kind>.pvd` whose frames (`vtk/<kind>_<step>.vtu` or `.pvtu`) come before step
+/// `step`: the frames a run restarted at `step` keeps. A missing `.pvd` lists none; one that is not a
+/// polydem collection is an error naming the file and line.
+pub fn earlier_entries(
+    out_dir: &Path,
+    kind: SeriesKind,
+    step: u64,
+) -> io::Result<Vec<(Real, String)>> {
+    let pvd = out_dir.join(format!("{}.pvd", kind.name()));
+    let text = match std::fs::read_to_string(&pvd) {
+        Ok(text) => text,
+        Err(e) if e.kind() == io::ErrorKind::NotFound => return Ok(Vec::new()),
+        Err(e) => return Err(io::Error::new(e.kind(), format!("{}: {e}", pvd.display()))),
+    };
+    let earlier = read_pvd(&text).map_err(|(line, what)| {
+        io::Error::new(
+            io::ErrorKind::InvalidData,
+            format!("{}:{line}: {what}", pvd.display()),
+        )
+    })?;
+    Ok(earlier
+        .into_iter()
+        .filter(|(_, file)| frame_step(kind.name(), file).is_some_and(|s| s < step))
+        .collect())
+}
+
+/// Replaces `out_dir/<kind>.pvd` by the collection of `entries`, written aside and then renamed, so a
+/// reader or a restart never sees half of it.
+pub fn replace_pvd(out_dir: &Path, kind: SeriesKind, entries: &[(Real, String)]) -> io::Result<()> {
+    let pvd = out_dir.join(format!("{}.pvd", kind.name()));
+    let partial = out_dir.join(format!("{}.pvd.partial", kind.name()));
+    let mut out = io::BufWriter::new(std::fs::File::create(&partial)?);
+    write_pvd(&mut out, entries)?;
+    out.flush()?;
+    drop(out);
+    std::fs::rename(&partial, &pvd)
 }
 
 /// Writes a `.pvd` collection of `(time, file)` entries (file paths relative to the `.pvd`).
@@ -351,14 +377,18 @@ pub fn read_pvd(text: &str) -> Result<Vec<(Real, String)>, (usize, String)> {
     Ok(entries)
 }
 
-/// The step of a frame file named `vtk/<series>_<step>.vtu`, if the name has that form.
+/// The step of a frame file named `vtk/<series>_<step>.vtu` (or `.pvtu`, the frames of a run over MPI
+/// ranks), if the name has that form.
 fn frame_step(series: &str, file: &str) -> Option<u64> {
-    file.strip_prefix("vtk/")?
+    let stem = file
+        .strip_prefix("vtk/")?
         .strip_prefix(series)?
-        .strip_prefix('_')?
-        .strip_suffix(".vtu")?
-        .parse()
-        .ok()
+        .strip_prefix('_')?;
+    // `.pvtu` first: a name ending in `.pvtu` also ends in `.vtu`.
+    let step = stem
+        .strip_suffix(".pvtu")
+        .or_else(|| stem.strip_suffix(".vtu"))?;
+    step.parse().ok()
 }
 
 /// The `.vtu` text of the polyhedral bodies (see the module docs).

@@ -64,14 +64,8 @@ pub fn run_observed<O: RunObserver>(
         observer.progress(first);
     }
     if let Some(pieces) = pieces.as_deref_mut().filter(|p| p.due(first)) {
-        let piece = run.owned_piece();
-        pieces
-            .write(
-                run.part_world(),
-                &piece,
-                observer.is_some().then_some(&sim.world),
-            )
-            .map_err(output)?;
+        let whole = observer.is_some().then_some(&sim.world);
+        write_pieces(run, pieces, whole).map_err(output)?;
     }
     let mut done = first;
     while done < sim.steps {
@@ -90,14 +84,8 @@ pub fn run_observed<O: RunObserver>(
             summary.gathers += 1;
         }
         if let Some(pieces) = pieces.as_deref_mut().filter(|_| frame) {
-            let piece = run.owned_piece();
-            pieces
-                .write(
-                    run.part_world(),
-                    &piece,
-                    observer.is_some().then_some(&sim.world),
-                )
-                .map_err(output)?;
+            let whole = observer.is_some().then_some(&sim.world);
+            write_pieces(run, pieces, whole).map_err(output)?;
         }
         if let Some(observer) = observer.as_deref_mut() {
             if wanted {
@@ -110,6 +98,16 @@ pub fn run_observed<O: RunObserver>(
     summary.part.wall_time = start.elapsed();
     summary.cuts = run.cuts;
     Ok(summary)
+}
+
+/// This rank's pieces of a frame: its owned bodies, and on rank 0 (`whole`, the gathered world) the walls
+/// and collections.
+fn write_pieces(
+    run: &DistributedRun,
+    pieces: &mut VtkPieces,
+    whole: Option<&polydem::world::World>,
+) -> std::io::Result<()> {
+    pieces.write(run.part_world(), &run.owned_piece(), whole)
 }
 
 /// Rank 0's choice of the next stretch after step `done`, broadcast: its last step, whether the observer

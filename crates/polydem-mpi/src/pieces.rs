@@ -9,16 +9,15 @@
 //! A run of one process writes `.vtu` frames of the whole world instead (`polydem::io::vtk`).
 
 use std::fmt::Write as _;
-use std::io::{self, Write};
+use std::io;
 use std::path::{Path, PathBuf};
 
 use polydem::io::output::Schedule;
 use polydem::io::vtk::{
-    polyhedra_piece_vtu, read_pvd, spheres_piece_vtu, surfaces_piece_vtu, walls_vtu, write_pvd,
-    BodyPiece, SeriesKind, VtkEncoding,
+    earlier_entries, polyhedra_piece_vtu, replace_pvd, series_kinds, spheres_piece_vtu,
+    surfaces_piece_vtu, walls_vtu, BodyPiece, SeriesKind, VtkEncoding,
 };
 use polydem::math::Real;
-use polydem::shape::Shape;
 use polydem::world::World;
 
 /// The piece writer of one rank.
@@ -55,20 +54,10 @@ impl VtkPieces {
                 format!("cannot create {}/vtk: {e}", out_dir.display()),
             )
         })?;
-        let has = |pred: fn(&Shape) -> bool| (0..whole.body_count()).any(|i| pred(whole.shape(i)));
-        let mut series = Vec::new();
-        if has(|s| matches!(s, Shape::Polyhedron(_))) {
-            series.push((SeriesKind::Polyhedra, Vec::new()));
-        }
-        if has(|s| matches!(s, Shape::Sphere(_))) {
-            series.push((SeriesKind::Spheres, Vec::new()));
-        }
-        if !whole.walls().is_empty() {
-            series.push((SeriesKind::Walls, Vec::new()));
-        }
-        if has(|s| !matches!(s, Shape::Polyhedron(_) | Shape::Sphere(_) | Shape::Plane(_))) {
-            series.push((SeriesKind::Surfaces, Vec::new()));
-        }
+        let series = series_kinds(whole)
+            .into_iter()
+            .map(|kind| (kind, Vec::new()))
+            .collect();
         let mut pieces = Self {
             out_dir: out_dir.to_owned(),
             encoding,
@@ -92,23 +81,7 @@ impl VtkPieces {
 
     fn resume(&mut self, step: u64) -> io::Result<()> {
         for (kind, entries) in &mut self.series {
-            let pvd = self.out_dir.join(format!("{}.pvd", kind.name()));
-            let text = match std::fs::read_to_string(&pvd) {
-                Ok(text) => text,
-                Err(e) if e.kind() == io::ErrorKind::NotFound => continue,
-                Err(e) => return Err(io::Error::new(e.kind(), format!("{}: {e}", pvd.display()))),
-            };
-            let earlier = read_pvd(&text).map_err(|(line, what)| {
-                io::Error::new(
-                    io::ErrorKind::InvalidData,
-                    format!("{}:{line}: {what}", pvd.display()),
-                )
-            })?;
-            entries.extend(
-                earlier
-                    .into_iter()
-                    .filter(|(_, file)| frame_step(file).is_some_and(|s| s < step)),
-            );
+            *entries = earlier_entries(&self.out_dir, *kind, step)?;
         }
         Ok(())
     }
@@ -143,7 +116,7 @@ impl VtkPieces {
             let entries = &mut self.series[k].1;
             entries.retain(|(_, f)| *f != frame);
             entries.push((part.time(), frame));
-            self.write_pvd(k)?;
+            replace_pvd(&self.out_dir, kind, entries)?;
         }
         self.frames_written += 1;
         Ok(())
@@ -156,18 +129,6 @@ impl VtkPieces {
         self.bytes_written += text.len() as u64;
         Ok(())
     }
-
-    /// Rewrites series `k`'s `.pvd` whole (aside, then renamed).
-    fn write_pvd(&self, k: usize) -> io::Result<()> {
-        let (kind, entries) = &self.series[k];
-        let pvd = self.out_dir.join(format!("{}.pvd", kind.name()));
-        let partial = self.out_dir.join(format!("{}.pvd.partial", kind.name()));
-        let mut out = io::BufWriter::new(std::fs::File::create(&partial)?);
-        write_pvd(&mut out, entries)?;
-        out.flush()?;
-        drop(out);
-        std::fs::rename(&partial, &pvd)
-    }
 }
 
 fn body_piece(out: &mut String, kind: SeriesKind, part: &World, piece: &BodyPiece, e: VtkEncoding) {
@@ -177,15 +138,6 @@ fn body_piece(out: &mut String, kind: SeriesKind, part: &World, piece: &BodyPiec
         SeriesKind::Surfaces => surfaces_piece_vtu(out, part, e, piece),
         SeriesKind::Walls => unreachable!("walls are not a body series"),
     };
-}
-
-/// The step of a frame `vtk/<series>_<step>.pvtu` or `.vtu`.
-fn frame_step(file: &str) -> Option<u64> {
-    let stem = file.strip_prefix("vtk/")?;
-    let stem = stem
-        .strip_suffix(".pvtu")
-        .or_else(|| stem.strip_suffix(".vtu"))?;
-    stem.rsplit('_').next()?.parse().ok()
 }
 
 /// The `.pvtu` of the pieces `<stem>_<rank>.vtu` of `ranks` ranks, declaring the arrays of `piece` (the

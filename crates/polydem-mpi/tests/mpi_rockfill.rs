@@ -22,10 +22,13 @@ use polydem_rockfill::penetration::{MonitorRow, Outcome, PenetrationOptions};
 
 /// Impact steps: the tip reaches the bed's face at step 103 (0.6 m at 5.8 mm per step) and five rocks press
 /// on it by step 180; the projectile's travel rebuilds the broad phase (and the subdomains are cut again)
-/// every third step. Each step of a run oversubscribed on a small machine waits for every rank in a few
-/// collectives, so the steps are kept to what shows all of this.
-const STEPS: u64 = 200;
+/// every third step; on 4 ranks the projectile's centre crosses the cut at x ≈ 0.96 m at step 351 and
+/// another rank owns it from there. Each step of a run oversubscribed on a small machine waits for every
+/// rank in a few collectives, so the steps are kept to what shows all of this.
+const STEPS: u64 = 360;
 const RANKS: [usize; 4] = [1, 2, 3, 4];
+/// The rank count whose run must see the projectile change owner.
+const OWNER_CHANGE_RANKS: usize = 4;
 
 fn main() {
     match std::env::var("POLYDEM_MPI_EXPECTED") {
@@ -99,13 +102,14 @@ fn child(expected: &Path) {
     let facts = report.ranks.expect("a distributed run reports its ranks");
     let per_step = |bytes: u64| bytes as f64 / STEPS as f64;
     println!(
-        "rank {}/{}: {:.1} owned, {:.1} ghosts on average, {} cuts, {elapsed:.2} s; sent per step: ghosts {:.0} B, \
-         agreements {:.0} B, cuts {:.0} B, gathers {:.0} B",
+        "rank {}/{}: {:.1} owned, {:.1} ghosts on average, {} cuts, {} projectile owner changes, {elapsed:.2} s; \
+         sent per step: ghosts {:.0} B, agreements {:.0} B, cuts {:.0} B, gathers {:.0} B",
         facts.rank,
         facts.ranks,
         facts.mean_owned,
         facts.mean_ghosts,
         facts.cuts,
+        facts.projectile_owner_changes,
         per_step(facts.ghost_bytes),
         per_step(facts.agreement_bytes),
         per_step(facts.cut_bytes),
@@ -118,6 +122,15 @@ fn child(expected: &Path) {
         let ranks = comm.size();
         if let Err(message) = compare(&bodies, result.world.bodies(), &rows, &report.rows) {
             eprintln!("rockfill quick on {ranks} ranks after {STEPS} steps: {message}");
+            comm.abort(1);
+        }
+        // The bits above must hold across a change of the projectile's owner (its row and contacts then
+        // come from another rank), so the largest split must show one.
+        if ranks as usize == OWNER_CHANGE_RANKS && facts.projectile_owner_changes == 0 {
+            eprintln!(
+                "rockfill quick on {ranks} ranks after {STEPS} steps: the projectile never changed owner \
+                 (measured 0 changes, expected at least 1): the test would not check a hand-over"
+            );
             comm.abort(1);
         }
         println!(

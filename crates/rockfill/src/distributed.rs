@@ -57,6 +57,9 @@ pub(crate) struct DistributedStepper {
     whole: Simulation,
     /// Σ over the steps of the bodies owned and held as ghosts after each, and the steps.
     held: (usize, usize, usize),
+    /// The rank that owned the projectile at its last row, and how often that rank changed.
+    projectile_owner: Option<usize>,
+    projectile_owner_changes: u64,
 }
 
 impl DistributedStepper {
@@ -70,6 +73,8 @@ impl DistributedStepper {
             run,
             whole: sim.clone(),
             held: (0, 0, 0),
+            projectile_owner: None,
+            projectile_owner_changes: 0,
         })
     }
 
@@ -88,6 +93,7 @@ impl DistributedStepper {
             agreement_bytes: traffic.agreements.bytes,
             cut_bytes: traffic.cuts.bytes,
             gather_bytes: traffic.gathers.bytes,
+            projectile_owner_changes: self.projectile_owner_changes,
         }
     }
 
@@ -114,14 +120,19 @@ impl ImpactStepper for DistributedStepper {
         &mut self,
         gauge: &ProjectileGauge,
     ) -> Result<(MonitorRow, RigidBody), PenetrationError> {
-        let measured = self.run.from_owner(gauge.index, |part, local| {
+        let rank = self.run.rank();
+        let (row, body, owner) = self.run.from_owner(gauge.index, |part, local| {
             let on_part = ProjectileGauge {
                 index: local,
                 ..*gauge
             };
-            (on_part.row(part), *part.body(local))
+            (on_part.row(part), *part.body(local), rank)
         })?;
-        Ok(measured)
+        if self.projectile_owner.is_some_and(|last| last != owner) {
+            self.projectile_owner_changes += 1;
+        }
+        self.projectile_owner = Some(owner);
+        Ok((row, body))
     }
 
     fn whole(&mut self) -> Result<&Simulation, PenetrationError> {

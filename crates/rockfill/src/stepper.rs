@@ -57,6 +57,9 @@ pub struct RankFacts {
     pub agreement_bytes: u64,
     pub cut_bytes: u64,
     pub gather_bytes: u64,
+    /// Times the rank owning the projectile changed from one monitored step to the next (the same on
+    /// every rank).
+    pub projectile_owner_changes: u64,
 }
 
 /// The whole world stepped in this process.
