@@ -64,3 +64,84 @@ fn elastic_vertex_face_collision_conserves_energy_through_the_engine() {
         end.rotational_kinetic / e0
     );
 }
+
+/// The energy sums of worlds marked as complementary parts (`World::count_only`: each counts the bodies
+/// it owns and the pairs whose lower body it owns) add up to the whole world's, on the general step (a
+/// mixed pile with friction, damping, a moving wall and global viscous damping) and on its sphere stage
+/// (sphere bed a). Every world here holds every body, so all three step the same states; only the counting
+/// differs. The parts' sums group the same terms differently, so they may differ from the whole's in
+/// rounding: at most about n ε of the sum of the terms' magnitudes, n ≤ ~10^4 terms per sum, ε = 1.1e-16;
+/// the tolerance is 1e-12 of the largest sum.
+#[test]
+fn shares_of_complementary_parts_add_up_to_the_whole_worlds_energy_sums() {
+    use polydem::dynamics::ViscousDamping;
+    use polydem::math::Vector;
+    use polydem::world::EnergyShare;
+
+    for (scene, steps) in [
+        ("mixed_spheres_polyhedra.toml", 400),
+        ("sphere_bed_a_hertz_5ms.toml", 100),
+    ] {
+        let mut sim = load_scene(&scene_path(scene)).expect("scene loads");
+        sim.params.damping = ViscousDamping::MassProportional(5.0);
+        sim.world
+            .set_wall_velocity(0, Vector::new(0.0, 0.0, 0.01))
+            .expect("a wall to move");
+        let n = sim.world.body_count();
+        let owners = [
+            |i: usize| i.is_multiple_of(3),
+            |i: usize| !i.is_multiple_of(3),
+        ];
+        let mut parts: Vec<_> = owners
+            .iter()
+            .map(|owns| {
+                let mut world = sim.world.clone();
+                world.count_only((0..n).map(owns).collect());
+                (world, StepScratch::default())
+            })
+            .collect();
+        let mut scratch = StepScratch::default();
+        for _ in 0..steps {
+            step(&sim.params, &mut sim.world, &mut scratch).expect("step");
+            for (world, scratch) in &mut parts {
+                step(&sim.params, world, scratch).expect("step");
+            }
+        }
+        let mut added = EnergyShare::default();
+        for (world, _) in &parts {
+            added.add(&world.energy_share());
+        }
+        let expected = sim.world.energy_share();
+        let fields = |s: &EnergyShare| -> Vec<(String, f64)> {
+            let json = serde_json::to_value(s).expect("a share serialises");
+            let mut out = Vec::new();
+            let mut walk = vec![(String::new(), json)];
+            while let Some((path, v)) = walk.pop() {
+                match v {
+                    serde_json::Value::Object(map) => {
+                        walk.extend(map.into_iter().map(|(k, v)| (format!("{path}/{k}"), v)))
+                    }
+                    v => out.push((path, v.as_f64().expect("a number"))),
+                }
+            }
+            out.sort_by(|a, b| a.0.cmp(&b.0));
+            out
+        };
+        let (got, want) = (fields(&added), fields(&expected));
+        let scale = want.iter().map(|(_, v)| v.abs()).fold(0.0, f64::max);
+        for ((name, a), (_, b)) in got.iter().zip(&want) {
+            let relative = (a - b).abs() / scale;
+            assert!(
+                relative <= 1e-12,
+                "{scene}, {steps} steps, parts owning i % 3 == 0 and the rest: {name} added over the parts \
+                 {a:e}, the whole world's {b:e}: {relative:.2e} of the largest sum {scale:e} (tolerance 1e-12)"
+            );
+        }
+        let counted: Vec<f64> = want.iter().map(|(_, v)| *v).filter(|v| *v != 0.0).collect();
+        assert!(
+            counted.len() >= 8,
+            "{scene}: only {} of the sums are non-zero ({want:?}): the test would not check them",
+            counted.len()
+        );
+    }
+}

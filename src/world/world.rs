@@ -255,6 +255,10 @@ pub struct World {
     /// The materials the bodies use, for the set-up checks (rebuilt after a checkpoint is read).
     #[serde(skip)]
     presence: MaterialPresence,
+    /// In a part of a split world ([`super::distributed`]), the bodies it owns: its energy sums count
+    /// those bodies and the pairs it answers for (the lower body owned). `None`: every body and pair.
+    #[serde(skip)]
+    pub(in crate::world) counted: Option<Vec<bool>>,
 }
 
 impl World {
@@ -278,6 +282,7 @@ impl World {
             time: 0.0,
             step_index: 0,
             presence: MaterialPresence::default(),
+            counted: None,
         }
     }
 
@@ -456,23 +461,36 @@ impl World {
     }
 }
 
-/// Mechanical terms of the current state: (T_trans, T_rot, U_gravity) over dynamic bodies.
+/// Mechanical terms of the current state: (T_trans, T_rot, U_gravity) over the dynamic bodies counted
+/// ([`World::counts_body`]).
 fn kinetic_and_gravity(world: &World) -> (Real, Real, Real) {
     let (mut trans, mut rot, mut grav) = (0.0, 0.0, 0.0);
-    for body in world.bodies.iter().filter(|b| b.is_dynamic()) {
+    for_each_counted_dynamic(world, |body| {
         trans += body.translational_kinetic_energy();
         rot += body.rotational_kinetic_energy();
         grav -= body.mass * world.gravity.dot(&body.position.coords);
-    }
+    });
     (trans, rot, grav)
 }
 
-/// Σ c(m)|v|² over dynamic bodies (W): the power of a global viscous damping.
+/// `f` on each dynamic body the world's energy sums count ([`World::counts_body`]), in body order.
+#[inline]
+fn for_each_counted_dynamic(world: &World, f: impl FnMut(&RigidBody)) {
+    let dynamic = |b: &&RigidBody| b.is_dynamic();
+    match world.counted.as_deref() {
+        None => world.bodies.iter().filter(dynamic).for_each(f),
+        Some(owned) => {
+            let counted = world.bodies.iter().zip(owned).filter(|(_, &o)| o);
+            counted.map(|(b, _)| b).filter(dynamic).for_each(f)
+        }
+    }
+}
+
+/// Σ c(m)|v|² over the dynamic bodies counted (W): the power of a global viscous damping.
 pub(crate) fn viscous_power(world: &World, coefficient: impl Fn(Real) -> Real) -> Real {
-    world
-        .bodies
-        .iter()
-        .filter(|b| b.is_dynamic())
-        .map(|b| coefficient(b.mass) * b.velocity.norm_squared())
-        .sum()
+    let mut power = 0.0;
+    for_each_counted_dynamic(world, |b| {
+        power += coefficient(b.mass) * b.velocity.norm_squared()
+    });
+    power
 }

@@ -71,8 +71,9 @@ fn distributed(args: &RunArgs, comm: &SimpleCommunicator) -> Result<()> {
     if !quiet {
         eprintln!("{} on {ranks} ranks", super::run_header(&origin, &sim));
         eprintln!(
-            "note: on several ranks energy.csv and the energy terms of checkpoints are rank 0's part's, not \
-             the whole world's (bodies.csv, walls.csv, VTK and the state of checkpoints are one process's)"
+            "note: on several ranks energy.csv and the energy terms of checkpoints are added over the ranks, \
+             equal to one process's up to rounding (bodies.csv, walls.csv, VTK and the state of \
+             checkpoints are one process's bit for bit)"
         );
     }
     let bar = super::progress_bar(quiet, &origin, &sim)?;

@@ -4,10 +4,11 @@
 //! written on P ranks continues on Q ranks (or without MPI) to the bits of an uninterrupted run; a rank that
 //! fails stops every rank with its message.
 //!
-//! What is not the whole world's on P > 1 ranks (documented in `polydem_mpi`): the sums over contacts of
-//! the last evaluation other than the walls' forces (the elastic potential, the step's work terms, the
-//! external power) and the energy ledger are rank 0's part's. The checkpoint comparison removes exactly those fields and requires every
-//! other byte of the state to be equal; the fields removed are printed with both values.
+//! What is not bit for bit on P > 1 ranks (documented in `polydem_mpi`): the energy sums (the ledger, and
+//! the elastic potential, the step's work terms and the external power of the last evaluation) are added
+//! over the ranks' shares, grouped by part. `energy.csv` and those fields of the checkpoints are compared
+//! within [`ENERGY_TOLERANCE`] of the largest magnitude among them; every other byte of a checkpoint's
+//! state must be equal.
 //!
 //! Launched with `mpirun.mpich` (or `$POLYDEM_MPIRUN`), oversubscribed on a small machine with one rayon
 //! thread per rank.
@@ -21,6 +22,12 @@ use polydem_mpi::launch;
 use serde_json::Value;
 
 const EXE: &str = env!("CARGO_BIN_EXE_polydem");
+
+/// How far an energy sum added over the parts may be from one process's, relative to the largest
+/// magnitude among the compared values: the same terms grouped differently, whose rounding differs by at
+/// most about n ε of the sum of their magnitudes, with n up to ~10^4 terms per sum here (the contacts of
+/// one evaluation) and ε = 1.1e-16.
+const ENERGY_TOLERANCE: f64 = 1e-12;
 
 fn scene(name: &str) -> PathBuf {
     Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../../scenes")).join(format!("{name}.toml"))
@@ -135,8 +142,89 @@ fn assert_same_state(case: &str, got: &Path, expected: &Path, lists: Lists) {
             context(&b)
         );
     }
-    println!("{case}: {} has the state of {} (sums over contacts and ledger apart: {sums} against {expected_sums})",
-        got.display(), expected.display());
+    let (got_sums, expected_sums) = (numbers(&sums), numbers(&expected_sums));
+    let worst = assert_close(case, &got_sums, &expected_sums, &got.display().to_string());
+    println!(
+        "{case}: {} has the state of {}, and its energy sums within {worst:.1e} of their scale",
+        got.display(),
+        expected.display()
+    );
+}
+
+/// The numbers of a JSON value, in document order (an absent initial total as NaN).
+fn numbers(value: &Value) -> Vec<(String, f64)> {
+    let mut out = Vec::new();
+    let mut walk = vec![(String::new(), value)];
+    while let Some((path, v)) = walk.pop() {
+        match v {
+            Value::Object(map) => {
+                walk.extend(map.iter().rev().map(|(k, v)| (format!("{path}/{k}"), v)))
+            }
+            Value::Number(n) => out.push((path, n.as_f64().expect("a number"))),
+            Value::Null => out.push((path, f64::NAN)),
+            other => panic!("{path}: not a number: {other}"),
+        }
+    }
+    out
+}
+
+/// Asserts that `got` and `expected` (named values) agree within [`ENERGY_TOLERANCE`] of the largest
+/// magnitude among `expected`; returns the largest difference relative to that scale.
+fn assert_close(case: &str, got: &[(String, f64)], expected: &[(String, f64)], what: &str) -> f64 {
+    assert_eq!(
+        got.len(),
+        expected.len(),
+        "{case}: {what}: {got:?} against {expected:?}"
+    );
+    let scale = expected
+        .iter()
+        .map(|(_, v)| v.abs())
+        .filter(|v| v.is_finite())
+        .fold(0.0, f64::max);
+    let mut worst: f64 = 0.0;
+    for ((name, a), (other, b)) in got.iter().zip(expected) {
+        assert_eq!(name, other, "{case}: {what}: fields differ");
+        if a.is_nan() && b.is_nan() {
+            continue;
+        }
+        let relative = (a - b).abs() / scale;
+        assert!(
+            relative <= ENERGY_TOLERANCE,
+            "{case}: {what}: {name} = {a:e} against {b:e} one process wrote: {relative:.2e} of the scale \
+             {scale:e} (tolerance {ENERGY_TOLERANCE:e})"
+        );
+        worst = worst.max(relative);
+    }
+    worst
+}
+
+/// `energy.csv` of `got` against `expected`'s: the same times, every term within [`ENERGY_TOLERANCE`] of
+/// the row's largest magnitude.
+fn assert_same_energy(case: &str, got: &Path, expected: &Path) {
+    let rows = |dir: &Path| -> Vec<Vec<(String, f64)>> {
+        let text = String::from_utf8(read(&dir.join("energy.csv"))).expect("UTF-8");
+        let mut lines = text.lines();
+        let header: Vec<String> = lines
+            .next()
+            .expect("a header")
+            .split(',')
+            .map(String::from)
+            .collect();
+        let parse = |line: &str| -> Vec<(String, f64)> {
+            let values = line.split(',').map(|v| v.parse::<f64>().expect("a number"));
+            header.iter().cloned().zip(values).collect()
+        };
+        lines.map(parse).collect()
+    };
+    let (mine, theirs) = (rows(got), rows(expected));
+    assert_eq!(mine.len(), theirs.len(), "{case}: rows of energy.csv");
+    let mut worst: f64 = 0.0;
+    for (k, (a, b)) in mine.iter().zip(&theirs).enumerate() {
+        assert_eq!(a[0], b[0], "{case}: energy.csv row {} time", k + 1);
+        let row = format!("{}/energy.csv row {}", got.display(), k + 1);
+        worst = worst.max(assert_close(case, a, b, &row));
+    }
+    println!("{case}: energy.csv within {worst:.1e} of each row's scale");
 }
 
 /// Per body, the values of every point and cell array of the `.vtu` files `files` (ASCII), keyed by
@@ -274,6 +362,7 @@ fn assert_same_run(case: &str, got: &Path, expected: &Path, kinds: &[&str], list
     for kind in kinds {
         assert_same_frames(case, kind, got, expected);
     }
+    assert_same_energy(case, got, expected);
 }
 
 /// How a compared run starts: a scene file, or a checkpoint.

@@ -10,13 +10,14 @@
 //! them when asked, with the build count the parts kept in step (a restored world's list is held as
 //! restored until its first rebuild).
 
-use polydem::math::{Real, Vector};
+use polydem::math::Real;
 use polydem::world::broad_phase::BroadPhase;
-use polydem::world::{ContactKey, World};
+use polydem::world::{EnergyShare, World};
 
 use crate::error::DistributedError;
 use crate::exchange::{gather_to_root, pack_ghost, unpack_ghost, GHOST_WORDS};
 use crate::run::{authoritative_contacts, DistributedRun, Part};
+use crate::wall_sums::{touching_walls, wall_forces};
 
 impl DistributedRun {
     /// Collective: gathers the whole state on rank 0 and writes it into `world` there (the whole world
@@ -28,14 +29,11 @@ impl DistributedRun {
         contacts: bool,
     ) -> Result<(), DistributedError> {
         let entries = authoritative_contacts(&self.part);
-        let touching_walls: Vec<(ContactKey, Vector)> = entries
-            .iter()
-            .filter(|(key, state)| matches!(key, ContactKey::Wall { .. }) && state.is_active())
-            .map(|(key, state)| (*key, state.force_on_b))
-            .collect();
+        let touching_walls = touching_walls(&entries);
         let entries = if contacts { entries } else { Vec::new() };
         let (ids, states) = owned_states(&self.part);
-        let mine = (ids, states, touching_walls, entries);
+        let share = self.part.world.energy_share();
+        let mine = (ids, states, touching_walls, entries, share);
         let traffic = &mut self.traffic;
         let all = gather_to_root(
             &self.comm,
@@ -48,7 +46,9 @@ impl DistributedRun {
         };
         world.copy_walls_and_clock(&self.part.world);
         let (mut store, mut walls) = (Vec::new(), Vec::new());
-        for (ids, states, touching_walls, entries) in all {
+        let mut total = EnergyShare::default();
+        for (ids, states, touching_walls, entries, share) in all {
+            total.add(&share);
             for (&gid, w) in ids.iter().zip(states.chunks_exact(GHOST_WORDS)) {
                 let (body, force, torque) = unpack_ghost(&world.bodies()[gid as usize], w);
                 world.copy_body_from_owner(gid as usize, &body, &force, &torque);
@@ -58,6 +58,7 @@ impl DistributedRun {
         }
         walls.sort_by_key(|entry| entry.0);
         world.replace_wall_forces(wall_forces(&walls, world.walls().len()));
+        world.replace_energy_share(&total);
         if contacts {
             store.sort_by_key(|entry| entry.0);
             let touched = self.part.world.contacts().last_touched();
@@ -76,18 +77,6 @@ impl DistributedRun {
         }
         self.whole.broad_phase()
     }
-}
-
-/// The contact force on each of `walls` walls: the opposite of the force on the body of every touching
-/// body–wall entry (`touching`, in key order), summed from zero in that order as the step sums them.
-fn wall_forces(touching: &[(ContactKey, Vector)], walls: usize) -> Vec<Vector> {
-    let mut forces = vec![Vector::zeros(); walls];
-    for (key, force_on_b) in touching {
-        if let ContactKey::Wall { wall, .. } = key {
-            forces[*wall as usize] -= force_on_b;
-        }
-    }
-    forces
 }
 
 /// The global indices of the bodies `part` owns and their states and loads, packed as the ghost exchange

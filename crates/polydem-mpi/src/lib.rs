@@ -49,12 +49,14 @@
 //! fails. `.ci/mpi.sh` installs the packages and runs both. Without the feature the crate builds its
 //! MPI-free parts only (decomposition, plan), so the workspace needs no MPI.
 //!
+//! # What is the whole world's up to rounding
+//! The energy sums ([`EnergyShare`](polydem::world::EnergyShare)): each part counts the bodies it owns and
+//! the pairs it answers for ([`World::count_only`](polydem::world::World::count_only)), books its share
+//! of the ledger across cuts, and an output adds the ranks' shares on rank 0 in rank order. `energy.csv`
+//! and a checkpoint's ledger and energy sums are then one process's up to the rounding of that grouping,
+//! not bit for bit; the state does not depend on them.
+//!
 //! # Limits of this stage
-//! - The energy ledger and the sums over contacts of an evaluation other than the walls' forces (elastic
-//!   potential, the step's work terms, external power) are those of rank 0's part (its ghosts' contacts
-//!   counted, the other parts' missing): `energy.csv` of a run on several ranks is not the whole world's,
-//!   and neither are those fields of its checkpoints. Making them whole needs each part to sum only the
-//!   pairs it answers for and a reduction per step (not in one process's order, so not bitwise).
 //! - Sleeping is refused ([`DistributedError::Sleeping`]); the time-step check does not run on the parts.
 //! - A cut gathers the whole state on every rank (O(N) memory and traffic per rebuild); an output step
 //!   gathers the owned bodies on rank 0 (O(N) there); the per-step ghost exchange is point to point in
@@ -83,6 +85,8 @@ pub mod observed;
 pub mod pieces;
 #[cfg(feature = "mpi")]
 pub mod run;
+#[cfg(feature = "mpi")]
+mod wall_sums;
 
 pub use error::DistributedError;
 #[cfg(feature = "mpi")]

@@ -13,14 +13,15 @@ use mpi::traits::*;
 use polydem::dynamics::RigidBody;
 use polydem::math::{Point, Real, Vector};
 use polydem::world::{
-    step, ContactKey, ContactState, PartBroadPhase, StepParams, StepReport, StepScratch,
-    TimeStepCheck, World,
+    step, ContactKey, ContactState, EnergyShare, PartBroadPhase, StepParams, StepReport,
+    StepScratch, TimeStepCheck, World,
 };
 
 use crate::consensus::Consensus;
 use crate::error::DistributedError;
 use crate::exchange::{all_gather, all_to_all, pack_ghost, unpack_ghost, RunTraffic, GHOST_WORDS};
 use crate::plan::{Plan, MOVE_ALLOWANCE_IN_SKINS};
+use crate::wall_sums::{touching_walls, wall_forces};
 
 /// This rank's part: the world it steps and what it exchanges.
 pub(crate) struct Part {
@@ -80,7 +81,7 @@ impl DistributedRun {
         let restored = world.loads().is_current();
         let list = world.broad_phase();
         let built = list.rebuilds() > 0 && list.centres_at_build().len() == world.body_count();
-        let part = if restored && built {
+        let mut part = if restored && built {
             cut(
                 &comm,
                 &world,
@@ -93,6 +94,10 @@ impl DistributedRun {
             let centres: Vec<Point> = world.bodies().iter().map(|b| b.position).collect();
             cut(&comm, &world, &centres, PartBroadPhase::Unbuilt)?
         };
+        if rank == 0 {
+            // The ledger so far (a restored world's) is counted once, on rank 0's part.
+            part.world.replace_ledger(*world.ledger());
+        }
         Ok(Self {
             comm,
             rank,
@@ -247,7 +252,10 @@ impl DistributedRun {
         let rebuilds = self.part.world.broad_phase().rebuilds();
         let centres: Vec<Point> = self.whole.bodies().iter().map(|b| b.position).collect();
         let built = PartBroadPhase::Build { rebuilds };
+        let ledger = *self.part.world.ledger();
         self.part = cut(&self.comm, &self.whole, &centres, built)?;
+        // Each rank keeps booking its share of the ledger: the sum over the ranks stays the whole's.
+        self.part.world.replace_ledger(ledger);
         self.whole_list_held = false;
         self.cuts += 1;
         Ok(())
@@ -325,7 +333,8 @@ fn cut(
     let consensus = Arc::new(Consensus::new(owned.clone()));
     let mut scratch = StepScratch::default();
     scratch.set_rebuild_consensus(Some(consensus.clone()));
-    let world = whole.part(&ids, broad_phase);
+    let mut world = whole.part(&ids, broad_phase);
+    world.count_only(owned.clone());
     let at_cut = (0..ids.len())
         .filter(|&i| owned[i])
         .map(|i| centres[ids[i]])
@@ -366,23 +375,34 @@ impl DistributedRun {
     }
 
     /// The whole world at the current step, on every rank: every body's state and loads from its owner,
-    /// every contact entry from the rank that answers for it, the walls and clock. The per-body state and
-    /// the contact store are one process's bit for bit; the energy ledger and the loads' sums (wall
-    /// forces, energy terms) are not distributed: they are this rank's part's.
+    /// every contact entry from the rank that answers for it, the walls and clock, the energy ledger and
+    /// sums added over the ranks' shares in rank order. The per-body state and the contact store are one
+    /// process's bit for bit, and so are the walls' forces (summed from the touching entries in key
+    /// order, as the step sums them); the energy sums are one process's up to rounding (grouped by part).
     pub fn gather_world(&mut self) -> Result<World, DistributedError> {
-        let mine = (owned_bodies(&self.part), authoritative_contacts(&self.part));
+        let share = self.part.world.energy_share();
+        let mine = (
+            owned_bodies(&self.part),
+            authoritative_contacts(&self.part),
+            share,
+        );
         let all = all_gather(&self.comm, &mine, &mut self.traffic.gathers)?;
         let mut whole = self.whole.clone();
         whole.copy_walls_and_clock(&self.part.world);
         let mut entries = Vec::new();
-        for (bodies, contacts) in all {
+        let mut total = EnergyShare::default();
+        for (bodies, contacts, share) in all {
             for (gid, body, force, torque) in bodies {
                 whole.copy_body_from_owner(gid, &body, &force, &torque);
             }
             entries.extend(contacts);
+            total.add(&share);
         }
         entries.sort_by_key(|entry| entry.0);
+        let walls = wall_forces(&touching_walls(&entries), whole.walls().len());
+        whole.replace_wall_forces(walls);
         whole.replace_contacts(entries, self.part.world.contacts().last_touched());
+        whole.replace_energy_share(&total);
         Ok(whole)
     }
 }

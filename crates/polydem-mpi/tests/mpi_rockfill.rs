@@ -8,7 +8,8 @@
 //! P. Each launched copy runs the same penetration with `PenetrationOptions::distributed`, and rank 0
 //! compares FNV-1a hashes of the positions, velocities, orientations and angular velocities of every body,
 //! and every monitor row word for word, with the file. A mismatch names P and the first body or row that
-//! differs, and aborts every rank.
+//! differs, and aborts every rank. The energy terms at the end (added over the ranks, so one process's up
+//! to rounding) must be within [`ENERGY_TOLERANCE`] of one process's.
 
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -29,6 +30,10 @@ const STEPS: u64 = 360;
 const RANKS: [usize; 4] = [1, 2, 3, 4];
 /// The rank count whose run must see the projectile change owner.
 const OWNER_CHANGE_RANKS: usize = 4;
+/// How far an energy term added over the ranks may be from one process's, relative to the largest term:
+/// the same contributions grouped by rank, whose rounding differs by at most about n ε of the sum of their
+/// magnitudes (n: up to ~10^4 contributions per sum, ε = 1.1e-16).
+const ENERGY_TOLERANCE: f64 = 1e-12;
 
 fn main() {
     match std::env::var("POLYDEM_MPI_EXPECTED") {
@@ -78,8 +83,12 @@ fn launch() {
     );
     let file =
         std::env::temp_dir().join(format!("polydem_mpi_rockfill_{}.txt", std::process::id()));
-    std::fs::write(&file, expected_text(expected.world.bodies(), &report.rows))
-        .unwrap_or_else(|e| panic!("writing {}: {e}", file.display()));
+    let text = expected_text(
+        expected.world.bodies(),
+        &report.rows,
+        &energy_terms(&expected),
+    );
+    std::fs::write(&file, text).unwrap_or_else(|e| panic!("writing {}: {e}", file.display()));
 
     let exe = std::env::current_exe().expect("the test binary's path");
     let failures = launch_each("rockfill quick", &RANKS, &exe, |c| {
@@ -118,12 +127,14 @@ fn child(expected: &Path) {
     if comm.rank() == 0 {
         let text = std::fs::read_to_string(expected)
             .unwrap_or_else(|e| panic!("reading {}: {e}", expected.display()));
-        let (bodies, rows) = parse_expected(&text);
+        let (bodies, rows, energy) = parse_expected(&text);
         let ranks = comm.size();
-        if let Err(message) = compare(&bodies, result.world.bodies(), &rows, &report.rows) {
+        let compared = compare(&bodies, result.world.bodies(), &rows, &report.rows)
+            .and_then(|()| compare_energy(&energy, &energy_terms(&result)));
+        let worst = compared.unwrap_or_else(|message| {
             eprintln!("rockfill quick on {ranks} ranks after {STEPS} steps: {message}");
-            comm.abort(1);
-        }
+            comm.abort(1)
+        });
         // The bits above must hold across a change of the projectile's owner (its row and contacts then
         // come from another rank), so the largest split must show one.
         if ranks as usize == OWNER_CHANGE_RANKS && facts.projectile_owner_changes == 0 {
@@ -135,7 +146,7 @@ fn child(expected: &Path) {
         }
         println!(
             "rockfill quick on {ranks} ranks after {STEPS} steps: the same bits as one process ({} bodies, {} \
-             monitor rows)",
+             monitor rows); energy terms within {worst:.1e} of the largest",
             bodies.len(),
             rows.len()
         );
@@ -156,11 +167,51 @@ const QUANTITIES: [(&str, Quantity); 4] = [
     }),
 ];
 
-/// The bodies (as their hashed quantities, in order) and the rows (as their words) of one process.
-type Expected = (Vec<Vec<u64>>, Vec<Vec<u64>>);
+/// The bodies (as their hashed quantities, in order), the rows (as their words) and the energy terms (as
+/// their bits) of one process.
+type Expected = (Vec<Vec<u64>>, Vec<Vec<u64>>, Vec<u64>);
 
-/// One line per body (the bits of its four quantities), then one per row (the bits of its words).
-fn expected_text(bodies: &[RigidBody], rows: &[MonitorRow]) -> String {
+/// The whole world's energy terms at the end of a run: time, kinetic, potential, ledger and balance.
+fn energy_terms(result: &ExperimentResult) -> Vec<f64> {
+    let e = result.world.energy();
+    vec![
+        e.time,
+        e.translational_kinetic,
+        e.rotational_kinetic,
+        e.elastic_potential,
+        e.gravitational_potential,
+        e.dissipated_damping,
+        e.dissipated_friction,
+        e.dissipated_viscous,
+        e.external_work,
+        e.tangential_stiffness_work,
+        e.balance,
+    ]
+}
+
+/// The largest difference between `got` and one process's energy terms (`expected`, as bits) relative to
+/// their largest magnitude; an error past [`ENERGY_TOLERANCE`].
+fn compare_energy(expected: &[u64], got: &[f64]) -> Result<f64, String> {
+    let expected: Vec<f64> = expected.iter().map(|&w| f64::from_bits(w)).collect();
+    let scale = expected.iter().map(|v| v.abs()).fold(0.0, f64::max);
+    let mut worst: f64 = 0.0;
+    for (k, (a, b)) in got.iter().zip(&expected).enumerate() {
+        let relative = (a - b).abs() / scale;
+        if relative.is_nan() || relative > ENERGY_TOLERANCE {
+            return Err(format!(
+                "energy term {k} (time, kinetic ×2, elastic, gravity, damping, friction, viscous, external, \
+                 stiffness, balance) {a:e}, one process {b:e}: {relative:.2e} of the largest term {scale:e} \
+                 (tolerance {ENERGY_TOLERANCE:e})"
+            ));
+        }
+        worst = worst.max(relative);
+    }
+    Ok(worst)
+}
+
+/// One line per body (the bits of its four quantities), then one per row (the bits of its words), then
+/// the energy terms' bits.
+fn expected_text(bodies: &[RigidBody], rows: &[MonitorRow], energy: &[f64]) -> String {
     let line = |words: Vec<u64>| {
         let hex: Vec<String> = words.iter().map(|w| format!("{w:016x}")).collect();
         hex.join(" ")
@@ -172,11 +223,15 @@ fn expected_text(bodies: &[RigidBody], rows: &[MonitorRow]) -> String {
     for row in rows {
         text += &format!("row {}\n", line(row_words(row)));
     }
+    text += &format!(
+        "energy {}\n",
+        line(energy.iter().map(|v| v.to_bits()).collect())
+    );
     text
 }
 
 fn parse_expected(text: &str) -> Expected {
-    let (mut bodies, mut rows) = (Vec::new(), Vec::new());
+    let (mut bodies, mut rows, mut energy) = (Vec::new(), Vec::new(), Vec::new());
     for line in text.lines() {
         let (kind, words) = line.split_once(' ').expect("a kind and words");
         let words: Vec<u64> = words
@@ -185,10 +240,11 @@ fn parse_expected(text: &str) -> Expected {
             .collect();
         match kind {
             "body" => bodies.push(words),
+            "energy" => energy = words,
             _ => rows.push(words),
         }
     }
-    (bodies, rows)
+    (bodies, rows, energy)
 }
 
 fn body_words(body: &RigidBody) -> Vec<u64> {

@@ -27,7 +27,8 @@
 //! # Limits
 //! - Sleeping is refused (the parts do not carry the sleep state), and so are VTK frames (their schedule
 //!   would need a gather on every rank; not written yet).
-//! - The energy ledger's sums are not distributed: the report's ledger terms are NaN.
+//! - The energy ledger's terms are the whole world's, added over the ranks' shares: one process's up to
+//!   rounding, not bit for bit.
 //! - The step counters are those of this rank's part (they include its ghosts' pairs); the largest overlap
 //!   and the steps with overlap warnings are reduced over the ranks (a pair is evaluated, at one
 //!   process's state, on every rank that holds it).

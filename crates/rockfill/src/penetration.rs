@@ -379,13 +379,7 @@ pub fn penetrate_with(
         run,
         start.elapsed(),
     );
-    if let Some(facts) = ranks {
-        // The energy ledger's sums are not distributed.
-        report.ledger_balance_relative = Real::NAN;
-        report.dissipated_damping = Real::NAN;
-        report.dissipated_friction = Real::NAN;
-        report.ranks = Some(facts);
-    }
+    report.ranks = ranks;
     Ok(report)
 }
 

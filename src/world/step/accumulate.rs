@@ -62,15 +62,17 @@ pub(super) fn stage(
             )
         });
     }
-    sum_picked(
-        &scratch.workers,
-        &scratch.candidates,
-        &scratch.evaluated,
-        params.overlap_warning_fraction,
+    let picked = Picked {
+        workers: &scratch.workers,
+        candidates: &scratch.candidates,
+        evaluated: &scratch.evaluated,
+        warning_fraction: params.overlap_warning_fraction,
         gather,
-        loads,
-        report,
-    );
+    };
+    match world.counted.as_deref() {
+        None => sum_picked(&picked, |_| true, loads, report),
+        Some(owned) => sum_picked(&picked, |key| owned[answering_body(key)], loads, report),
+    }
     // The frozen contacts, summed once while the sleeping set and the store's pairs stay the same, added
     // after the candidates in both summation modes (the same bits on any number of threads).
     if world.sleep.sleeping > 0 {
@@ -83,7 +85,9 @@ pub(super) fn stage(
     } else {
         &[]
     };
-    loads.external_power = external_power(loads, prescribed, &world.walls);
+    let counted = world.counted.as_deref();
+    let counts_body = |i: usize| counted.is_none_or(|owned| owned[i]);
+    loads.external_power = external_power(loads, prescribed, &world.walls, counts_body);
     loads.current = true;
     clock.serial_end(Section::SerialSums, profile_sums);
     report.counters.add(Stage::Accumulate, clock.stop());
@@ -106,8 +110,29 @@ fn reset(loads: &mut Loads, n: usize, n_walls: usize, gather: bool) {
     loads.tangential_stiffness_work = 0.0;
 }
 
+/// The candidates stages 4–5 picked and what stage 6 needs to sum them.
+struct Picked<'a> {
+    workers: &'a [Worker],
+    candidates: &'a [ContactKey],
+    evaluated: &'a [Evaluated],
+    warning_fraction: Real,
+    /// Whether the bodies' forces and torques are gathered per body (else scattered here).
+    gather: bool,
+}
+
+/// The body whose part answers for a pair in a split world: a body pair's lower body, a body–wall pair's
+/// body ([`super::super::energy_share`]).
+#[inline]
+fn answering_body(key: &ContactKey) -> usize {
+    match *key {
+        ContactKey::Body { a, .. } => a as usize,
+        ContactKey::Wall { body, .. } => body as usize,
+    }
+}
+
 /// The serial sums in candidate order: the ledger terms, the report, the walls' forces and (on one thread,
-/// `!gather`) the bodies' forces and torques by a scatter.
+/// `!gather`) the bodies' forces and torques by a scatter. The energy sums and the walls' forces take the
+/// pairs `counts` counts (every pair but in a part of a split world); the bodies' forces take every pair.
 ///
 /// They visit only the candidates stages 4–5 picked (overlapping, or with ledger terms: a pair that opens
 /// in this step books its release), in candidate order: the others would add nothing (their ledger terms
@@ -115,27 +140,27 @@ fn reset(loads: &mut Loads, n: usize, n_walls: usize, gather: bool) {
 /// all candidates, for any number of threads (see [`Worker::picked`]).
 #[inline]
 fn sum_picked(
-    workers: &[Worker],
-    candidates: &[ContactKey],
-    evaluated: &[Evaluated],
-    warning_fraction: Real,
-    gather: bool,
+    p: &Picked,
+    counts: impl Fn(&ContactKey) -> bool,
     loads: &mut Loads,
     report: &mut StepReport,
 ) {
-    let picked = workers.iter().flat_map(|w| &w.picked);
+    let picked = p.workers.iter().flat_map(|w| &w.picked);
     for &i in picked {
-        let (key, e) = (&candidates[i as usize], &evaluated[i as usize]);
-        loads.damping_work += e.work.damping;
-        loads.friction_dissipation += e.work.friction;
-        loads.tangential_stiffness_work += e.work.stiffness;
+        let (key, e) = (&p.candidates[i as usize], &p.evaluated[i as usize]);
+        let counted = counts(key);
+        if counted {
+            loads.damping_work += e.work.damping;
+            loads.friction_dissipation += e.work.friction;
+            loads.tangential_stiffness_work += e.work.stiffness;
+        }
         if !e.overlapping {
             // A separated pair contributes nothing (its response slot is stale).
             continue;
         }
         report.contacts += 1;
         report.max_overlap_ratio = report.max_overlap_ratio.max(e.overlap_ratio);
-        if e.overlap_ratio > warning_fraction {
+        if e.overlap_ratio > p.warning_fraction {
             report.overlap_warnings.push(OverlapWarning {
                 key: *key,
                 depth: e.depth,
@@ -143,7 +168,7 @@ fn sum_picked(
             });
         }
         match *key {
-            ContactKey::Body { a, b } if !gather => {
+            ContactKey::Body { a, b } if !p.gather => {
                 loads.forces[a as usize] -= e.force_on_b;
                 loads.torques[a as usize] += e.torque_on_a;
                 loads.forces[b as usize] += e.force_on_b;
@@ -151,14 +176,18 @@ fn sum_picked(
             }
             ContactKey::Body { .. } => {}
             ContactKey::Wall { body, wall } => {
-                loads.wall_forces[wall as usize] -= e.force_on_b;
-                if !gather {
+                if counted {
+                    loads.wall_forces[wall as usize] -= e.force_on_b;
+                }
+                if !p.gather {
                     loads.forces[body as usize] += e.force_on_b;
                     loads.torques[body as usize] += e.torque_on_b;
                 }
             }
         }
-        loads.elastic_potential += e.potential;
+        if counted {
+            loads.elastic_potential += e.potential;
+        }
     }
 }
 

@@ -6,13 +6,18 @@ use crate::math::Real;
 
 use super::super::world::{viscous_power, Loads, Wall, World};
 
-/// Power (W) delivered to the system through contacts by the prescribed bodies among `bodies` and by
-/// `walls`, with the contact loads `loads` and the velocities they have now: P = −Σ F·v (− Σ M·ω).
-/// `bodies` may be empty when none is prescribed (the sum skips them anyway).
-pub(super) fn external_power(loads: &Loads, bodies: &[RigidBody], walls: &[Wall]) -> Real {
+/// Power (W) delivered to the system through contacts by the prescribed bodies among `bodies` (those
+/// `counts_body` counts) and by `walls`, with the contact loads `loads` and the velocities they have now:
+/// P = −Σ F·v (− Σ M·ω). `bodies` may be empty when none is prescribed (the sum skips them anyway).
+pub(super) fn external_power(
+    loads: &Loads,
+    bodies: &[RigidBody],
+    walls: &[Wall],
+    counts_body: impl Fn(usize) -> bool,
+) -> Real {
     let mut power = 0.0;
     for (i, body) in bodies.iter().enumerate() {
-        if let Motion::Prescribed { .. } = body.motion {
+        if matches!(body.motion, Motion::Prescribed { .. }) && counts_body(i) {
             power -= loads.forces[i].dot(&body.velocity)
                 + loads.torques[i].dot(&body.angular_velocity());
         }
@@ -50,7 +55,9 @@ impl StepPowers {
     /// too, and a step after a checkpoint load has no record of which bodies are prescribed).
     pub(super) fn at_start(damping: ViscousDamping, world: &World) -> Self {
         Self {
-            external: external_power(&world.loads, &world.bodies, &world.walls),
+            external: external_power(&world.loads, &world.bodies, &world.walls, |i| {
+                world.counts_body(i)
+            }),
             viscous: damping_power(damping, world),
         }
     }

@@ -6,7 +6,7 @@
 //! so that recursive bisection cuts it along x into P slabs of the one-rank scene's size. Two kinds:
 //! spheres (radius 5 mm, s = 2.1 r) and polyhedra (cubes of half side 5 mm given as 8 hull points, placed
 //! face to face with the same gap, s = 2.2 h, so that they collide within the first steps). Both use the linear law
-//! with Δt = t_c / 20 and no energy ledger (the distributed ledger is not summed over ranks).
+//! with Δt = t_c / 20 and no energy ledger (the runs time the step, not its audit).
 
 use std::fmt::Write;
 
