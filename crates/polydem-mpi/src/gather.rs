@@ -16,7 +16,7 @@ use polydem::world::{EnergyShare, World};
 
 use crate::error::DistributedError;
 use crate::exchange::{gather_to_root, pack_ghost, unpack_ghost, GHOST_WORDS};
-use crate::run::{authoritative_contacts, DistributedRun, Part};
+use crate::run::{authoritative_contacts, before_first_step, DistributedRun, Part};
 use crate::wall_sums::{touching_walls, wall_forces};
 
 impl DistributedRun {
@@ -28,6 +28,10 @@ impl DistributedRun {
         world: Option<&mut World>,
         contacts: bool,
     ) -> Result<(), DistributedError> {
+        if before_first_step(&self.part) {
+            // `world` is still the state the run started from.
+            return Ok(());
+        }
         let entries = authoritative_contacts(&self.part);
         let touching_walls = touching_walls(&entries);
         let entries = if contacts { entries } else { Vec::new() };

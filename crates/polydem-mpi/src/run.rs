@@ -262,6 +262,13 @@ impl DistributedRun {
     }
 }
 
+/// Whether `part` has not been stepped yet: the whole state is then the world the run started from (a
+/// fresh world, whose loads are not evaluated: one process's stale loads are its own). Every rank
+/// answers alike, so every rank skips a gather alike.
+pub(crate) fn before_first_step(part: &Part) -> bool {
+    !part.world.loads().is_current()
+}
+
 type OwnedBody = (usize, RigidBody, Vector, Vector);
 
 fn owned_bodies(part: &Part) -> Vec<OwnedBody> {
@@ -380,6 +387,9 @@ impl DistributedRun {
     /// process's bit for bit, and so are the walls' forces (summed from the touching entries in key
     /// order, as the step sums them); the energy sums are one process's up to rounding (grouped by part).
     pub fn gather_world(&mut self) -> Result<World, DistributedError> {
+        if before_first_step(&self.part) {
+            return Ok(self.whole.clone());
+        }
         let share = self.part.world.energy_share();
         let mine = (
             owned_bodies(&self.part),

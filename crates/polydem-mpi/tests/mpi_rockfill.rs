@@ -9,7 +9,9 @@
 //! compares FNV-1a hashes of the positions, velocities, orientations and angular velocities of every body,
 //! and every monitor row word for word, with the file. A mismatch names P and the first body or row that
 //! differs, and aborts every rank. The energy terms at the end (added over the ranks, so one process's up
-//! to rounding) must be within [`ENERGY_TOLERANCE`] of one process's.
+//! to rounding) must be within [`ENERGY_TOLERANCE`] of one process's. The files rank 0 writes (the monitor
+//! series and VTK frames every [`FRAME_EVERY`] steps, gathered from every rank) must be one process's
+//! byte for byte.
 
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -19,7 +21,7 @@ use polydem_mpi::launch::launch_each;
 use polydem_mpi::mpi::traits::*;
 use polydem_rockfill::config::ExperimentConfig;
 use polydem_rockfill::experiment::{run_experiment_with, BedSource, ExperimentResult};
-use polydem_rockfill::penetration::{MonitorRow, Outcome, PenetrationOptions};
+use polydem_rockfill::penetration::{MonitorRow, Outcome, PenetrationFiles, PenetrationOptions};
 
 /// Impact steps: the tip reaches the bed's face at step 103 (0.6 m at 5.8 mm per step) and five rocks press
 /// on it by step 180; the projectile's travel rebuilds the broad phase (and the subdomains are cut again)
@@ -28,6 +30,8 @@ use polydem_rockfill::penetration::{MonitorRow, Outcome, PenetrationOptions};
 /// rank in a few collectives, so the steps are kept to what shows all of this.
 const STEPS: u64 = 360;
 const RANKS: [usize; 4] = [1, 2, 3, 4];
+/// Steps between VTK frames (by step index, as the CLI's `--vtk-every`).
+const FRAME_EVERY: u64 = 100;
 /// The rank count whose run must see the projectile change owner.
 const OWNER_CHANGE_RANKS: usize = 4;
 /// How far an energy term added over the ranks may be from one process's, relative to the largest term:
@@ -42,17 +46,29 @@ fn main() {
     }
 }
 
+/// Where a run of `label` (`one`, or a rank count) writes its files, for the launch with files `base`.
+fn files_dir(base: &str, label: &str) -> PathBuf {
+    PathBuf::from(format!("{base}_{label}"))
+}
+
 fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../..")
 }
 
-/// The quick penetration, in one process or split over the ranks.
-fn penetrate(distributed: bool) -> ExperimentResult {
+/// The quick penetration, in one process or split over the ranks, writing its monitors and VTK frames
+/// into `out` (rank 0 only, split over ranks).
+fn penetrate(distributed: bool, out: &Path) -> ExperimentResult {
     let config = ExperimentConfig::load(&root().join("scenes/rockfill/quick.toml"))
         .expect("scenes/rockfill/quick.toml loads");
+    let _ = std::fs::remove_dir_all(out);
+    let files = PenetrationFiles {
+        vtk_every: Some(FRAME_EVERY),
+        ..PenetrationFiles::monitors_in(out)
+    };
     let options = PenetrationOptions {
         max_steps: Some(STEPS),
         distributed,
+        files: Some(files),
         ..Default::default()
     };
     let bed = root().join("reference/rockfill/quick_bed");
@@ -62,7 +78,9 @@ fn penetrate(distributed: bool) -> ExperimentResult {
 
 fn launch() {
     let start = Instant::now();
-    let expected = penetrate(false);
+    let base = std::env::temp_dir().join(format!("polydem_mpi_rockfill_{}", std::process::id()));
+    let base = base.display().to_string();
+    let expected = penetrate(false, &files_dir(&base, "one"));
     let report = &expected.penetration;
     let contacts = report.rows.last().map_or(0, |r| r.contacts);
     assert_eq!(
@@ -92,20 +110,26 @@ fn launch() {
 
     let exe = std::env::current_exe().expect("the test binary's path");
     let failures = launch_each("rockfill quick", &RANKS, &exe, |c| {
-        c.env("POLYDEM_MPI_EXPECTED", &file);
+        c.env("POLYDEM_MPI_EXPECTED", &file)
+            .env("POLYDEM_MPI_FILES", &base);
     });
     let _ = std::fs::remove_file(&file);
     assert!(
         failures.is_empty(),
-        "distributed runs that failed: {failures:?}"
+        "distributed runs that failed: {failures:?} (their files are kept in {base}_*)"
     );
+    for label in ["one", "1", "2", "3", "4"] {
+        let _ = std::fs::remove_dir_all(files_dir(&base, label));
+    }
 }
 
 fn child(expected: &Path) {
     let universe = polydem_mpi::mpi::initialize().expect("MPI initialised once");
     let comm = universe.world();
     let start = Instant::now();
-    let result = penetrate(true);
+    let base = std::env::var("POLYDEM_MPI_FILES").expect("the launcher names the files' place");
+    let out = files_dir(&base, &comm.size().to_string());
+    let result = penetrate(true, &out);
     let elapsed = start.elapsed().as_secs_f64();
     let report = &result.penetration;
     let facts = report.ranks.expect("a distributed run reports its ranks");
@@ -130,6 +154,7 @@ fn child(expected: &Path) {
         let (bodies, rows, energy) = parse_expected(&text);
         let ranks = comm.size();
         let compared = compare(&bodies, result.world.bodies(), &rows, &report.rows)
+            .and_then(|()| compare_files(&out, &files_dir(&base, "one")))
             .and_then(|()| compare_energy(&energy, &energy_terms(&result)));
         let worst = compared.unwrap_or_else(|message| {
             eprintln!("rockfill quick on {ranks} ranks after {STEPS} steps: {message}");
@@ -146,7 +171,7 @@ fn child(expected: &Path) {
         }
         println!(
             "rockfill quick on {ranks} ranks after {STEPS} steps: the same bits as one process ({} bodies, {} \
-             monitor rows); energy terms within {worst:.1e} of the largest",
+             monitor rows, the same files); energy terms within {worst:.1e} of the largest",
             bodies.len(),
             rows.len()
         );
@@ -207,6 +232,74 @@ fn compare_energy(expected: &[u64], got: &[f64]) -> Result<f64, String> {
         worst = worst.max(relative);
     }
     Ok(worst)
+}
+
+/// Every file under `expected` (one process's) against the one of the same path under `got`, byte for
+/// byte, and no other file there.
+fn compare_files(got: &Path, expected: &Path) -> Result<(), String> {
+    let (mine, theirs) = (files_under(got), files_under(expected));
+    if mine
+        .iter()
+        .map(|(p, _)| p)
+        .ne(theirs.iter().map(|(p, _)| p))
+    {
+        let names = |f: &[(PathBuf, Vec<u8>)]| f.iter().map(|(p, _)| p.clone()).collect::<Vec<_>>();
+        return Err(format!(
+            "files {:?} in {}, one process wrote {:?}",
+            names(&mine),
+            got.display(),
+            names(&theirs)
+        ));
+    }
+    if theirs
+        .iter()
+        .filter(|(p, _)| p.extension().is_some_and(|e| e == "vtu"))
+        .count()
+        < 3
+    {
+        return Err(format!(
+            "fewer than 3 VTK frames in {}: nothing to compare",
+            expected.display()
+        ));
+    }
+    for ((path, a), (_, b)) in mine.iter().zip(&theirs) {
+        if a != b {
+            let at = a
+                .iter()
+                .zip(b)
+                .position(|(x, y)| x != y)
+                .unwrap_or(a.len().min(b.len()));
+            return Err(format!(
+                "{} differs from one process's (sizes {} and {}, first at byte {at})",
+                got.join(path).display(),
+                a.len(),
+                b.len()
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// The files under `dir` (relative paths, sorted) with their bytes.
+fn files_under(dir: &Path) -> Vec<(PathBuf, Vec<u8>)> {
+    let mut files = Vec::new();
+    let mut stack = vec![dir.to_path_buf()];
+    while let Some(d) = stack.pop() {
+        let entries = std::fs::read_dir(&d).unwrap_or_else(|e| panic!("{}: {e}", d.display()));
+        for entry in entries {
+            let path = entry.expect("a directory entry").path();
+            if path.is_dir() {
+                stack.push(path);
+            } else {
+                let bytes =
+                    std::fs::read(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+                let relative = path.strip_prefix(dir).expect("under dir").to_path_buf();
+                files.push((relative, bytes));
+            }
+        }
+    }
+    files.sort();
+    files
 }
 
 /// One line per body (the bits of its four quantities), then one per row (the bits of its words), then

@@ -2,7 +2,7 @@
 //!
 //! ```text
 //! polydem rockfill [--config FILE | --full] [--size MM] [--seed N] [--bed DIR] [--out DIR] [--vtk-every N]
-//! mpirun -n P polydem rockfill --mpi [--config FILE | --full] [--bed DIR] [--out DIR]   (feature `mpi`)
+//! mpirun -n P polydem rockfill --mpi [--config FILE | --full] [--bed DIR] [--out DIR] [--vtk-every N]  (feature `mpi`)
 //! polydem rockfill study [--config FILE | --full] --sizes 100,130,175,200,290 --seeds 1,2,3
 //!                        [--section-sizes K] [--reuse-beds] --out DIR
 //! polydem rockfill convergence [--config FILE | --full] [--dt-divisors 1,2,4] [--sections 1.0,1.5,2.0]
@@ -61,7 +61,7 @@ pub struct RockfillArgs {
     /// Run the penetration split over the ranks of the MPI job this process is launched in
     /// (`mpirun -n P polydem rockfill --mpi …`; a build with the `mpi` feature): the same bits as one
     /// process; rank 0 writes the files and the summary. Without `--bed` every rank packs the same bed.
-    #[arg(long, conflicts_with = "vtk_every")]
+    #[arg(long)]
     pub mpi: bool,
 }
 

@@ -25,8 +25,9 @@
 //! without the time-step check (it reads the state only, so one process's bits do not depend on it).
 //!
 //! # Limits
-//! - Sleeping is refused (the parts do not carry the sleep state), and so are VTK frames (their schedule
-//!   would need a gather on every rank; not written yet).
+//! - Sleeping is refused (the parts do not carry the sleep state).
+//! - VTK frames gather the whole world on every rank at each frame (every rank knows the schedule; rank 0
+//!   writes the frame as one process does, the same bytes): O(N) traffic per frame.
 //! - The energy ledger's terms are the whole world's, added over the ranks' shares: one process's up to
 //!   rounding, not bit for bit.
 //! - The step counters are those of this rank's part (they include its ghosts' pairs); the largest overlap

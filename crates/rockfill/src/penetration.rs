@@ -397,13 +397,6 @@ fn check_distributed(
     if config.sleeping.penetration {
         return Err(PenetrationError::DistributedSleeping);
     }
-    if options
-        .files
-        .as_ref()
-        .is_some_and(|f| f.vtk_every.is_some())
-    {
-        return Err(PenetrationError::DistributedFrames);
-    }
     Ok(())
 }
 
@@ -463,10 +456,21 @@ fn step_impact(
 }
 
 /// The outputs of a run: the monitor series, driven step by step through the [`Output`] trait (the run
-/// reads its rows), and the other outputs of [`PenetrationFiles`] in an [`OutputSet`].
+/// reads its rows), and the other outputs of [`PenetrationFiles`] in an [`OutputSet`] (empty on the
+/// ranks other than 0 of a run split over MPI ranks).
 struct RunOutputs {
     monitors: MonitorSeries,
     others: OutputSet<'static>,
+    /// The VTK frames' schedule, known on every rank: the whole state is gathered at those steps, a
+    /// collective every rank must enter, though only rank 0 writes.
+    frames: Option<Schedule>,
+}
+
+impl RunOutputs {
+    /// Whether the outputs read the whole state after step `step` (the same answer on every rank).
+    fn wants_state(&self, step: u64) -> bool {
+        self.frames.is_some_and(|s| s.due(step)) || self.others.wants_state(step)
+    }
 }
 
 fn open_outputs(
@@ -475,25 +479,33 @@ fn open_outputs(
     gauge: ProjectileGauge,
 ) -> Result<RunOutputs, PenetrationError> {
     let start_step = world.step_index();
+    let frames = options
+        .files
+        .as_ref()
+        .and_then(|f| f.vtk_every)
+        .map(|every| Schedule {
+            start_step,
+            last_step: u64::MAX,
+            every: Some(every),
+            at_start: true,
+            at_end: false,
+        });
     let files = options.files.as_ref().filter(|_| writes_files(options));
     let monitors = MonitorSeries::new(gauge, start_step, files.map(|f| f.dir.join(&f.monitors)));
     let mut others = OutputSet::new();
     if let Some(f) = files {
         std::fs::create_dir_all(&f.dir).map_err(|e| in_dir(&f.dir, e))?;
-        if let Some(every) = f.vtk_every {
+        if let Some(schedule) = frames {
             let writer =
                 VtkWriter::new(&f.dir, world, f.vtk_encoding).map_err(|e| in_dir(&f.dir, e))?;
-            let schedule = Schedule {
-                start_step,
-                last_step: u64::MAX,
-                every: Some(every),
-                at_start: true,
-                at_end: false,
-            };
             others.push(VtkFrames::new(writer, schedule));
         }
     }
-    Ok(RunOutputs { monitors, others })
+    Ok(RunOutputs {
+        monitors,
+        others,
+        frames,
+    })
 }
 
 fn in_dir(dir: &std::path::Path, e: std::io::Error) -> std::io::Error {
@@ -561,7 +573,7 @@ fn run_impact<S: ImpactStepper>(
     let mut pending: Vec<Real> = options.snapshot_tip_x.clone();
     pending.sort_by(|a, b| b.total_cmp(a));
     let gauge = *outputs.monitors.gauge();
-    if outputs.others.wants_state(start_step) {
+    if outputs.wants_state(start_step) {
         outputs.others.observe(stepper.whole()?, start_step)?;
     }
     let outcome = loop {
@@ -576,7 +588,7 @@ fn run_impact<S: ImpactStepper>(
         let at = start_step + steps;
         let (row, body) = stepper.projectile(&gauge)?;
         outputs.monitors.push(row);
-        if outputs.others.wants_state(at) {
+        if outputs.wants_state(at) {
             outputs.others.observe(stepper.whole()?, at)?;
         }
         while pending.last().is_some_and(|&x| row.tip.x >= x) {
@@ -812,18 +824,6 @@ mod tests {
         assert!(
             matches!(refused, Err(PenetrationError::DistributedSleeping)),
             "sleeping.penetration = true: {refused:?}, expected DistributedSleeping"
-        );
-        let frames = PenetrationOptions {
-            files: Some(PenetrationFiles {
-                vtk_every: Some(10),
-                ..PenetrationFiles::monitors_in("unused")
-            }),
-            ..distributed
-        };
-        let refused = check_distributed(&config, &frames);
-        assert!(
-            matches!(refused, Err(PenetrationError::DistributedFrames)),
-            "VTK frames every 10 steps: {refused:?}, expected DistributedFrames"
         );
     }
 }

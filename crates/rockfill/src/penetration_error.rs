@@ -36,11 +36,6 @@ pub enum PenetrationError {
          parts do not carry the sleep state; set it to false"
     )]
     DistributedSleeping,
-    /// A run split over MPI ranks asked for VTK frames.
-    #[error(
-        "a penetration split over MPI ranks does not write VTK frames yet; leave out the frames"
-    )]
-    DistributedFrames,
     /// The run split over MPI ranks failed (the message names the rank).
     #[cfg(feature = "mpi")]
     #[error(transparent)]

@@ -32,7 +32,7 @@ pub fn is_isotropic(moments: &Vector) -> bool {
 /// Turns `orientation` (body → world) over `dt` about the world angular momentum `angular_momentum` of a
 /// body with isotropic principal moment `moment` (kg·m²), by the angle Δt|L|/J (`Exact`) or its Cayley
 /// form 4 atan(θ/4) (`Cayley`).
-#[inline]
+#[inline(always)]
 pub fn drift_isotropic(
     form: SubRotation,
     orientation: &mut Rotation,
