@@ -74,7 +74,7 @@
 use super::sat::Polytope;
 use super::wall_depth::smoothed_depth;
 use super::{ContactGeometry, ContactKind};
-use crate::math::{Point, Pose, Real, Vector};
+use crate::math::{Point, Pose, Real, Rotation, Vector};
 
 /// What a polyhedron–polyhedron contact hands to the law.
 #[derive(Copy, Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -104,16 +104,43 @@ const SAME_NORMAL: Real = 1e-9;
 /// h of δ_M); the deepest ones are dropped, which never drops the lowest.
 const MAX_CANDIDATES: usize = 8;
 
-/// Adds `c` to the first `len` entries of `cands`, replacing the deepest one when full.
-fn add(c: Candidate, cands: &mut [Candidate; MAX_CANDIDATES], len: &mut usize) {
-    if *len < MAX_CANDIDATES {
-        cands[*len] = c;
-        *len += 1;
-    } else if let Some(worst) = (0..MAX_CANDIDATES)
-        .max_by(|&i, &j| cands[i].depth.total_cmp(&cands[j].depth))
-        .filter(|&k| cands[k].depth > c.depth)
-    {
-        cands[worst] = c;
+/// The candidates found so far: at most `MAX_CANDIDATES`, the deepest dropped first.
+struct Candidates {
+    list: [Candidate; MAX_CANDIDATES],
+    len: usize,
+    /// Whether a face candidate has the EPA normal.
+    has_epa_normal: bool,
+}
+
+impl Default for Candidates {
+    fn default() -> Self {
+        let none = Candidate {
+            depth: 0.0,
+            normal: Vector::zeros(),
+            point_b: Vector::zeros(),
+            smoothed: false,
+        };
+        Self {
+            list: [none; MAX_CANDIDATES],
+            len: 0,
+            has_epa_normal: false,
+        }
+    }
+}
+
+impl Candidates {
+    /// Adds `c`, replacing the deepest one when full.
+    #[inline(always)]
+    fn add(&mut self, c: Candidate) {
+        if self.len < MAX_CANDIDATES {
+            self.list[self.len] = c;
+            self.len += 1;
+        } else if let Some(worst) = (0..MAX_CANDIDATES)
+            .max_by(|&i, &j| self.list[i].depth.total_cmp(&self.list[j].depth))
+            .filter(|&k| self.list[k].depth > c.depth)
+        {
+            self.list[worst] = c;
+        }
     }
 }
 
@@ -452,124 +479,45 @@ fn smooth_pair_overlap_by<A: Polytope + ?Sized, B: Polytope + ?Sized>(
     }
     let h = band * a.length_scale().min(b.length_scale());
     let pos12 = pos1.inv_mul(pos2);
-    let (rot12, t12) = (pos12.rotation, pos12.translation.vector);
     let n0 = pos1.rotation.inverse_transform_vector(&exact.normal);
     let pa = pos1.inverse_transform_point(&exact.point_a).coords;
     let pb = pos1.inverse_transform_point(&exact.point_b).coords;
-    let pa_b = pos12.inverse_transform_point(&Point::from(pa)).coords;
-    let delta = exact.depth;
-    let reach = delta + REACH * h;
-    let (va, vb) = (a.vertices(), b.vertices());
-    let mut band_buf = Band::new();
-    let mut cands = [Candidate {
-        depth: 0.0,
-        normal: Vector::zeros(),
-        point_b: Vector::zeros(),
-        smoothed: false,
-    }; MAX_CANDIDATES];
-    let mut len = 0;
-    let mut has_epa_normal = false;
-    let walk_a = starts.is_some() && va.len() >= WALK_MIN_VERTICES;
-    let walk_b = starts.is_some() && vb.len() >= WALK_MIN_VERTICES;
-    let [mut start_a, mut start_b] = starts.unwrap_or_default();
-    // Without starts (the reference of the tests): every face candidate's band in full, no early rejection.
-    let rejecting = starts.is_some();
-    // A candidate is dropped once a vertex lies deeper than this: its smoothed depth cannot win then.
-    let reject_beyond = |margin: Real| {
-        if rejecting {
-            reach + 2.0 * h + margin
-        } else {
-            Real::INFINITY
-        }
+    let frame = Frame {
+        h,
+        reach: exact.depth + REACH * h,
+        rot12: pos12.rotation,
+        t12: pos12.translation.vector,
+        n0,
+        // Without starts (the reference of the tests): every face candidate's band in full, no early
+        // rejection.
+        rejecting: starts.is_some(),
     };
-    // Faces of A: B's vertices below the face plane.
-    for f in 0..a.num_faces() {
-        let n = a.face_normal(f);
-        let o = a.face_offset(f);
-        if o - n.dot(&pb) > reach {
-            continue;
-        }
-        let u = rot12.inverse_transform_vector(&n);
-        let s = o - n.dot(&t12);
-        let margin = WALK_MARGIN * (s.abs() + b.bounding_radius());
-        let Some((d, c2, smoothed)) = smoothed_support(
-            b,
-            |j| s - u.dot(&vb[j].coords),
-            |j| rot12 * vb[j].coords + t12,
-            h,
-            &mut start_b,
-            walk_b.then_some(margin),
-            reject_beyond(margin),
-            &mut band_buf,
-        ) else {
-            continue;
-        };
-        if d > reach {
-            continue;
-        }
-        has_epa_normal |= n.cross(&n0).norm() < SAME_NORMAL;
-        add(
-            Candidate {
-                depth: d,
-                normal: n,
-                point_b: c2,
-                smoothed,
-            },
-            &mut cands,
-            &mut len,
-        );
+    let [start_a, start_b] = starts.unwrap_or_default();
+    let mut walk_a = Walk {
+        enabled: starts.is_some() && a.vertices().len() >= WALK_MIN_VERTICES,
+        start: start_a,
+    };
+    let mut walk_b = Walk {
+        enabled: starts.is_some() && b.vertices().len() >= WALK_MIN_VERTICES,
+        start: start_b,
+    };
+    let mut out = FaceSearch {
+        band: Band::new(),
+        candidates: Candidates::default(),
+    };
+    frame.faces_of_a(a, b, &pb, &mut walk_b, &mut out);
+    let pa_b = pos12.inverse_transform_point(&Point::from(pa)).coords;
+    frame.faces_of_b(a, b, &pa_b, &mut walk_a, &mut out);
+    let found = &mut out.candidates;
+    if !found.has_epa_normal {
+        found.add(Candidate {
+            depth: exact.depth,
+            normal: n0,
+            point_b: pb,
+            smoothed: false,
+        });
     }
-    // Faces of B: A's vertices below the face plane (contact normal −m, m the face normal in A's frame).
-    for g in 0..b.num_faces() {
-        let m_b = b.face_normal(g);
-        let o_b = b.face_offset(g);
-        if o_b - m_b.dot(&pa_b) > reach {
-            continue;
-        }
-        let m = rot12 * m_b;
-        let s = o_b + m.dot(&t12);
-        let margin = WALK_MARGIN * (s.abs() + a.bounding_radius());
-        let Some((d, c1, smoothed)) = smoothed_support(
-            a,
-            |i| s - m.dot(&va[i].coords),
-            |i| va[i].coords,
-            h,
-            &mut start_a,
-            walk_a.then_some(margin),
-            reject_beyond(margin),
-            &mut band_buf,
-        ) else {
-            continue;
-        };
-        if d > reach {
-            continue;
-        }
-        has_epa_normal |= m.cross(&n0).norm() < SAME_NORMAL;
-        add(
-            Candidate {
-                depth: d,
-                normal: -m,
-                point_b: c1 + m * d,
-                smoothed,
-            },
-            &mut cands,
-            &mut len,
-        );
-    }
-    if !has_epa_normal {
-        add(
-            Candidate {
-                depth: delta,
-                normal: n0,
-                point_b: pb,
-                smoothed: false,
-            },
-            &mut cands,
-            &mut len,
-        );
-    }
-    let cands = &cands[..len];
-    let lead = cands
+    let lead = found.list[..found.len]
         .iter()
         .min_by(|x, y| x.depth.total_cmp(&y.depth))
         .expect("the EPA facet is a candidate");
@@ -578,7 +526,7 @@ fn smooth_pair_overlap_by<A: Polytope + ?Sized, B: Polytope + ?Sized>(
         return *exact;
     }
     let (depth, normal, point_b) = (lead.depth, lead.normal, lead.point_b);
-    let depth = depth.clamp(0.0, delta);
+    let depth = depth.clamp(0.0, exact.depth);
     let point_a = point_b + normal * depth;
     ContactGeometry::from_points(
         exact.kind,
@@ -589,6 +537,136 @@ fn smooth_pair_overlap_by<A: Polytope + ?Sized, B: Polytope + ?Sized>(
         pos1 * Point::from(point_b),
         exact.status,
     )
+}
+
+/// A pair's frame for the band search, in A's frame (copied into each face loop, so that its values stay
+/// in registers).
+#[derive(Clone, Copy)]
+struct Frame {
+    /// The smoothing band (m).
+    h: Real,
+    /// Faces whose depth exceeds this (δ_M + `REACH` h) cannot win.
+    reach: Real,
+    /// B's pose in A's frame.
+    rot12: Rotation,
+    t12: Vector,
+    /// The EPA normal in A's frame.
+    n0: Vector,
+    /// Whether deep candidates are dropped early (not in the reference).
+    rejecting: bool,
+}
+
+/// Where a side's vertex walks start (updated as they go), and whether that side walks at all.
+struct Walk {
+    enabled: bool,
+    start: u32,
+}
+
+/// What the face loops fill: the candidates, and the band buffer they reuse.
+struct FaceSearch {
+    band: Band,
+    candidates: Candidates,
+}
+
+impl Frame {
+    /// A candidate is dropped once a vertex lies deeper than this: its smoothed depth cannot win then.
+    #[inline(always)]
+    fn reject_beyond(self, margin: Real) -> Real {
+        if self.rejecting {
+            self.reach + 2.0 * self.h + margin
+        } else {
+            Real::INFINITY
+        }
+    }
+
+    /// Faces of A (`pb`: the EPA point of B in A's frame): B's vertices below each face plane.
+    fn faces_of_a<A: Polytope + ?Sized, B: Polytope + ?Sized>(
+        self,
+        a: &A,
+        b: &B,
+        pb: &Vector,
+        walk_b: &mut Walk,
+        out: &mut FaceSearch,
+    ) {
+        let (rot12, t12, vb) = (self.rot12, self.t12, b.vertices());
+        for f in 0..a.num_faces() {
+            let n = a.face_normal(f);
+            let o = a.face_offset(f);
+            if o - n.dot(pb) > self.reach {
+                continue;
+            }
+            let u = rot12.inverse_transform_vector(&n);
+            let s = o - n.dot(&t12);
+            let margin = WALK_MARGIN * (s.abs() + b.bounding_radius());
+            let Some((d, c2, smoothed)) = smoothed_support(
+                b,
+                |j| s - u.dot(&vb[j].coords),
+                |j| rot12 * vb[j].coords + t12,
+                self.h,
+                &mut walk_b.start,
+                walk_b.enabled.then_some(margin),
+                self.reject_beyond(margin),
+                &mut out.band,
+            ) else {
+                continue;
+            };
+            if d > self.reach {
+                continue;
+            }
+            out.candidates.has_epa_normal |= n.cross(&self.n0).norm() < SAME_NORMAL;
+            out.candidates.add(Candidate {
+                depth: d,
+                normal: n,
+                point_b: c2,
+                smoothed,
+            });
+        }
+    }
+
+    /// Faces of B (`pa_b`: the EPA point of A in B's frame): A's vertices below each face plane (contact
+    /// normal −m, m the face normal in A's frame).
+    fn faces_of_b<A: Polytope + ?Sized, B: Polytope + ?Sized>(
+        self,
+        a: &A,
+        b: &B,
+        pa_b: &Vector,
+        walk_a: &mut Walk,
+        out: &mut FaceSearch,
+    ) {
+        let (rot12, t12, va) = (self.rot12, self.t12, a.vertices());
+        for g in 0..b.num_faces() {
+            let m_b = b.face_normal(g);
+            let o_b = b.face_offset(g);
+            if o_b - m_b.dot(pa_b) > self.reach {
+                continue;
+            }
+            let m = rot12 * m_b;
+            let s = o_b + m.dot(&t12);
+            let margin = WALK_MARGIN * (s.abs() + a.bounding_radius());
+            let Some((d, c1, smoothed)) = smoothed_support(
+                a,
+                |i| s - m.dot(&va[i].coords),
+                |i| va[i].coords,
+                self.h,
+                &mut walk_a.start,
+                walk_a.enabled.then_some(margin),
+                self.reject_beyond(margin),
+                &mut out.band,
+            ) else {
+                continue;
+            };
+            if d > self.reach {
+                continue;
+            }
+            out.candidates.has_epa_normal |= m.cross(&self.n0).norm() < SAME_NORMAL;
+            out.candidates.add(Candidate {
+                depth: d,
+                normal: -m,
+                point_b: c1 + m * d,
+                smoothed,
+            });
+        }
+    }
 }
 
 #[cfg(test)]
