@@ -580,6 +580,7 @@ impl Frame {
     }
 
     /// Faces of A (`pb`: the EPA point of B in A's frame): B's vertices below each face plane.
+    #[inline(never)]
     fn faces_of_a<A: Polytope + ?Sized, B: Polytope + ?Sized>(
         self,
         a: &A,
@@ -625,6 +626,7 @@ impl Frame {
 
     /// Faces of B (`pa_b`: the EPA point of A in B's frame): A's vertices below each face plane (contact
     /// normal −m, m the face normal in A's frame).
+    #[inline(never)]
     fn faces_of_b<A: Polytope + ?Sized, B: Polytope + ?Sized>(
         self,
         a: &A,
