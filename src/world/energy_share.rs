@@ -56,6 +56,10 @@ impl World {
     /// docs). With current loads, the walls' forces of the last evaluation are recounted over those pairs
     /// from the contact store, so that the next step's external power is this part's share too (stale
     /// loads are evaluated afresh by the next step).
+    ///
+    /// The mark is for a part's whole life: the body set must not change afterwards (the flags are
+    /// indexed by body), and sleeping must stay off (the frozen contacts of sleeping bodies are summed
+    /// once for all of them, not split by owner; a split run refuses sleeping).
     pub fn count_only(&mut self, owned: Vec<bool>) {
         assert_eq!(owned.len(), self.bodies.len(), "one flag per body");
         if self.loads.current && self.loads.wall_forces.len() == self.walls.len() {
