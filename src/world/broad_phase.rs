@@ -227,6 +227,78 @@ impl BroadPhase {
         }
     }
 
+    /// The list a build at `centres` with `walls` would give for another set of bodies, taken over from
+    /// this one where it can: `old_of_new[k]` is new body `k`'s index in this list (increasing where
+    /// given), or `None` for a body this list does not hold. Pairs among held bodies are this list's
+    /// (renumbered, in the same order); pairs and wall pairs of the others are tested one by one with the
+    /// build's criterion. Valid when every held body's centre and radius are those of this list's build and
+    /// the walls are those of its build (a part of a world split over processes, cut again right after the
+    /// step that built this list: its bodies mostly stay).
+    pub fn carried_over(
+        &self,
+        old_of_new: &[Option<u32>],
+        centres: &[Point],
+        radii: &[Real],
+        walls: &[Wall],
+    ) -> BroadPhase {
+        debug_assert_eq!(old_of_new.len(), centres.len());
+        debug_assert!(old_of_new.iter().enumerate().all(|(k, old)| {
+            old.is_none_or(|i| self.centres_at_build[i as usize] == centres[k])
+        }));
+        let mut new_of_old = vec![u32::MAX; self.centres_at_build.len()];
+        let mut newcomers = Vec::new();
+        for (k, old) in old_of_new.iter().enumerate() {
+            match old {
+                Some(i) => new_of_old[*i as usize] = k as u32,
+                None => newcomers.push(k),
+            }
+        }
+        let held = |&(i, j): &Pair| {
+            let (a, b) = (new_of_old[i as usize], new_of_old[j as usize]);
+            (a != u32::MAX && b != u32::MAX).then_some((a, b))
+        };
+        let mut found = Vec::new();
+        for &k in &newcomers {
+            // A pair of two newcomers is found from the later one.
+            let partners = (0..centres.len()).filter(|&j| j < k || old_of_new[j].is_some());
+            for j in partners.filter(|&j| j != k) {
+                if spheres_within(centres[k], radii[k], centres[j], radii[j], self.skin) {
+                    found.push((k.min(j) as u32, k.max(j) as u32));
+                }
+            }
+        }
+        found.sort_unstable();
+        let pairs = merge_sorted(self.pairs.iter().filter_map(held), found);
+        let newcomer_walls = newcomers.iter().flat_map(|&k| {
+            let one = brute_force_wall_pairs(&centres[k..=k], &radii[k..=k], walls, self.skin);
+            one.into_iter().map(move |(_, w)| (k as u32, w))
+        });
+        let kept_walls = self.wall_pairs.iter().filter_map(|&(i, w)| {
+            let a = new_of_old[i as usize];
+            (a != u32::MAX).then_some((a, w))
+        });
+        let wall_pairs = merge_sorted(kept_walls, newcomer_walls.collect());
+        BroadPhase {
+            skin: self.skin,
+            centres_at_build: centres.to_vec(),
+            pairs,
+            rebuilds: self.rebuilds,
+            wall_pairs,
+            walls_at_build: walls.iter().map(|w| w.pose.translation.vector).collect(),
+            generation: fresh_generation(),
+            ..BroadPhase::default()
+        }
+    }
+
+    /// Drops the pairs and body–wall pairs that hold no body for which `counts` is true (a part of a world
+    /// split over processes: a pair of two ghosts only moves ghosts, whose states come from their owners).
+    /// The build's centres and count stay, so the next rebuild happens when it would have.
+    pub fn keep_pairs_of(&mut self, counts: impl Fn(u32) -> bool) {
+        self.pairs.retain(|&(i, j)| counts(i) || counts(j));
+        self.wall_pairs.retain(|&(i, _)| counts(i));
+        self.generation = fresh_generation();
+    }
+
     /// Sets the build count, for a list built in step with another that counts the builds (a part of a
     /// world split over processes, whose list is built anew at each cut).
     pub fn set_rebuilds(&mut self, rebuilds: u64) {
@@ -500,6 +572,20 @@ impl PairSearch<'_> {
     }
 }
 
+/// The pairs of `a` and of `b` (each sorted, no pair in both) in one sorted list.
+fn merge_sorted(a: impl Iterator<Item = Pair>, b: Vec<Pair>) -> Vec<Pair> {
+    let mut out = Vec::with_capacity(b.len());
+    let mut b = b.into_iter().peekable();
+    for pair in a {
+        while let Some(next) = b.next_if(|next| *next < pair) {
+            out.push(next);
+        }
+        out.push(pair);
+    }
+    out.extend(b);
+    out
+}
+
 /// The pair criterion: spheres closer than the sum of their radii plus the skin.
 fn spheres_within(c1: Point, r1: Real, c2: Point, r2: Real, skin: Real) -> bool {
     let reach = r1 + r2 + skin;
@@ -683,6 +769,58 @@ mod tests {
         let radii: Vec<Real> = (0..n).map(|_| 10f64.powf(rng.uniform(-3.0, 0.0))).collect();
         assert_matches_oracle("log-uniform radii 1e-3..1", &centres, &radii, 0.0);
         assert_matches_oracle("log-uniform radii 1e-3..1, skin", &centres, &radii, 0.02);
+    }
+
+    #[test]
+    fn a_list_carried_over_to_another_set_of_bodies_is_the_list_built_for_that_set() {
+        // The old set holds bodies 0..1200 but every seventh; the new one drops every fifth of those and
+        // takes in the seventh ones (newcomers) and bodies 1200..1300, with a wall cutting through both.
+        let (centres, radii) = random_scene(21, 1300, 1.0, 0.04, 0.06);
+        let walls = vec![Wall {
+            name: "w".to_owned(),
+            plane: crate::shape::Plane::new(Vector::z(), 0.2).expect("plane"),
+            pose: crate::math::Pose::identity(),
+            velocity: Vector::zeros(),
+            material: 0,
+        }];
+        let skin = 0.01;
+        let old_ids: Vec<usize> = (0..1200).filter(|i| i % 7 != 0).collect();
+        let new_ids: Vec<usize> = (0..1300)
+            .filter(|i| *i >= 1200 || i % 7 == 0 || i % 5 != 0)
+            .collect();
+        let pick = |ids: &[usize]| -> (Vec<Point>, Vec<Real>) {
+            (
+                ids.iter().map(|&i| centres[i]).collect(),
+                ids.iter().map(|&i| radii[i]).collect(),
+            )
+        };
+        let (old_centres, old_radii) = pick(&old_ids);
+        let mut old = BroadPhase::new(skin);
+        old.rebuild_with_walls(&old_centres, &old_radii, &walls);
+        let (new_centres, new_radii) = pick(&new_ids);
+        let mut built = BroadPhase::new(skin);
+        built.rebuild_with_walls(&new_centres, &new_radii, &walls);
+        let old_of_new: Vec<Option<u32>> = new_ids
+            .iter()
+            .map(|gid| old_ids.binary_search(gid).ok().map(|k| k as u32))
+            .collect();
+        let newcomers = old_of_new.iter().filter(|o| o.is_none()).count();
+        let carried = old.carried_over(&old_of_new, &new_centres, &new_radii, &walls);
+        assert!(
+            newcomers > 100 && built.pairs().len() > 1000 && built.wall_pairs().len() > 20,
+            "{newcomers} newcomers, {} pairs, {} wall pairs: the test tests too little",
+            built.pairs().len(),
+            built.wall_pairs().len()
+        );
+        assert!(
+            carried.pairs() == built.pairs() && carried.wall_pairs() == built.wall_pairs(),
+            "{newcomers} newcomers: carried over {} pairs and {} wall pairs, built {} and {}",
+            carried.pairs().len(),
+            carried.wall_pairs().len(),
+            built.pairs().len(),
+            built.wall_pairs().len()
+        );
+        assert_eq!(carried.centres_at_build(), built.centres_at_build());
     }
 
     #[test]

@@ -295,6 +295,23 @@ impl ContactStore {
         counts
     }
 
+    /// A store of the entries `keys` (strictly increasing) with their `states`, synced last at step
+    /// `last_touched`.
+    pub fn from_entries(
+        keys: Vec<ContactKey>,
+        states: Vec<ContactState>,
+        last_touched: u64,
+    ) -> Self {
+        debug_assert!(keys.windows(2).all(|w| w[0] < w[1]));
+        debug_assert_eq!(keys.len(), states.len());
+        Self {
+            keys,
+            states,
+            last_touched,
+            ..Self::default()
+        }
+    }
+
     /// The stored keys, sorted.
     pub fn keys(&self) -> &[ContactKey] {
         &self.keys

@@ -12,7 +12,7 @@ use crate::math::{Point, Vector};
 
 use super::broad_phase::BroadPhase;
 use super::contact_store::{ContactKey, ContactState, ContactStore};
-use super::world::{Loads, World};
+use super::world::{Loads, Wall, World};
 
 /// The broad phase a part of a world starts with ([`World::part`]).
 #[derive(Copy, Clone, Debug, PartialEq, Eq)]
@@ -36,36 +36,35 @@ impl World {
     /// whose bodies are all kept, and its broad phase as `broad_phase` says. The energy ledger starts
     /// empty and no body sleeps.
     pub fn part(&self, ids: &[usize], broad_phase: PartBroadPhase) -> World {
-        debug_assert!(ids.windows(2).all(|w| w[0] < w[1]));
-        let mut local = vec![u32::MAX; self.bodies.len()];
-        for (k, &i) in ids.iter().enumerate() {
-            local[i] = k as u32;
-        }
-        let pick = |v: &[Vector]| -> Vec<Vector> {
-            if v.len() == self.bodies.len() {
-                ids.iter().map(|&i| v[i]).collect()
-            } else {
-                Vec::new()
-            }
-        };
-        let loads = Loads {
-            forces: pick(&self.loads.forces),
-            torques: pick(&self.loads.torques),
-            ..self.loads.clone()
-        };
         let entries = self.contacts.keys().iter().zip(self.contacts.states());
-        let kept = entries.filter_map(|(key, state)| {
-            let renumbered = match *key {
+        let entries = entries.map(|(key, state)| (*key, *state));
+        self.part_with_contacts(ids, entries, self.contacts.last_touched(), broad_phase)
+    }
+
+    /// As [`World::part`], with the contact entries `entries` (keyed in this world's numbering, in
+    /// increasing key order; those with a body not kept are dropped) in place of this world's store, touched
+    /// last at step `last_touched`: a part assembled from entries that other processes sent.
+    pub fn part_with_contacts(
+        &self,
+        ids: &[usize],
+        entries: impl IntoIterator<Item = (ContactKey, ContactState)>,
+        last_touched: u64,
+        broad_phase: PartBroadPhase,
+    ) -> World {
+        debug_assert!(ids.windows(2).all(|w| w[0] < w[1]));
+        let local = |i: u32| ids.binary_search(&(i as usize)).ok().map(|k| k as u32);
+        let kept = entries.into_iter().filter_map(|(key, state)| {
+            let renumbered = match key {
                 ContactKey::Body { a, b } => {
-                    let (a, b) = (local[a as usize], local[b as usize]);
-                    (a != u32::MAX && b != u32::MAX).then_some(ContactKey::Body { a, b })
+                    let (a, b) = (local(a)?, local(b)?);
+                    ContactKey::Body { a, b }
                 }
-                ContactKey::Wall { body, wall } => {
-                    let body = local[body as usize];
-                    (body != u32::MAX).then_some(ContactKey::Wall { body, wall })
-                }
+                ContactKey::Wall { body, wall } => ContactKey::Wall {
+                    body: local(body)?,
+                    wall,
+                },
             };
-            renumbered.map(|key| (key, *state))
+            Some((renumbered, state))
         });
         let mut part = World::new(
             self.gravity,
@@ -78,11 +77,11 @@ impl World {
         part.material_of = ids.iter().map(|&i| self.material_of[i]).collect();
         part.radii = ids.iter().map(|&i| self.radii[i]).collect();
         part.names = ids.iter().map(|&i| self.names[i].clone()).collect();
-        part.loads = loads;
+        part.loads = self.loads_of(ids);
         part.walls = self.walls.clone();
         part.time = self.time;
         part.step_index = self.step_index;
-        part.replace_contacts(kept.collect(), self.contacts.last_touched());
+        part.replace_contacts(kept.collect(), last_touched);
         match broad_phase {
             PartBroadPhase::Unbuilt => {}
             PartBroadPhase::Build { rebuilds } => {
@@ -94,6 +93,29 @@ impl World {
             PartBroadPhase::Restrict => part.broad_phase = self.broad_phase.restricted(ids),
         }
         part
+    }
+
+    /// The loads with the per-body forces and torques of `ids` only (none where none are evaluated).
+    fn loads_of(&self, ids: &[usize]) -> Loads {
+        let pick = |v: &[Vector]| -> Vec<Vector> {
+            if v.len() == self.bodies.len() {
+                ids.iter().map(|&i| v[i]).collect()
+            } else {
+                Vec::new()
+            }
+        };
+        let l = &self.loads;
+        Loads {
+            forces: pick(&l.forces),
+            torques: pick(&l.torques),
+            wall_forces: l.wall_forces.clone(),
+            elastic_potential: l.elastic_potential,
+            damping_work: l.damping_work,
+            friction_dissipation: l.friction_dissipation,
+            tangential_stiffness_work: l.tangential_stiffness_work,
+            external_power: l.external_power,
+            current: l.current,
+        }
     }
 
     /// Body `i`'s state and loads copied from the process that owns it, bit for bit. Unlike the `set_body_*`
@@ -117,13 +139,8 @@ impl World {
         entries: Vec<(ContactKey, ContactState)>,
         last_touched: u64,
     ) {
-        let keys: Vec<ContactKey> = entries.iter().map(|(key, _)| *key).collect();
-        let mut store = ContactStore::default();
-        store.sync(&keys, last_touched);
-        for (slot, (_, state)) in store.states_mut().iter_mut().zip(entries) {
-            *slot = state;
-        }
-        self.contacts = store;
+        let (keys, states) = entries.into_iter().unzip();
+        self.contacts = ContactStore::from_entries(keys, states, last_touched);
     }
 
     /// The walls, the clock and the loads other than the bodies' (wall forces, sums) of `other` (a part of
@@ -146,13 +163,22 @@ impl World {
         };
     }
 
-    /// The broad phase rebuilt at the current positions and walls, as the `rebuilds`-th build (a whole
-    /// world reassembled from parts cut at its last build, whose list each part built for itself).
-    pub fn rebuild_broad_phase_as(&mut self, rebuilds: u64) {
-        let centres: Vec<Point> = self.bodies.iter().map(|b| b.position).collect();
+    /// The broad phase rebuilt at `centres` (one per body) and `walls`, as the `rebuilds`-th build (a whole
+    /// world reassembled from parts cut at its last build, whose list each part built for itself at those
+    /// centres and walls).
+    pub fn rebuild_broad_phase_at(&mut self, centres: &[Point], walls: &[Wall], rebuilds: u64) {
+        debug_assert_eq!(centres.len(), self.bodies.len());
         self.broad_phase
-            .rebuild_with_walls(&centres, &self.radii, &self.walls);
+            .rebuild_with_walls(centres, &self.radii, walls);
         self.broad_phase.set_rebuilds(rebuilds);
+    }
+
+    /// The broad phase without the pairs of two bodies not `owned` here, nor the wall pairs of such a
+    /// body: a part of a world split over processes need not evaluate them, since the bodies' states and
+    /// loads are overwritten by their owners' after each step ([`BroadPhase::keep_pairs_of`]).
+    pub fn keep_pairs_of_owned(&mut self, owned: &[bool]) {
+        debug_assert_eq!(owned.len(), self.bodies.len());
+        self.broad_phase.keep_pairs_of(|i| owned[i as usize]);
     }
 
     /// The broad phase replaced by `broad_phase` (of the same bodies).

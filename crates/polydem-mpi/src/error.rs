@@ -35,6 +35,12 @@ pub enum DistributedError {
         /// The step's error.
         source: polydem::world::StepError,
     },
+    /// A body's centre lies in no subdomain (it is not finite).
+    #[error("body {body} has a centre that is not finite: it belongs to no subdomain")]
+    NotFinite {
+        /// The body's global index.
+        body: usize,
+    },
     /// A message could not be decoded.
     #[error("message from rank {rank} could not be decoded: {message}")]
     Decode {

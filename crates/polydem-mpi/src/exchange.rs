@@ -98,6 +98,37 @@ pub fn all_to_all(
     recv
 }
 
+/// Sends the bytes `blocks[q]` to every rank q and returns what each rank sent here, in rank order (one
+/// all-to-all of the counts, then one of the bytes; an empty block is no message in `traffic`).
+pub fn all_to_all_bytes(
+    comm: &SimpleCommunicator,
+    blocks: &[Vec<u8>],
+    traffic: &mut Traffic,
+) -> Vec<Vec<u8>> {
+    let counts: Vec<Count> = blocks.iter().map(|b| b.len() as Count).collect();
+    let mut recv_counts = vec![0 as Count; blocks.len()];
+    comm.all_to_all_into(&counts[..], &mut recv_counts[..]);
+    let send: Vec<u8> = blocks.concat();
+    let mut recv = vec![0u8; recv_counts.iter().map(|&c| c as usize).sum()];
+    let (send_displs, recv_displs) = (displacements(&counts), displacements(&recv_counts));
+    comm.all_to_all_varcount_into(
+        &Partition::new(&send[..], counts.clone(), send_displs),
+        &mut PartitionMut::new(&mut recv[..], recv_counts.clone(), recv_displs.clone()),
+    );
+    let me = comm.rank() as usize;
+    for (q, block) in blocks.iter().enumerate() {
+        if q != me && !block.is_empty() {
+            traffic.bytes += block.len() as u64;
+            traffic.messages += 1;
+        }
+    }
+    let block = |q: usize| {
+        let start = recv_displs[q] as usize;
+        recv[start..start + recv_counts[q] as usize].to_vec()
+    };
+    (0..blocks.len()).map(block).collect()
+}
+
 /// Gathers `value` from every rank, in rank order.
 pub fn all_gather<T: Serialize + DeserializeOwned>(
     comm: &SimpleCommunicator,

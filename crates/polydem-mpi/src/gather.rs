@@ -10,8 +10,7 @@
 //! them when asked, with the build count the parts kept in step (a restored world's list is held as
 //! restored until its first rebuild).
 
-use polydem::math::Real;
-use polydem::world::broad_phase::BroadPhase;
+use polydem::math::{Point, Real};
 use polydem::world::{EnergyShare, World};
 
 use crate::error::DistributedError;
@@ -37,7 +36,19 @@ impl DistributedRun {
         let entries = if contacts { entries } else { Vec::new() };
         let (ids, states) = owned_states(&self.part);
         let share = self.part.world.energy_share();
-        let mine = (ids, states, touching_walls, entries, share);
+        // The whole list is rebuilt on rank 0 from the positions of the last cut (once per cut).
+        let rebuild_list = contacts && !self.whole_list_held;
+        let at_cut: Vec<Real> = match rebuild_list {
+            true => self
+                .part
+                .at_cut
+                .iter()
+                .flat_map(|x| x.coords.iter().copied())
+                .collect(),
+            false => Vec::new(),
+        };
+        self.whole_list_held |= contacts;
+        let mine = (ids, states, touching_walls, entries, share, at_cut);
         let traffic = &mut self.traffic;
         let all = gather_to_root(
             &self.comm,
@@ -51,11 +62,15 @@ impl DistributedRun {
         world.copy_walls_and_clock(&self.part.world);
         let (mut store, mut walls) = (Vec::new(), Vec::new());
         let mut total = EnergyShare::default();
-        for (ids, states, touching_walls, entries, share) in all {
+        let mut centres = vec![Point::origin(); world.body_count()];
+        for (ids, states, touching_walls, entries, share, at_cut) in all {
             total.add(&share);
             for (&gid, w) in ids.iter().zip(states.chunks_exact(GHOST_WORDS)) {
                 let (body, force, torque) = unpack_ghost(&world.bodies()[gid as usize], w);
                 world.copy_body_from_owner(gid as usize, &body, &force, &torque);
+            }
+            for (&gid, x) in ids.iter().zip(at_cut.chunks_exact(3)) {
+                centres[gid as usize] = Point::new(x[0], x[1], x[2]);
             }
             walls.extend(touching_walls);
             store.extend(entries);
@@ -67,19 +82,14 @@ impl DistributedRun {
             store.sort_by_key(|entry| entry.0);
             let touched = self.part.world.contacts().last_touched();
             world.replace_contacts(store, touched);
-            world.set_broad_phase(self.whole_list().clone());
+            if rebuild_list {
+                let rebuilds = self.part.world.broad_phase().rebuilds();
+                let walls = &self.part.walls_at_cut;
+                self.whole.rebuild_broad_phase_at(&centres, walls, rebuilds);
+            }
+            world.set_broad_phase(self.whole.broad_phase().clone());
         }
         Ok(())
-    }
-
-    /// The whole world's broad phase as one process holds it now.
-    fn whole_list(&mut self) -> &BroadPhase {
-        if !self.whole_list_held {
-            let rebuilds = self.part.world.broad_phase().rebuilds();
-            self.whole.rebuild_broad_phase_as(rebuilds);
-            self.whole_list_held = true;
-        }
-        self.whole.broad_phase()
     }
 }
 

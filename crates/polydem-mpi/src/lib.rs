@@ -80,6 +80,8 @@ pub mod exchange;
 #[cfg(feature = "mpi")]
 pub mod gather;
 #[cfg(feature = "mpi")]
+mod migrate;
+#[cfg(feature = "mpi")]
 pub mod observed;
 #[cfg(feature = "mpi")]
 pub mod pieces;

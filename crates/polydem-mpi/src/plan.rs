@@ -27,6 +27,8 @@ pub struct Plan {
     pub decomposition: Decomposition,
     /// Global indices of the bodies of each rank's part (owned and ghosts), increasing.
     pub parts: Vec<Vec<usize>>,
+    /// The width (m) of the ghost layer around each subdomain ([`ghost_width`]).
+    pub ghost_width: Real,
 }
 
 impl Plan {
@@ -55,6 +57,7 @@ impl Plan {
         Ok(Self {
             decomposition,
             parts,
+            ghost_width: width,
         })
     }
 

@@ -14,10 +14,11 @@ use polydem::dynamics::RigidBody;
 use polydem::math::{Point, Real, Vector};
 use polydem::world::{
     step, ContactKey, ContactState, EnergyShare, PartBroadPhase, StepParams, StepReport,
-    StepScratch, TimeStepCheck, World,
+    StepScratch, TimeStepCheck, Wall, World,
 };
 
 use crate::consensus::Consensus;
+use crate::decomposition::Region;
 use crate::error::DistributedError;
 use crate::exchange::{all_gather, all_to_all, pack_ghost, unpack_ghost, RunTraffic, GHOST_WORDS};
 use crate::plan::{Plan, MOVE_ALLOWANCE_IN_SKINS};
@@ -38,6 +39,47 @@ pub(crate) struct Part {
     pub(crate) consensus: Arc<Consensus>,
     /// Positions of the owned bodies at the cut.
     pub(crate) at_cut: Vec<Point>,
+    /// The walls at the cut (the whole world's list is built at them and at the bodies' `at_cut`).
+    pub(crate) walls_at_cut: Vec<Wall>,
+    /// Every rank's subdomain, as of the last bisection (kept by the migrations since).
+    pub(crate) regions: Vec<Region>,
+    /// The width (m) of the ghost layer around each subdomain.
+    pub(crate) ghost_width: Real,
+}
+
+impl Part {
+    /// The part holding the bodies `ids` (renumbered in `world`), of which `owned` are this rank's, with
+    /// the ghost lists, the subdomains it was cut by, and the owned bodies' positions at the cut.
+    #[allow(clippy::too_many_arguments)]
+    pub(crate) fn new(
+        mut world: World,
+        ids: Vec<usize>,
+        owned: Vec<bool>,
+        sends: Vec<Vec<usize>>,
+        receives: Vec<Vec<usize>>,
+        regions: Vec<Region>,
+        ghost_width: Real,
+        at_cut: Vec<Point>,
+    ) -> Self {
+        let consensus = Arc::new(Consensus::new(owned.clone()));
+        let mut scratch = StepScratch::default();
+        scratch.set_rebuild_consensus(Some(consensus.clone()));
+        world.count_only(owned.clone());
+        let walls_at_cut = world.walls().to_vec();
+        Self {
+            world,
+            scratch,
+            ids,
+            owned,
+            sends,
+            receives,
+            consensus,
+            at_cut,
+            walls_at_cut,
+            regions,
+            ghost_width,
+        }
+    }
 }
 
 /// A world stepped on every rank of `MPI_COMM_WORLD`.
@@ -52,10 +94,21 @@ pub struct DistributedRun {
     pub(crate) traffic: RunTraffic,
     /// Cuts so far (the first included).
     pub cuts: u64,
+    /// Cuts so far that bisected the whole world (the first included); the others migrated bodies.
+    pub bisections: u64,
+    /// Migrations so far whose part took its list over from the old part (the others built it again).
+    pub lists_carried: u64,
     /// Whether `whole`'s broad phase is the whole world's list (a restored world until its first rebuild);
-    /// else the list is the one built at `whole`'s positions and walls (those of the last cut).
+    /// else the list is the one built at the positions and walls of the last cut.
     pub(crate) whole_list_held: bool,
+    /// Above which imbalance (the largest owned count over the mean) a cut bisects the whole world again
+    /// instead of migrating bodies between neighbours.
+    pub(crate) rebalance_above: Real,
 }
+
+/// The imbalance above which a cut bisects again by default: a rank with 10 % more bodies than the
+/// mean makes every rank wait about 10 % of a step.
+pub const REBALANCE_ABOVE: Real = 1.1;
 
 impl DistributedRun {
     /// Splits `world` over the ranks: a fresh one (its loads not yet evaluated, as a scene builds it) or
@@ -106,8 +159,17 @@ impl DistributedRun {
             part,
             traffic: RunTraffic::default(),
             cuts: 1,
+            bisections: 1,
+            lists_carried: 0,
             whole_list_held: restored,
+            rebalance_above: REBALANCE_ABOVE,
         })
+    }
+
+    /// Sets the imbalance (largest owned count over the mean) above which a cut bisects the whole world
+    /// again ([`REBALANCE_ABOVE`] by default); at most 1, every cut bisects. The bits do not depend on it.
+    pub fn set_rebalance_above(&mut self, imbalance: Real) {
+        self.rebalance_above = imbalance;
     }
 
     /// This rank.
@@ -158,7 +220,11 @@ impl DistributedRun {
         })?;
         if part.consensus.last_rebuilt() {
             self.check_moves()?;
-            self.recut()?;
+            if self.rebalance_due() {
+                self.recut()?;
+            } else {
+                self.migrate()?;
+            }
         } else {
             self.exchange_ghosts();
         }
@@ -232,8 +298,18 @@ impl DistributedRun {
         Ok(())
     }
 
-    /// Gathers the whole state and cuts new parts from it (after a rebuild: the parts' lists are built at
-    /// these positions, as one process's is).
+    /// Whether the owned counts are too uneven to migrate again (every rank answers alike).
+    fn rebalance_due(&self) -> bool {
+        let owned = self.part.owned.iter().filter(|&&o| o).count() as Real;
+        let mut largest = 0.0;
+        self.comm
+            .all_reduce_into(&owned, &mut largest, SystemOperation::max());
+        let mean = self.whole.body_count() as Real / self.comm.size() as Real;
+        largest > self.rebalance_above * mean
+    }
+
+    /// Gathers the whole state and cuts new parts from it by a new bisection (after a rebuild: the parts'
+    /// lists are built at these positions, as one process's is).
     fn recut(&mut self) -> Result<(), DistributedError> {
         let mine = (owned_bodies(&self.part), authoritative_contacts(&self.part));
         let all = all_gather(&self.comm, &mine, &mut self.traffic.cuts)?;
@@ -258,6 +334,7 @@ impl DistributedRun {
         self.part.world.replace_ledger(ledger);
         self.whole_list_held = false;
         self.cuts += 1;
+        self.bisections += 1;
         Ok(())
     }
 }
@@ -337,25 +414,21 @@ fn cut(
         .iter()
         .map(|&i| plan.decomposition.owner[i] as usize == rank)
         .collect();
-    let consensus = Arc::new(Consensus::new(owned.clone()));
-    let mut scratch = StepScratch::default();
-    scratch.set_rebuild_consensus(Some(consensus.clone()));
     let mut world = whole.part(&ids, broad_phase);
-    world.count_only(owned.clone());
-    let at_cut = (0..ids.len())
-        .filter(|&i| owned[i])
-        .map(|i| centres[ids[i]])
-        .collect();
-    Ok(Part {
+    world.keep_pairs_of_owned(&owned);
+    let (sends, receives) = (to_local(plan.sends(rank)), to_local(plan.receives(rank)));
+    let at_cut = (0..ids.len()).filter(|&i| owned[i]);
+    let at_cut = at_cut.map(|i| centres[ids[i]]).collect();
+    Ok(Part::new(
         world,
-        scratch,
-        sends: to_local(plan.sends(rank)),
-        receives: to_local(plan.receives(rank)),
         ids,
         owned,
-        consensus,
+        sends,
+        receives,
+        plan.decomposition.regions,
+        plan.ghost_width,
         at_cut,
-    })
+    ))
 }
 
 /// What a caller reads of the whole run between steps: one body's facts from its owner, the whole world.

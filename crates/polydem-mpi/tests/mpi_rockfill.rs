@@ -135,13 +135,14 @@ fn child(expected: &Path) {
     let facts = report.ranks.expect("a distributed run reports its ranks");
     let per_step = |bytes: u64| bytes as f64 / STEPS as f64;
     println!(
-        "rank {}/{}: {:.1} owned, {:.1} ghosts on average, {} cuts, {} projectile owner changes, {elapsed:.2} s; \
+        "rank {}/{}: {:.1} owned, {:.1} ghosts on average, {} cuts ({} bisections), {} projectile owner changes, {elapsed:.2} s; \
          sent per step: ghosts {:.0} B, agreements {:.0} B, cuts {:.0} B, gathers {:.0} B",
         facts.rank,
         facts.ranks,
         facts.mean_owned,
         facts.mean_ghosts,
         facts.cuts,
+        facts.bisections,
         facts.projectile_owner_changes,
         per_step(facts.ghost_bytes),
         per_step(facts.agreement_bytes),

@@ -89,6 +89,7 @@ impl DistributedStepper {
             rank: self.run.rank(),
             ranks: SimpleCommunicator::world().size() as usize,
             cuts: self.run.cuts,
+            bisections: self.run.bisections,
             mean_owned: mean(owned),
             mean_ghosts: mean(ghosts),
             ghost_bytes: traffic.ghosts.bytes,

@@ -48,6 +48,9 @@ pub struct RankFacts {
     pub ranks: usize,
     /// Times the subdomains were cut (the first included; one per broad-phase rebuild after it).
     pub cuts: u64,
+    /// Of those, the cuts that bisected the whole world again (the others migrated bodies between
+    /// neighbours).
+    pub bisections: u64,
     /// Bodies this rank owned and held as ghosts, averaged over the steps.
     pub mean_owned: Real,
     pub mean_ghosts: Real,

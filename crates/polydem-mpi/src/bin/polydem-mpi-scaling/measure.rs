@@ -29,6 +29,9 @@ pub struct Spec {
     pub lattice: Lattice,
     pub steps: u64,
     pub csv: PathBuf,
+    /// The imbalance above which a cut bisects again ([`polydem_mpi::run::REBALANCE_ABOVE`] unless
+    /// `--rebalance-above` says; 0: every cut bisects).
+    pub rebalance_above: f64,
 }
 
 /// The seed of every scene's velocities: repeats of a configuration are the same run.
@@ -47,6 +50,10 @@ impl Spec {
             },
             steps: args.number("steps")?,
             csv: PathBuf::from(args.text("csv")?),
+            rebalance_above: match args.0.contains_key("rebalance-above") {
+                true => args.number("rebalance-above")?,
+                false => polydem_mpi::run::REBALANCE_ABOVE,
+            },
         })
     }
 }
@@ -137,6 +144,7 @@ pub fn measure(spec: &Spec) -> Result<(), Error> {
     let width = ghost_width(r_max, sim.world.broad_phase().skin()) / spec.scene.spacing();
     let bodies = sim.world.body_count();
     let mut run = DistributedRun::new(sim.world, sim.params).unwrap_or_else(|e| abort(&comm, e));
+    run.set_rebalance_above(spec.rebalance_above);
     let (owned, ghosts) = run.part_size();
     let t = step_all(&mut run, spec.steps, &comm);
     let traffic = run.traffic();

@@ -1,0 +1,224 @@
+//! A cut by migration: after a rebuild, each rank sends each body it owns to the ranks that hold it next
+//! (its new owner, the rank whose subdomain holds its centre, and the ranks whose ghost layer it lies in),
+//! and each contact entry it answers for to the ranks that receive the entry's lower body. The subdomains
+//! stay those of the last bisection, so a rank exchanges with its neighbours only and no rank holds the
+//! whole state. The parts are the ones a bisection with these subdomains would cut, so the bits are too.
+
+use polydem::math::{Point, Real};
+use polydem::world::{ContactKey, ContactState, PartBroadPhase, World};
+use serde::{Deserialize, Serialize};
+
+use crate::decomposition::Region;
+use crate::error::DistributedError;
+use crate::exchange::{all_to_all_bytes, pack_ghost, unpack_ghost, GHOST_WORDS};
+use crate::plan::MOVE_ALLOWANCE_IN_SKINS;
+use crate::run::{DistributedRun, Part};
+
+/// The most bodies new to a rank for which its part's list is carried over rather than built again: each
+/// costs a test against every body of the part, a build about 3000 instructions per body.
+const MAX_NEWCOMERS_CARRIED: usize = 128;
+
+/// What one rank sends another at a migration.
+#[derive(Clone, Default, Serialize, Deserialize)]
+struct Migrants {
+    /// Global indices of the bodies, increasing.
+    ids: Vec<u32>,
+    /// Their states and loads, [`GHOST_WORDS`] numbers each.
+    states: Vec<Real>,
+    /// The contact entries (global keys) whose lower body is among `ids`.
+    entries: Vec<(ContactKey, ContactState)>,
+}
+
+/// The rank whose subdomain holds `x` (the lower rank on a boundary).
+fn owner_of(regions: &[Region], x: &Point, gid: usize) -> Result<usize, DistributedError> {
+    let inside = regions.iter().position(|r| r.distance(x) == 0.0);
+    inside.ok_or(DistributedError::NotFinite { body: gid })
+}
+
+/// The gap (m) between two boxes (0 where they touch or overlap).
+fn gap(a: &Region, b: &Region) -> Real {
+    let mut sq = 0.0;
+    for axis in 0..3 {
+        let g = (a.min[axis] - b.max[axis])
+            .max(b.min[axis] - a.max[axis])
+            .max(0.0);
+        sq += g * g;
+    }
+    sq.sqrt()
+}
+
+impl DistributedRun {
+    /// Cuts new parts by migration (after a rebuild and the check of the moves since the last cut).
+    pub(crate) fn migrate(&mut self) -> Result<(), DistributedError> {
+        let mut outgoing = self.outgoing()?;
+        let mut mine = Some(std::mem::take(&mut outgoing[self.rank]));
+        let blocks: Vec<Vec<u8>> = outgoing
+            .iter()
+            .map(|m| match m.ids.is_empty() {
+                true => Vec::new(),
+                false => postcard::to_allocvec(m).expect("encoding to memory does not fail"),
+            })
+            .collect();
+        let received = all_to_all_bytes(&self.comm, &blocks, &mut self.traffic.cuts);
+        let mut all = Vec::with_capacity(received.len());
+        for (q, bytes) in received.iter().enumerate() {
+            let migrants = match (q == self.rank, bytes.is_empty()) {
+                (true, _) => mine.take().expect("this rank's own share is taken once"),
+                (false, true) => Migrants::default(),
+                (false, false) => {
+                    postcard::from_bytes(bytes).map_err(|e| DistributedError::Decode {
+                        rank: q,
+                        message: e.to_string(),
+                    })?
+                }
+            };
+            all.push(migrants);
+        }
+        self.traffic.agreements += self.part.consensus.traffic();
+        let ledger = *self.part.world.ledger();
+        self.part = self.assemble(all)?;
+        self.part.world.replace_ledger(ledger);
+        self.whole_list_held = false;
+        self.cuts += 1;
+        Ok(())
+    }
+
+    /// What this rank sends each rank (its own entry included, not sent).
+    fn outgoing(&self) -> Result<Vec<Migrants>, DistributedError> {
+        let part = &self.part;
+        let (regions, width) = (&part.regions, part.ghost_width);
+        let allowance = MOVE_ALLOWANCE_IN_SKINS * self.whole.broad_phase().skin();
+        // A body owned here lies within the allowance of this subdomain, so only these ranks can hold it.
+        let near: Vec<usize> = (0..regions.len())
+            .filter(|&q| gap(&regions[q], &regions[self.rank]) <= width + 2.0 * allowance)
+            .collect();
+        let (bodies, loads) = (part.world.bodies(), part.world.loads());
+        let mut out = vec![Migrants::default(); regions.len()];
+        let mut destinations = vec![Vec::new(); part.ids.len()];
+        for i in (0..part.ids.len()).filter(|&i| part.owned[i]) {
+            let (gid, x) = (part.ids[i], &bodies[i].position);
+            let owner = owner_of(regions, x, gid)?;
+            for &q in &near {
+                if q == owner || regions[q].distance(x) < width {
+                    out[q].ids.push(gid as u32);
+                    let (force, torque) = (&loads.forces()[i], &loads.torques()[i]);
+                    pack_ghost(&bodies[i], force, torque, &mut out[q].states);
+                    destinations[i].push(q);
+                }
+            }
+            if !destinations[i].contains(&owner) {
+                return Err(DistributedError::HaloExceeded {
+                    moved: regions[self.rank].distance(x),
+                    allowance,
+                });
+            }
+        }
+        let store = part.world.contacts();
+        let global = |i: u32| part.ids[i as usize] as u32;
+        for (key, state) in store.keys().iter().zip(store.states()) {
+            let (lower, key) = match *key {
+                ContactKey::Body { a, b } => (
+                    a,
+                    ContactKey::Body {
+                        a: global(a),
+                        b: global(b),
+                    },
+                ),
+                ContactKey::Wall { body, wall } => (
+                    body,
+                    ContactKey::Wall {
+                        body: global(body),
+                        wall,
+                    },
+                ),
+            };
+            for &q in &destinations[lower as usize] {
+                out[q].entries.push((key, *state));
+            }
+        }
+        Ok(out)
+    }
+
+    /// The new part `world` (of global bodies `ids`) with the list one process built in this step: the
+    /// old part's, built at the same centres, carried over when few bodies are new to this rank (each is
+    /// tested against every body), else built again.
+    fn carry_list_over(&mut self, mut world: World, ids: &[usize]) -> World {
+        let old = &self.part;
+        let old_of_new: Vec<Option<u32>> = ids
+            .iter()
+            .map(|gid| old.ids.binary_search(gid).ok().map(|k| k as u32))
+            .collect();
+        let newcomers = old_of_new.iter().filter(|o| o.is_none()).count();
+        let centres: Vec<Point> = world.bodies().iter().map(|b| b.position).collect();
+        let rebuilds = old.world.broad_phase().rebuilds();
+        if newcomers <= MAX_NEWCOMERS_CARRIED {
+            let list = old.world.broad_phase();
+            let list = list.carried_over(&old_of_new, &centres, world.radii(), world.walls());
+            world.set_broad_phase(list);
+            self.lists_carried += 1;
+        } else {
+            let walls = world.walls().to_vec();
+            world.rebuild_broad_phase_at(&centres, &walls, rebuilds);
+        }
+        world
+    }
+
+    /// This rank's new part from what every rank sent it (in rank order).
+    fn assemble(&mut self, all: Vec<Migrants>) -> Result<Part, DistributedError> {
+        let mut arrivals: Vec<(usize, &[Real])> = all
+            .iter()
+            .flat_map(|m| {
+                let ids = m.ids.iter().map(|&gid| gid as usize);
+                ids.zip(m.states.chunks_exact(GHOST_WORDS))
+            })
+            .collect();
+        // Each rank's bodies and entries come in increasing order: a stable sort merges the runs.
+        arrivals.sort_by_key(|(gid, _)| *gid);
+        // The whole world is the template of the part (shapes, materials, names); its bodies are written
+        // only where this rank holds them.
+        self.whole.copy_walls_and_clock(&self.part.world);
+        for &(gid, w) in &arrivals {
+            let (body, force, torque) = unpack_ghost(&self.whole.bodies()[gid], w);
+            self.whole.copy_body_from_owner(gid, &body, &force, &torque);
+        }
+        let ids: Vec<usize> = arrivals.iter().map(|(gid, _)| *gid).collect();
+        let mut entries: Vec<(ContactKey, ContactState)> =
+            all.into_iter().flat_map(|m| m.entries).collect();
+        entries.sort_by_key(|entry| entry.0);
+        let touched = self.part.world.contacts().last_touched();
+        let world = self
+            .whole
+            .part_with_contacts(&ids, entries, touched, PartBroadPhase::Unbuilt);
+        let (regions, width) = (self.part.regions.clone(), self.part.ghost_width);
+        let positions: Vec<Point> = world.bodies().iter().map(|b| b.position).collect();
+        let mut owners = Vec::with_capacity(ids.len());
+        for (x, &gid) in positions.iter().zip(&ids) {
+            owners.push(owner_of(&regions, x, gid)?);
+        }
+        let me = self.rank;
+        let owned: Vec<bool> = owners.iter().map(|&o| o == me).collect();
+        let mut world = self.carry_list_over(world, &ids);
+        world.keep_pairs_of_owned(&owned);
+        let receives = (0..regions.len())
+            .map(|q| {
+                (0..ids.len())
+                    .filter(|&i| q != me && owners[i] == q)
+                    .collect()
+            })
+            .collect();
+        let sends = (0..regions.len())
+            .map(|q| {
+                let held =
+                    |i: &usize| q != me && owned[*i] && regions[q].distance(&positions[*i]) < width;
+                (0..ids.len()).filter(held).collect()
+            })
+            .collect();
+        let at_cut = (0..ids.len())
+            .filter(|&i| owned[i])
+            .map(|i| positions[i])
+            .collect();
+        Ok(Part::new(
+            world, ids, owned, sends, receives, regions, width, at_cut,
+        ))
+    }
+}
