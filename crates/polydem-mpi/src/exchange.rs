@@ -98,35 +98,36 @@ pub fn all_to_all(
     recv
 }
 
-/// Sends the bytes `blocks[q]` to every rank q and returns what each rank sent here, in rank order (one
-/// all-to-all of the counts, then one of the bytes; an empty block is no message in `traffic`).
-pub fn all_to_all_bytes(
+/// The tag of the messages of a migration (the only point-to-point messages of a run).
+const MIGRATION_TAG: mpi::Tag = 17;
+
+/// Sends the bytes `blocks[q]` to each rank q of `near` other than this one, and returns what each of them
+/// sent here (empty for the other ranks), in rank order: one message each way per pair of near ranks, an
+/// empty one included, so no count travels. `near` must be symmetric (q is near p where p is near q).
+pub fn exchange_with_near(
     comm: &SimpleCommunicator,
+    near: &[usize],
     blocks: &[Vec<u8>],
     traffic: &mut Traffic,
 ) -> Vec<Vec<u8>> {
-    let counts: Vec<Count> = blocks.iter().map(|b| b.len() as Count).collect();
-    let mut recv_counts = vec![0 as Count; blocks.len()];
-    comm.all_to_all_into(&counts[..], &mut recv_counts[..]);
-    let send: Vec<u8> = blocks.concat();
-    let mut recv = vec![0u8; recv_counts.iter().map(|&c| c as usize).sum()];
-    let (send_displs, recv_displs) = (displacements(&counts), displacements(&recv_counts));
-    comm.all_to_all_varcount_into(
-        &Partition::new(&send[..], counts.clone(), send_displs),
-        &mut PartitionMut::new(&mut recv[..], recv_counts.clone(), recv_displs.clone()),
-    );
     let me = comm.rank() as usize;
-    for (q, block) in blocks.iter().enumerate() {
-        if q != me && !block.is_empty() {
-            traffic.bytes += block.len() as u64;
+    let others: Vec<usize> = near.iter().copied().filter(|&q| q != me).collect();
+    let mut received = vec![Vec::new(); blocks.len()];
+    mpi::request::multiple_scope(others.len(), |scope, sends| {
+        for &q in &others {
+            let to = comm.process_at_rank(q as i32);
+            sends.add(to.immediate_send_with_tag(scope, &blocks[q][..], MIGRATION_TAG));
+            traffic.bytes += blocks[q].len() as u64;
             traffic.messages += 1;
         }
-    }
-    let block = |q: usize| {
-        let start = recv_displs[q] as usize;
-        recv[start..start + recv_counts[q] as usize].to_vec()
-    };
-    (0..blocks.len()).map(block).collect()
+        for &q in &others {
+            let from = comm.process_at_rank(q as i32);
+            received[q] = from.receive_vec_with_tag::<u8>(MIGRATION_TAG).0;
+        }
+        let mut done = Vec::new();
+        sends.wait_all(&mut done);
+    });
+    received
 }
 
 /// Gathers `value` from every rank, in rank order.

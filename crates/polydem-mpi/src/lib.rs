@@ -6,7 +6,9 @@
 //!   world down to some bodies, [`World::copy_body_from_owner`](polydem::world::World::copy_body_from_owner)
 //!   writes a ghost's state and loads, and a [`RebuildConsensus`](polydem::world::RebuildConsensus) set on
 //!   the step's scratch takes the broad-phase rebuild decision. A run without MPI takes none of them.
-//! - **Subdomains** ([`decomposition`]): recursive coordinate bisection balanced by body count.
+//! - **Subdomains** ([`decomposition`]): recursive coordinate bisection balanced by body count, at the
+//!   start and again when the owned counts drift apart by more than [`run::REBALANCE_ABOVE`]; in between
+//!   the subdomains stay and bodies migrate.
 //! - **Parts** ([`plan`]): a rank steps the bodies it owns and ghosts within the reach of a candidate pair
 //!   plus twice the move a body may make between rebuilds, numbered in global order. The engine sums a
 //!   body's forces over its pairs in key order (lower partners by increasing index, higher ones, walls) and
@@ -15,8 +17,11 @@
 //!   states and loads: the next step's first kick and drift of a ghost then repeat its owner's exactly, so
 //!   every pair with an owned body is evaluated on the state one process has. Walls are on every rank.
 //! - **Rebuilds** are agreed ([`consensus`]): the two largest moves of the whole world decide, as in one
-//!   process. After a rebuild the parts are cut again (migration) with the contact entries (tangential
-//!   springs, solver caches) taken from the rank that owns the pair's lower body.
+//!   process. After a rebuild the parts are cut again by migration (`migrate`): each owner sends its
+//!   bodies to the near ranks that hold them next (the owner of the subdomain the centre lies in, the
+//!   ranks whose ghost layer it lies in), with the contact entries it answers for (tangential springs,
+//!   solver caches), one message each way between near ranks. A part takes over the list its step just
+//!   built where few bodies are new to it, and drops the pairs of two ghosts (they only move ghosts).
 //!
 //! - **Restarts** ([`DistributedRun::new`]): a world restored from a checkpoint (written by any number of
 //!   ranks: the format is one) is cut at the centres its broad phase was built at, as if the cut had
@@ -58,9 +63,11 @@
 //!
 //! # Limits of this stage
 //! - Sleeping is refused ([`DistributedError::Sleeping`]); the time-step check does not run on the parts.
-//! - A cut gathers the whole state on every rank (O(N) memory and traffic per rebuild); an output step
-//!   gathers the owned bodies on rank 0 (O(N) there); the per-step ghost exchange is point to point in
-//!   content (one all-to-all).
+//! - Every rank keeps the whole world's fixed data (shapes, names, radii, materials) for the bodies that
+//!   migrate to it: O(N) memory. A re-bisection gathers the whole state on every rank (O(N) traffic); an
+//!   output step gathers the owned bodies on rank 0 (O(N) there). The per-step ghost exchange is point
+//!   to point in content but one all-to-all, and the rebuild agreement an all-gather of four numbers per
+//!   rank: both cost O(P) in MPI's own work.
 //! - A rank whose step or output fails returns the error; the caller aborts the communicator
 //!   (`polydem run` prints `rank R: error: …` and does), else the others wait in the next collective.
 //! - Subdomains by recursive bisection of the body centres never leave a rank without a body (P larger

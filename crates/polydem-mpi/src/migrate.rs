@@ -10,7 +10,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::decomposition::Region;
 use crate::error::DistributedError;
-use crate::exchange::{all_to_all_bytes, pack_ghost, unpack_ghost, GHOST_WORDS};
+use crate::exchange::{exchange_with_near, pack_ghost, unpack_ghost, GHOST_WORDS};
 use crate::plan::MOVE_ALLOWANCE_IN_SKINS;
 use crate::run::{DistributedRun, Part};
 
@@ -50,7 +50,8 @@ fn gap(a: &Region, b: &Region) -> Real {
 impl DistributedRun {
     /// Cuts new parts by migration (after a rebuild and the check of the moves since the last cut).
     pub(crate) fn migrate(&mut self) -> Result<(), DistributedError> {
-        let mut outgoing = self.outgoing()?;
+        let near = self.near();
+        let mut outgoing = self.outgoing(&near)?;
         let mut mine = Some(std::mem::take(&mut outgoing[self.rank]));
         let blocks: Vec<Vec<u8>> = outgoing
             .iter()
@@ -59,7 +60,7 @@ impl DistributedRun {
                 false => postcard::to_allocvec(m).expect("encoding to memory does not fail"),
             })
             .collect();
-        let received = all_to_all_bytes(&self.comm, &blocks, &mut self.traffic.cuts);
+        let received = exchange_with_near(&self.comm, &near, &blocks, &mut self.traffic.cuts);
         let mut all = Vec::with_capacity(received.len());
         for (q, bytes) in received.iter().enumerate() {
             let migrants = match (q == self.rank, bytes.is_empty()) {
@@ -83,22 +84,28 @@ impl DistributedRun {
         Ok(())
     }
 
+    /// The ranks that can hold a body this rank owns (itself included): those whose subdomain lies within
+    /// the ghost layer plus twice the allowance of this one (a body owned here moved at most the allowance
+    /// from this subdomain). The relation is symmetric, so each rank of a pair sends the other a message.
+    fn near(&self) -> Vec<usize> {
+        let (regions, width) = (&self.part.regions, self.part.ghost_width);
+        let allowance = MOVE_ALLOWANCE_IN_SKINS * self.whole.broad_phase().skin();
+        let within = |q: &usize| gap(&regions[*q], &regions[self.rank]) <= width + 2.0 * allowance;
+        (0..regions.len()).filter(within).collect()
+    }
+
     /// What this rank sends each rank (its own entry included, not sent).
-    fn outgoing(&self) -> Result<Vec<Migrants>, DistributedError> {
+    fn outgoing(&self, near: &[usize]) -> Result<Vec<Migrants>, DistributedError> {
         let part = &self.part;
         let (regions, width) = (&part.regions, part.ghost_width);
         let allowance = MOVE_ALLOWANCE_IN_SKINS * self.whole.broad_phase().skin();
-        // A body owned here lies within the allowance of this subdomain, so only these ranks can hold it.
-        let near: Vec<usize> = (0..regions.len())
-            .filter(|&q| gap(&regions[q], &regions[self.rank]) <= width + 2.0 * allowance)
-            .collect();
         let (bodies, loads) = (part.world.bodies(), part.world.loads());
         let mut out = vec![Migrants::default(); regions.len()];
         let mut destinations = vec![Vec::new(); part.ids.len()];
         for i in (0..part.ids.len()).filter(|&i| part.owned[i]) {
             let (gid, x) = (part.ids[i], &bodies[i].position);
             let owner = owner_of(regions, x, gid)?;
-            for &q in &near {
+            for &q in near {
                 if q == owner || regions[q].distance(x) < width {
                     out[q].ids.push(gid as u32);
                     let (force, torque) = (&loads.forces()[i], &loads.torques()[i]);

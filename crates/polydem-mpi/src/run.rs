@@ -1,9 +1,10 @@
 //! A run of one world split over the ranks of `MPI_COMM_WORLD`, the same bits as one process.
 //!
 //! Each step: the part's step (the engine's, with the rebuild decision agreed by every rank), then either
-//! the ghost exchange (each owner sends its ghosts' states and loads) or, after a rebuild, a cut: every
-//! rank gathers the whole state (owned bodies, the contact entries each rank is authoritative for) and cuts
-//! new parts from it.
+//! the ghost exchange (each owner sends its ghosts' states and loads) or, after a rebuild, a cut. A cut
+//! migrates bodies between near ranks within the subdomains of the last bisection ([`crate::migrate`]);
+//! when the owned counts have drifted apart (above [`REBALANCE_ABOVE`]) every rank instead gathers the
+//! whole state (owned bodies, the contact entries each rank is authoritative for) and bisects it again.
 
 use std::sync::Arc;
 

@@ -54,8 +54,9 @@ pub struct RankFacts {
     /// Bodies this rank owned and held as ghosts, averaged over the steps.
     pub mean_owned: Real,
     pub mean_ghosts: Real,
-    /// Bytes this rank sent: ghost states after each step, rebuild agreements, whole states at the cuts,
-    /// and the gathers of the run itself (the projectile's row each step, snapshots, the end state).
+    /// Bytes this rank sent: ghost states after each step, rebuild agreements, bodies and contact entries at
+    /// the cuts, and the gathers of the run itself (the projectile's row each step, snapshots, the end
+    /// state).
     pub ghost_bytes: u64,
     pub agreement_bytes: u64,
     pub cut_bytes: u64,

@@ -211,15 +211,16 @@ fn ranks(s: &mut String, f: &RankFacts, steps: u64) {
     let per_step = |bytes: u64| bytes as f64 / steps.max(1) as f64;
     let _ = writeln!(
         s,
-        "  split over {} MPI ranks (the stage times and counters above are rank {}'s part's, ghosts included; the \
-         ledger is not distributed): {:.1} bodies owned and {:.1} ghosts on average, {} cuts; sent per step: \
-         ghost states {:.0} B, rebuild agreements {:.0} B, whole states at the cuts {:.0} B, the run's gathers \
-         {:.0} B",
+        "  split over {} MPI ranks (the stage times and counters above are rank {}'s part's, ghosts \
+         included): {:.1} bodies owned and {:.1} ghosts on average, {} cuts ({} of them bisections); \
+         sent per step: ghost states {:.0} B, rebuild agreements {:.0} B, bodies and contact entries at \
+         the cuts {:.0} B, the run's gathers {:.0} B",
         f.ranks,
         f.rank,
         f.mean_owned,
         f.mean_ghosts,
         f.cuts,
+        f.bisections,
         per_step(f.ghost_bytes),
         per_step(f.agreement_bytes),
         per_step(f.cut_bytes),

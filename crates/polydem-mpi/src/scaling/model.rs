@@ -11,12 +11,13 @@
 //!   + ⌈log₂P⌉ α + 32 (P − 1) / β                     rebuild agreement: an all-gather of 4 f64 per rank
 //!   + C / k                                         a cut every k steps, costing C:
 //!
-//! - [`Migration::WholeWorld`], what the crate does today: every rank gathers the whole state and cuts it
+//! - [`Migration::Neighbours`], what the crate does: bodies and contact entries move to the near ranks
+//!   only (one message each way), each rank assembles its own part, and two all-reduces check the moves
+//!   and the balance: C = m α + b g / β + 2 ⌈log₂P⌉ α + (t_cut + t_plan)(n + g).
+//! - [`Migration::WholeWorld`], a whole-world cut at every rebuild (the crate's first design, and still
+//!   its re-bisection when the owned counts drift apart): every rank gathers the whole state and cuts it
 //!   again, C = ⌈log₂P⌉ α + b N (P − 1)/P / β + t_cut N + t_plan N P. The last term is the plan: every
 //!   rank computes every rank's part (P regions × N centres).
-//! - [`Migration::Neighbours`], what it must become to scale: bodies and contact entries move only to the
-//!   neighbours, the agreement becomes an all-reduce, and each rank plans its own part:
-//!   C = m α + b g / β + (t_cut + t_plan)(n + g), agreement ⌈log₂P⌉ (α + 32/β).
 
 use crate::scaling::record::RunFigures;
 
@@ -61,9 +62,9 @@ pub struct Calibration {
 /// How bodies change ranks at a cut.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Migration {
-    /// Every rank gathers the whole world (today's code).
+    /// Every rank gathers the whole world at every cut (the first design; today's re-bisection).
     WholeWorld,
-    /// Bodies move to neighbouring ranks only.
+    /// Bodies move to neighbouring ranks only (today's cut).
     Neighbours,
 }
 
@@ -144,20 +145,20 @@ pub fn step_cost_of(
     }
     let (alpha, beta, p) = (net.latency_s, net.bandwidth, ranks as f64);
     let halo = sub.neighbours * alpha + GHOST_BYTES * sub.ghosts / beta;
-    let (agreement, cut) = match migration {
-        Migration::WholeWorld => (
-            rounds(ranks) * alpha + AGREEMENT_BYTES * (p - 1.0) / beta,
+    let agreement = rounds(ranks) * alpha + AGREEMENT_BYTES * (p - 1.0) / beta;
+    let cut = match migration {
+        Migration::WholeWorld => {
             rounds(ranks) * alpha
                 + cal.cut_bytes_per_body * bodies * (p - 1.0) / p / beta
                 + cal.cut_s_per_body * bodies
-                + cal.plan_s_per_body_rank * bodies * p,
-        ),
-        Migration::Neighbours => (
-            rounds(ranks) * net.message(AGREEMENT_BYTES),
+                + cal.plan_s_per_body_rank * bodies * p
+        }
+        Migration::Neighbours => {
             sub.neighbours * alpha
                 + cal.cut_bytes_per_body * sub.ghosts / beta
-                + (cal.cut_s_per_body + cal.plan_s_per_body_rank) * (sub.owned + sub.ghosts),
-        ),
+                + 2.0 * rounds(ranks) * alpha
+                + (cal.cut_s_per_body + cal.plan_s_per_body_rank) * (sub.owned + sub.ghosts)
+        }
     };
     StepCost {
         compute,

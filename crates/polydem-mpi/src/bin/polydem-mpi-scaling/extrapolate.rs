@@ -27,21 +27,24 @@ pub fn calibrations<'a>(
          T(P, N) per step, for an interior rank of n = N/P bodies in a near-cubic subdomain of side \
          a = n^(1/3) spacings with a ghost layer w spacings wide (g = (a + 2w)³ − a³ ghosts, 26 \
          neighbours), α–β messages (`polydem_mpi::scaling::model`):\n\n\
-         - compute t_c (n + g): the ghosts are stepped with the owned bodies (their pairs with \
-         each other included, work a halo that only evaluates pairs with owned bodies would not do: an \
-         upper bound, and the term that limits the neighbour-only efficiency below, since w is \
-         2 r_max + 4 skins wide);\n\
+         - compute t_c (n + g): the ghosts are integrated with the owned bodies and their pairs with \
+         owned bodies evaluated (not the pairs of two ghosts), so a ghost costs less than an owned body: \
+         an upper bound, and the term that limits the efficiency below, since w is 2 r_max + 4 skins \
+         wide;\n\
          - ghost exchange 26 α + 152 g/β;\n\
-         - rebuild agreement: today an all-gather of 4 f64 per rank, ⌈log₂P⌉ α + 32 (P − 1)/β;\n\
-         - a cut every k steps. **Today every rank gathers the whole world at a cut** and plans every \
-         rank's part: C = ⌈log₂P⌉ α + b N (P−1)/P / β + t_cut N + t_plan N P — O(N) traffic, memory \
-         and work per rank, O(N P) for the plan. To scale it must become a **neighbour-only \
-         migration** (bodies and contact entries to the adjacent ranks, each rank planning its own \
-         part, the agreement an all-reduce): C = 26 α + b g/β + (t_cut + t_plan)(n + g), agreement \
-         ⌈log₂P⌉(α + 32/β). Both are tabled below.\n\n\
+         - rebuild agreement: an all-gather of 4 f64 per rank, ⌈log₂P⌉ α + 32 (P − 1)/β;\n\
+         - a cut every k steps. **Today a cut migrates bodies between near ranks**: each owner sends \
+         its bodies and the contact entries it answers for to the ranks that hold them next, one \
+         message each way, and each rank assembles its own part: C = 26 α + b g/β + 2 ⌈log₂P⌉ α + \
+         (t_cut + t_plan)(n + g) (the all-reduces check the moves and the balance). A **whole-world \
+         cut** (every rank gathers the whole state and plans every rank's part, the first design and \
+         still the re-bisection when the owned counts drift apart by more than 10 %) costs \
+         C = ⌈log₂P⌉ α + b N (P−1)/P / β + t_cut N + t_plan N P — O(N) traffic, memory and work per \
+         rank, O(N P) for the plan. Both are tabled below.\n\n\
          **Calibrated on this machine** (the median repeat of each configuration): t_c, the \
          compute time per body-step (one rank, steps without a cut); t_cut, the extra time of a step \
-         with a cut per body (one rank); k, steps per cut; b, bytes per body of a cut (two ranks); \
+         with a cut per body (one rank, where a cut migrates to the rank itself: for a whole-world cut, \
+         which also encodes and decodes the whole state, a lower bound); k, steps per cut; b, bytes per body of a cut (two ranks); \
          w, from the scene's radii and skin; t_plan, from the timed plan. **Assumed**: the cluster's \
          cores step a body as fast as this machine's, and its interconnect has α = {:.1} µs and \
          β = {:.0} GB/s — MPI over EDR/HDR InfiniBand (link rates 100/200 Gb/s = 12.5/25 GB/s; a \
@@ -73,7 +76,7 @@ pub fn calibrations<'a>(
             two.bodies as f64,
             2,
             sub,
-            Migration::WholeWorld,
+            Migration::Neighbours,
         );
         let _ = writeln!(
             page,
@@ -104,7 +107,7 @@ fn extrapolation_table(page: &mut String, scene: &str, cal: &Calibration) {
     let _ = writeln!(
         page,
         "### {scene}\n\n\
-         | N | P | bodies/rank | ghosts/owned | T today (ms) | cut share today | gathered world per rank (GB) | E today | T neighbour-only (ms) | E neighbour-only |\n\
+         | N | P | bodies/rank | ghosts/owned | T whole-world cut (ms) | its cut share | gathered world per rank (GB) | E whole-world cut | T migration, today (ms) | E migration, today |\n\
          |---|---|---|---|---|---|---|---|---|---|"
     );
     for bodies in [1e6, 1e8] {
@@ -142,7 +145,7 @@ fn weak_table(page: &mut String, cal: &Calibration) {
     let _ = writeln!(
         page,
         "Weak scaling at {WEAK_PER_RANK:.0} bodies per rank (10⁸ on 4096 ranks), E = T(1, n)/T(P, nP):\n\n\
-         | P | N | E today | E neighbour-only |\n|---|---|---|---|"
+         | P | N | E whole-world cut | E migration, today |\n|---|---|---|---|"
     );
     let e = |p: usize, m| {
         let one = step_cost(cal, &CLUSTER, WEAK_PER_RANK, 1, m).total();
@@ -177,8 +180,8 @@ pub fn model(
     let mut series = Vec::new();
     for (bodies, name) in [(EXADEM_BODIES, "1.65 M"), (1e8, "10^8")] {
         for (m, how) in [
-            (Migration::WholeWorld, "today"),
-            (Migration::Neighbours, "neighbour-only"),
+            (Migration::WholeWorld, "whole-world cut"),
+            (Migration::Neighbours, "migration (today)"),
         ] {
             let points = CLUSTER_RANKS
                 .iter()
@@ -235,8 +238,8 @@ fn exadem(page: &mut String, poly: &Calibration) {
     let _ = writeln!(
         page,
         "![strong-scaling efficiency](mpi/strong_efficiency.svg)\n\n\
-         Data: [mpi/strong_efficiency.csv](mpi/strong_efficiency.csv). The two \"today\" curves \
-         coincide: the whole-world cut, the same for any N per rank, dominates both.\n\n\
+         Data: [mpi/strong_efficiency.csv](mpi/strong_efficiency.csv). The two whole-world-cut curves \
+         coincide: that cut, the same for any N per rank, dominates both.\n\n\
          ## Against exaDEM\n\n\
          exaDEM's polyhedra benchmark (\"Blade\", 1,651,637 polyhedra, 10,000 steps, MPI + OpenMP on \
          the Skylake nodes of CCRT-IRENE up to 16,384 cores, best with 24 OpenMP threads per MPI \
@@ -247,16 +250,16 @@ fn exadem(page: &mut String, poly: &Calibration) {
          figure is read from plots we could not open here, so the ~{:.0} % from 64 to 2048 cores is \
          used **as stated in the issue**.\n\n\
          The model for the same number of polyhedra (our cubes' per-body cost), 64 → 2048 ranks of \
-         one thread: **{:.0} %** with today's whole-world cut, **{:.0} %** with a neighbour-only \
+         one thread: **{:.0} %** with a whole-world cut at every rebuild, **{:.0} %** with today's \
          migration ({:.0}–{:.0} % and {:.0}–{:.0} % over α = 1–2 µs, β = 10–25 GB/s). The comparison is on paper: exaDEM's bodies are more costly polyhedra (more \
          compute per body hides more communication), its ranks are 24-thread processes (fewer, \
          larger subdomains: a smaller halo per core), and our per-body cost is this machine's.\n\n\
-         **What the model says about today's code.** The ghost exchange and the compute on ghosts \
-         scale as a surface; the whole-world cut does not: each rank receives b N bytes, holds the \
-         whole world, and plans P parts at every cut, every k steps. At 10⁸ bodies that is the \
-         memory column above per rank — beyond a node's — and the cut's share of the step grows \
-         with P. A neighbour-only migration (and an all-reduce for the agreement) is required \
-         before runs beyond a few tens of ranks.\n",
+         **What the model says about today's code.** The ghost exchange, the compute on ghosts and \
+         the migration scale as a surface; what grows with P is the agreement's all-gather (32 (P − 1) \
+         bytes per rank per step) and the ghost exchange's all-to-all inside MPI; every rank also keeps \
+         the whole world's fixed data (shapes, names), and a re-bisection gathers the whole state. A \
+         whole-world cut at every rebuild would receive b N bytes per rank and plan P parts every k \
+         steps: at 10⁸ bodies that is the memory column above per rank, beyond a node's.\n",
         100.0 * EXADEM_EFFICIENCY,
         100.0 * e(Migration::WholeWorld),
         100.0 * e(Migration::Neighbours),

@@ -41,6 +41,16 @@ impl Group {
         median(&mut self.runs.iter().map(f).collect::<Vec<_>>()).unwrap_or(f64::NAN)
     }
 
+    fn fastest_of(&self, f: fn(&RunFigures) -> f64) -> f64 {
+        self.runs.iter().map(f).fold(f64::INFINITY, f64::min)
+    }
+
+    /// The spread of the repeats' wall times, (slowest − fastest)/median.
+    fn wall_spread(&self) -> f64 {
+        let slowest = self.runs.iter().map(|r| r.wall_s).fold(0.0, f64::max);
+        (slowest - self.fastest_of(|r| r.wall_s)) / self.median_of(|r| r.wall_s)
+    }
+
     /// The repeat whose wall time is the median (the lower middle one for an even count).
     pub fn median_run(&self) -> &RunFigures {
         let mut order: Vec<&RunFigures> = self.runs.iter().collect();
@@ -240,10 +250,12 @@ fn scalings<'a>(page: &mut String, groups: &'a [Group]) -> Result<Vec<Scaling<'a
         "## Weak and strong scaling on this machine\n\n\
          Weak: one rank on the base lattice against two ranks on the lattice doubled along x (bodies \
          per rank fixed): E = T₁(N)/T₂(2N). Strong: one rank against two on the doubled lattice: \
-         E = T₁(2N)/(2 T₂(2N)). The CPU ratio is the same ratio of CPU time per rank (weak) or of total \
-         CPU time (strong).\n\n\
-         | scene | scaling | wall T₁ (s) | wall T₂ (s) | efficiency | CPU ratio | foreign load (max) | status |\n\
-         |---|---|---|---|---|---|---|---|"
+         E = T₁(2N)/(2 T₂(2N)). The efficiency is taken from the median repeats and, beside it, from the \
+         fastest repeat of each configuration (on a shared host, other machines' work only adds time). \
+         The spread is that of the repeats' wall times, (slowest − fastest)/median. The CPU ratio is \
+         the efficiency's ratio of CPU time per rank (weak) or of total CPU time (strong), medians.\n\n\
+         | scene | scaling | wall T₁ (s) | wall T₂ (s) | efficiency | efficiency, fastest repeats | spread T₁ / T₂ | CPU ratio | foreign load (max) | status |\n\
+         |---|---|---|---|---|---|---|---|---|---|"
     );
     let mut list = Vec::new();
     for (kind, base, _) in SCENES {
@@ -266,30 +278,24 @@ fn scalings<'a>(page: &mut String, groups: &'a [Group]) -> Result<Vec<Scaling<'a
             two: find(2, 2 * n)?,
         };
         let wall = |g: &Group| g.median_of(|r| r.wall_s);
+        let fastest = |g: &Group| g.fastest_of(|r| r.wall_s);
         let cpu = |g: &Group| g.median_of(|r| r.cpu_s);
         let rows = [
-            (
-                "weak",
-                s.small,
-                wall(s.small) / wall(s.two),
-                cpu(s.small) / (cpu(s.two) / 2.0),
-            ),
-            (
-                "strong",
-                s.big,
-                wall(s.big) / (2.0 * wall(s.two)),
-                cpu(s.big) / cpu(s.two),
-            ),
+            ("weak", s.small, 1.0, cpu(s.small) / (cpu(s.two) / 2.0)),
+            ("strong", s.big, 0.5, cpu(s.big) / cpu(s.two)),
         ];
-        for (name, one, efficiency, cpu_ratio) in rows {
+        for (name, one, per_rank, cpu_ratio) in rows {
             let quiet = one.quiet() && s.two.quiet();
             let _ = writeln!(
                 page,
-                "| {} | {name} | {:.3} | {:.3} | {:.1} % | {cpu_ratio:.3} | {:.2} | {} |",
+                "| {} | {name} | {:.3} | {:.3} | {:.1} % | {:.1} % | {:.0} % / {:.0} % | {cpu_ratio:.3} | {:.2} | {} |",
                 s.scene,
                 wall(one),
                 wall(s.two),
-                100.0 * efficiency,
+                100.0 * per_rank * wall(one) / wall(s.two),
+                100.0 * per_rank * fastest(one) / fastest(s.two),
+                100.0 * one.wall_spread(),
+                100.0 * s.two.wall_spread(),
                 one.foreign_load().max(s.two.foreign_load()),
                 quiet_note(quiet)
             );
@@ -314,8 +320,9 @@ fn traffic(page: &mut String, groups: &[Group]) {
          Payload bytes and messages sent per step, summed over the ranks (the median repeat; exact \
          counts, from the sizes of the buffers handed to MPI: MPI's own headers are not counted). \
          Ghosts: 19 f64 (152 B) per ghost after each step without a cut; agreements: 4 f64 per rank \
-         to every other rank at each rebuild decision; cuts: every rank's owned bodies and contact \
-         entries to every other rank (postcard), spread over the steps.\n\n\
+         to every other rank at each rebuild decision; cuts: each owner's bodies and contact entries to \
+         the near ranks that hold them next (postcard), one message each way between near ranks, spread \
+         over the steps.\n\n\
          | scene | ranks | bodies | ghosts / bodies | ghost B/step | ghost msg/step | agreement B/step | agreement msg/step | cut B/step | cut msg/step | steps per cut |\n\
          |---|---|---|---|---|---|---|---|---|---|---|"
     );
@@ -393,8 +400,9 @@ fn network(page: &mut String, pingpong: &[Vec<f64>], fit: &Network, plan: &[Vec<
         page,
         "\nFit: α = {:.2} µs (the least one-way time up to 512 B), β = {:.2} GB/s (from 1 MiB). Shared memory between two processes on \
          2 cores that other programs also use: a measurement of this machine, not of a network.\n\n\
-         **The plan.** Every rank computes every rank's part at a cut ([`Plan::new`]: bisection, then P \
-         regions × N centres). Best of 3 on a lattice:\n\n| bodies | ranks | time (ms) |\n|---|---|---|",
+         **The plan.** At a bisection (the first cut, and a re-bisection when the owned counts drift \
+         apart) every rank computes every rank's part ([`Plan::new`]: bisection, then P regions × N \
+         centres). Best of 3 on a lattice:\n\n| bodies | ranks | time (ms) |\n|---|---|---|",
         fit.latency_s * 1e6,
         fit.bandwidth * 1e-9
     );
