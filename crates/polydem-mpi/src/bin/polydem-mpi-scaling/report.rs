@@ -58,8 +58,9 @@ impl Group {
         order[(order.len() - 1) / 2]
     }
 
+    /// No repeat had foreign load, and the repeats agree within [`QUIET_SPREAD`].
     pub fn quiet(&self) -> bool {
-        self.runs.iter().all(RunFigures::quiet)
+        self.runs.iter().all(RunFigures::quiet) && self.wall_spread() <= QUIET_SPREAD
     }
 
     fn foreign_load(&self) -> f64 {
@@ -188,11 +189,17 @@ fn header(page: &mut String, groups: &[Group]) {
         "**Load.** Rank 0 reads the threads runnable on the machine (`/proc/loadavg`) every 10 steps; \
          the mean minus the run's own ranks is the *foreign load*. A configuration whose foreign load \
          exceeded {QUIET_FOREIGN_LOAD} in any repeat is marked **not measured quietly**: its wall times \
-         include other programs' work and its ratios are not a measurement of this code. CPU time \
-         (the process clock, summed over the ranks; MPICH's waits spin and count) is printed beside \
-         each wall time.\n"
+         include other programs' work and its ratios are not a measurement of this code. So is one \
+         whose repeats' wall times spread by more than {:.0} % of their median: the same run then took \
+         different times for reasons outside it (other virtual machines on the host share its cores, \
+         which no load figure inside this one shows). CPU time (the process clock, summed over the \
+         ranks; MPICH's waits spin and count) is printed beside each wall time.\n",
+        100.0 * QUIET_SPREAD
     );
 }
+
+/// The largest spread of a configuration's repeats, (slowest − fastest)/median, for a quiet measurement.
+const QUIET_SPREAD: f64 = 0.2;
 
 pub fn quiet_note(quiet: bool) -> &'static str {
     if quiet {
