@@ -1,11 +1,12 @@
-//! The messages of a distributed run: ghost states after every step, the whole state at a cut.
+//! The messages of a distributed run: ghost states after every step, bodies and contact entries at a cut.
 //!
 //! A ghost's state travels as 19 numbers (position, velocity, orientation quaternion, angular momentum,
 //! force, torque), bit for bit; the receiver knows from the plan which ghost each block fills, so no index
-//! travels. At a cut every rank gathers the bodies and contact entries of every other rank (encoded with
-//! postcard, which keeps each f64's bits).
+//! travels. At a migration near ranks send each other the bodies and contact entries they take over, point
+//! to point; at a re-bisection every rank gathers those of every other rank. Both are encoded with
+//! postcard, which keeps each f64's bits.
 
-use mpi::datatype::{Partition, PartitionMut};
+use mpi::datatype::PartitionMut;
 use mpi::topology::SimpleCommunicator;
 use mpi::traits::*;
 use mpi::Count;
@@ -72,29 +73,44 @@ pub fn unpack_ghost(template: &RigidBody, w: &[Real]) -> (RigidBody, Vector, Vec
     (body, v(13), v(16))
 }
 
-/// Sends `blocks[q]` to every rank q and returns what each rank sent here (`expected[q]` numbers from q).
-pub fn all_to_all(
+/// The tag of the ghost exchange's messages.
+const GHOST_TAG: mpi::Tag = 16;
+
+/// Sends `blocks[q]` to each rank q whose block is not empty and returns what each rank sent here
+/// (`expected[q]` numbers from q, concatenated in rank order), point to point: a rank exchanges with the
+/// ranks it shares ghosts with only. A rank expects numbers from q exactly when q's block for it is not
+/// empty (the send and receive lists of a part are two views of one plan).
+pub fn exchange_ghost_states(
     comm: &SimpleCommunicator,
     blocks: &[Vec<Real>],
     expected: &[usize],
     traffic: &mut Traffic,
 ) -> Vec<Real> {
-    let counts: Vec<Count> = blocks.iter().map(|b| b.len() as Count).collect();
-    let send: Vec<Real> = blocks.concat();
-    let recv_counts: Vec<Count> = expected.iter().map(|&n| n as Count).collect();
-    let mut recv = vec![0.0; expected.iter().sum()];
-    let (send_displs, recv_displs) = (displacements(&counts), displacements(&recv_counts));
-    comm.all_to_all_varcount_into(
-        &Partition::new(&send[..], counts.clone(), send_displs),
-        &mut PartitionMut::new(&mut recv[..], recv_counts, recv_displs),
-    );
     let me = comm.rank() as usize;
-    for (q, block) in blocks.iter().enumerate() {
-        if q != me && !block.is_empty() {
-            traffic.bytes += (block.len() * std::mem::size_of::<Real>()) as u64;
-            traffic.messages += 1;
+    let mut recv = vec![0.0; expected.iter().sum()];
+    let messages = blocks.iter().filter(|b| !b.is_empty()).count()
+        + expected.iter().filter(|&&n| n > 0).count();
+    mpi::request::multiple_scope(messages, |scope, requests| {
+        let mut rest = &mut recv[..];
+        for (q, &n) in expected.iter().enumerate() {
+            let (mine, others) = rest.split_at_mut(n);
+            rest = others;
+            if q != me && n > 0 {
+                let from = comm.process_at_rank(q as i32);
+                requests.add(from.immediate_receive_into_with_tag(scope, mine, GHOST_TAG));
+            }
         }
-    }
+        for (q, block) in blocks.iter().enumerate() {
+            if q != me && !block.is_empty() {
+                let to = comm.process_at_rank(q as i32);
+                requests.add(to.immediate_send_with_tag(scope, &block[..], GHOST_TAG));
+                traffic.bytes += (block.len() * std::mem::size_of::<Real>()) as u64;
+                traffic.messages += 1;
+            }
+        }
+        let mut done = Vec::new();
+        requests.wait_all(&mut done);
+    });
     recv
 }
 

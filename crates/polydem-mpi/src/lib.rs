@@ -65,9 +65,9 @@
 //! - Sleeping is refused ([`DistributedError::Sleeping`]); the time-step check does not run on the parts.
 //! - Every rank keeps the whole world's fixed data (shapes, names, radii, materials) for the bodies that
 //!   migrate to it: O(N) memory. A re-bisection gathers the whole state on every rank (O(N) traffic); an
-//!   output step gathers the owned bodies on rank 0 (O(N) there). The per-step ghost exchange is point
-//!   to point in content but one all-to-all, and the rebuild agreement an all-gather of four numbers per
-//!   rank: both cost O(P) in MPI's own work.
+//!   output step gathers the owned bodies on rank 0 (O(N) there). The ghost exchange and the migration
+//!   are point to point between ranks that share bodies; the rebuild agreement is an all-gather of four
+//!   numbers per rank at every step (O(P)).
 //! - A rank whose step or output fails returns the error; the caller aborts the communicator
 //!   (`polydem run` prints `rank R: error: …` and does), else the others wait in the next collective.
 //! - Subdomains by recursive bisection of the body centres never leave a rank without a body (P larger

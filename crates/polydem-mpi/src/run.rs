@@ -21,7 +21,9 @@ use polydem::world::{
 use crate::consensus::Consensus;
 use crate::decomposition::Region;
 use crate::error::DistributedError;
-use crate::exchange::{all_gather, all_to_all, pack_ghost, unpack_ghost, RunTraffic, GHOST_WORDS};
+use crate::exchange::{
+    all_gather, exchange_ghost_states, pack_ghost, unpack_ghost, RunTraffic, GHOST_WORDS,
+};
 use crate::plan::{Plan, MOVE_ALLOWANCE_IN_SKINS};
 use crate::wall_sums::{touching_walls, wall_forces};
 
@@ -270,7 +272,8 @@ impl DistributedRun {
             .iter()
             .map(|l| l.len() * GHOST_WORDS)
             .collect();
-        let received = all_to_all(&self.comm, &blocks, &expected, &mut self.traffic.ghosts);
+        let received =
+            exchange_ghost_states(&self.comm, &blocks, &expected, &mut self.traffic.ghosts);
         let ghosts = part.receives.iter().flatten();
         for (&i, w) in ghosts.zip(received.chunks_exact(GHOST_WORDS)) {
             let (body, force, torque) = unpack_ghost(&part.world.bodies()[i], w);
