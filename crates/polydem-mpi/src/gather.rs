@@ -1,14 +1,14 @@
 //! The whole world's state gathered on rank 0 for outputs: every owned body's state and loads (19 numbers,
-//! as in the ghost exchange), the
-//! touching body–wall entries (the walls' forces are summed from them on rank 0, in the order and with
-//! the bits of one process's step), and, for an output that reads them (a checkpoint), the whole contact
-//! store and broad phase as one process holds them.
+//! as in the ghost exchange), the touching body–wall entries (the walls' forces are summed from them on
+//! rank 0, in the order and with the bits of one process's step), and, for an output that reads them (a
+//! checkpoint), the whole contact store and broad phase as one process holds them.
 //!
 //! The contact entries come from the ranks that answer for them (a body pair from the owner of its lower
 //! body, a body–wall pair from the body's owner), in key order. The whole broad phase is a function of the
-//! centres, radii and walls at its last build, which are those of the last cut: rank 0 rebuilds it from
-//! them when asked, with the build count the parts kept in step (a restored world's list is held as
-//! restored until its first rebuild).
+//! centres, radii and walls at its last build, which are those of the last cut: the owners send their
+//! bodies' positions at the cut with the first such gather after it, and rank 0 rebuilds the list from
+//! them and the walls at the cut, with the build count the parts kept in step (a restored world's list is
+//! held as restored until its first rebuild).
 
 use polydem::math::{Point, Real};
 use polydem::world::{EnergyShare, World};

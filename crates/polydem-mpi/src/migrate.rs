@@ -2,7 +2,8 @@
 //! (its new owner, the rank whose subdomain holds its centre, and the ranks whose ghost layer it lies in),
 //! and each contact entry it answers for to the ranks that receive the entry's lower body. The subdomains
 //! stay those of the last bisection, so a rank exchanges with its neighbours only and no rank holds the
-//! whole state. The parts are the ones a bisection with these subdomains would cut, so the bits are too.
+//! whole state. Each part holds what a cut of the whole state with these subdomains would give it, so the
+//! bits stay one process's.
 
 use polydem::math::{Point, Real};
 use polydem::world::{ContactKey, ContactState, PartBroadPhase, World};
@@ -77,7 +78,7 @@ impl DistributedRun {
         }
         self.traffic.agreements += self.part.consensus.traffic();
         let ledger = *self.part.world.ledger();
-        self.part = self.assemble(all)?;
+        self.part = self.assemble(all, &near)?;
         self.part.world.replace_ledger(ledger);
         self.whole_list_held = false;
         self.cuts += 1;
@@ -170,8 +171,9 @@ impl DistributedRun {
         world
     }
 
-    /// This rank's new part from what every rank sent it (in rank order).
-    fn assemble(&mut self, all: Vec<Migrants>) -> Result<Part, DistributedError> {
+    /// This rank's new part from what every rank sent it (in rank order); `near` as [`Self::near`] (every
+    /// ghost's owner is among them, and every rank that holds a body owned here).
+    fn assemble(&mut self, all: Vec<Migrants>, near: &[usize]) -> Result<Part, DistributedError> {
         let mut arrivals: Vec<(usize, &[Real])> = all
             .iter()
             .flat_map(|m| {
@@ -206,20 +208,21 @@ impl DistributedRun {
         let owned: Vec<bool> = owners.iter().map(|&o| o == me).collect();
         let mut world = self.carry_list_over(world, &ids);
         world.keep_pairs_of_owned(&owned);
-        let receives = (0..regions.len())
-            .map(|q| {
-                (0..ids.len())
-                    .filter(|&i| q != me && owners[i] == q)
-                    .collect()
-            })
-            .collect();
-        let sends = (0..regions.len())
-            .map(|q| {
-                let held =
-                    |i: &usize| q != me && owned[*i] && regions[q].distance(&positions[*i]) < width;
-                (0..ids.len()).filter(held).collect()
-            })
-            .collect();
+        let (mut sends, mut receives) = (
+            vec![Vec::new(); regions.len()],
+            vec![Vec::new(); regions.len()],
+        );
+        for i in 0..ids.len() {
+            if !owned[i] {
+                receives[owners[i]].push(i);
+                continue;
+            }
+            for &q in near {
+                if q != me && regions[q].distance(&positions[i]) < width {
+                    sends[q].push(i);
+                }
+            }
+        }
         let at_cut = (0..ids.len())
             .filter(|&i| owned[i])
             .map(|i| positions[i])

@@ -222,8 +222,7 @@ impl DistributedRun {
             }
         })?;
         if part.consensus.last_rebuilt() {
-            self.check_moves()?;
-            if self.rebalance_due() {
+            if self.check_before_cut()? {
                 self.recut()?;
             } else {
                 self.migrate()?;
@@ -281,35 +280,29 @@ impl DistributedRun {
         }
     }
 
-    /// Refuses to go on when a body moved beyond the ghost layer's allowance since the cut.
-    fn check_moves(&mut self) -> Result<(), DistributedError> {
+    /// Before a cut, one all-reduce of two maxima: refuses to go on when a body moved beyond the ghost
+    /// layer's allowance since the last cut, and tells whether the owned counts are too uneven to migrate
+    /// again (every rank answers alike).
+    fn check_before_cut(&self) -> Result<bool, DistributedError> {
         let part = &self.part;
         let owned = (0..part.ids.len()).filter(|&i| part.owned[i]);
         let moved = owned
             .zip(&part.at_cut)
             .map(|(i, then)| (part.world.bodies()[i].position - then).norm())
             .fold(0.0, Real::max);
-        let mut largest = 0.0;
+        let mine = [moved, part.at_cut.len() as Real];
+        let mut largest = [0.0; 2];
         self.comm
-            .all_reduce_into(&moved, &mut largest, SystemOperation::max());
+            .all_reduce_into(&mine[..], &mut largest[..], SystemOperation::max());
         let allowance = MOVE_ALLOWANCE_IN_SKINS * self.whole.broad_phase().skin();
-        if largest > allowance {
+        if largest[0] > allowance {
             return Err(DistributedError::HaloExceeded {
-                moved: largest,
+                moved: largest[0],
                 allowance,
             });
         }
-        Ok(())
-    }
-
-    /// Whether the owned counts are too uneven to migrate again (every rank answers alike).
-    fn rebalance_due(&self) -> bool {
-        let owned = self.part.owned.iter().filter(|&&o| o).count() as Real;
-        let mut largest = 0.0;
-        self.comm
-            .all_reduce_into(&owned, &mut largest, SystemOperation::max());
         let mean = self.whole.body_count() as Real / self.comm.size() as Real;
-        largest > self.rebalance_above * mean
+        Ok(largest[1] > self.rebalance_above * mean)
     }
 
     /// Gathers the whole state and cuts new parts from it by a new bisection (after a rebuild: the parts'

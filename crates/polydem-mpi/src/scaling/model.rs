@@ -12,8 +12,8 @@
 //!   + C / k                                         a cut every k steps, costing C:
 //!
 //! - [`Migration::Neighbours`], what the crate does: bodies and contact entries move to the near ranks
-//!   only (one message each way), each rank assembles its own part, and two all-reduces check the moves
-//!   and the balance: C = m α + b g / β + 2 ⌈log₂P⌉ α + (t_cut + t_plan)(n + g).
+//!   only (one message each way), each rank assembles its own part, and one all-reduce checks the moves
+//!   and the balance: C = m α + b g / β + ⌈log₂P⌉ α + (t_cut + t_plan)(n + g).
 //! - [`Migration::WholeWorld`], a whole-world cut at every rebuild (the crate's first design, and still
 //!   its re-bisection when the owned counts drift apart): every rank gathers the whole state and cuts it
 //!   again, C = ⌈log₂P⌉ α + b N (P − 1)/P / β + t_cut N + t_plan N P. The last term is the plan: every
@@ -156,7 +156,7 @@ pub fn step_cost_of(
         Migration::Neighbours => {
             sub.neighbours * alpha
                 + cal.cut_bytes_per_body * sub.ghosts / beta
-                + 2.0 * rounds(ranks) * alpha
+                + rounds(ranks) * alpha
                 + (cal.cut_s_per_body + cal.plan_s_per_body_rank) * (sub.owned + sub.ghosts)
         }
     };

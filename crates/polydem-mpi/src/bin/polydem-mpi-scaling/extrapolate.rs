@@ -35,8 +35,8 @@ pub fn calibrations<'a>(
          - rebuild agreement: an all-gather of 4 f64 per rank, ⌈log₂P⌉ α + 32 (P − 1)/β;\n\
          - a cut every k steps. **Today a cut migrates bodies between near ranks**: each owner sends \
          its bodies and the contact entries it answers for to the ranks that hold them next, one \
-         message each way, and each rank assembles its own part: C = 26 α + b g/β + 2 ⌈log₂P⌉ α + \
-         (t_cut + t_plan)(n + g) (the all-reduces check the moves and the balance). A **whole-world \
+         message each way, and each rank assembles its own part: C = 26 α + b g/β + ⌈log₂P⌉ α + \
+         (t_cut + t_plan)(n + g) (an all-reduce checks the moves and the balance). A **whole-world \
          cut** (every rank gathers the whole state and plans every rank's part, the first design and \
          still the re-bisection when the owned counts drift apart by more than 10 %) costs \
          C = ⌈log₂P⌉ α + b N (P−1)/P / β + t_cut N + t_plan N P — O(N) traffic, memory and work per \
