@@ -46,7 +46,7 @@ pub use sleeping::{SleepParams, SleepState};
 pub use sphere_flat::{NotSphereOnly, SphereSim, StepFlatError};
 pub use step::sphere::applies as sphere_step_applies;
 pub use step::{
-    step, RebuildConsensus, RebuildVote, StepCounters, StepError, StepParams, StepReport,
-    StepScratch, TimeStepCheck, TimeStepFinding,
+    evaluate_initial_loads, step, RebuildConsensus, RebuildVote, StepCounters, StepError,
+    StepParams, StepReport, StepScratch, TimeStepCheck, TimeStepFinding,
 };
 pub use world::{Loads, MaterialTable, SetupStats, Wall, World, WorldError};

@@ -15,7 +15,7 @@ use polydem::world::{EnergyShare, World};
 
 use crate::error::DistributedError;
 use crate::exchange::{gather_to_root, pack_ghost, unpack_ghost, GHOST_WORDS};
-use crate::run::{authoritative_contacts, before_first_step, DistributedRun, Part};
+use crate::run::{authoritative_contacts, DistributedRun, Part};
 use crate::wall_sums::{touching_walls, wall_forces};
 
 impl DistributedRun {
@@ -27,7 +27,7 @@ impl DistributedRun {
         world: Option<&mut World>,
         contacts: bool,
     ) -> Result<(), DistributedError> {
-        if before_first_step(&self.part) {
+        if self.fresh {
             // `world` is still the state the run started from.
             return Ok(());
         }

@@ -9,13 +9,17 @@
 //! - **Subdomains** ([`decomposition`]): recursive coordinate bisection balanced by body count, at the
 //!   start and again when the owned counts drift apart by more than [`run::REBALANCE_ABOVE`]; in between
 //!   the subdomains stay and bodies migrate.
-//! - **Parts** ([`plan`]): a rank steps the bodies it owns and ghosts within the reach of a candidate pair
-//!   plus twice the move a body may make between rebuilds, numbered in global order. The engine sums a
+//! - **Parts** ([`plan`]): a rank steps the bodies it owns and the ghosts within reach of them: a body is
+//!   held where its bounding radius, the largest one the rank owns, the skin and twice the move a body may
+//!   make between rebuilds reach the rank's subdomain (so a projectile widens its owner's layer only),
+//!   numbered in global order. The engine sums a
 //!   body's forces over its pairs in key order (lower partners by increasing index, higher ones, walls) and
 //!   integrates one body at a time, so an owned body gets the bits it gets in one process.
 //! - **Ghosts** are stepped with the rest of the part, then overwritten after each step by their owners'
 //!   states and loads: the next step's first kick and drift of a ghost then repeat its owner's exactly, so
-//!   every pair with an owned body is evaluated on the state one process has. Walls are on every rank.
+//!   every pair with an owned body is evaluated on the state one process has. A fresh world's initial
+//!   loads are evaluated by each part before the first step and its ghosts' then taken from their owners
+//!   (a ghost's own pairs reach beyond the layer). Walls are on every rank.
 //! - **Rebuilds** are agreed ([`consensus`]): the two largest moves of the whole world decide, as in one
 //!   process. After a rebuild the parts are cut again by migration (`migrate`): each owner sends its
 //!   bodies to the near ranks that hold them next (the owner of the subdomain the centre lies in, the
@@ -72,7 +76,7 @@
 //!   (`polydem run` prints `rank R: error: …` and does), else the others wait in the next collective.
 //! - Subdomains by recursive bisection of the body centres never leave a rank without a body (P larger
 //!   than the bodies is refused, [`DistributedError::TooManyRanks`]); a body larger than its subdomain is
-//!   covered, since the ghost layer is sized by the largest bounding radius.
+//!   covered, since the ghost layer of its owner is sized by its bounding radius.
 
 pub mod decomposition;
 pub mod error;

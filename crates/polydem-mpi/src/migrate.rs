@@ -12,7 +12,7 @@ use serde::{Deserialize, Serialize};
 use crate::decomposition::Region;
 use crate::error::DistributedError;
 use crate::exchange::{exchange_with_near, pack_ghost, unpack_ghost, GHOST_WORDS};
-use crate::plan::MOVE_ALLOWANCE_IN_SKINS;
+use crate::plan::{ghost_width, MOVE_ALLOWANCE_IN_SKINS};
 use crate::run::{DistributedRun, Part};
 
 /// The most bodies new to a rank for which its part's list is carried over rather than built again: each
@@ -31,7 +31,11 @@ struct Migrants {
 }
 
 /// The rank whose subdomain holds `x` (the lower rank on a boundary).
-fn owner_of(regions: &[Region], x: &Point, gid: usize) -> Result<usize, DistributedError> {
+pub(crate) fn owner_of(
+    regions: &[Region],
+    x: &Point,
+    gid: usize,
+) -> Result<usize, DistributedError> {
     let inside = regions.iter().position(|r| r.distance(x) == 0.0);
     inside.ok_or(DistributedError::NotFinite { body: gid })
 }
@@ -50,8 +54,10 @@ fn gap(a: &Region, b: &Region) -> Real {
 
 impl DistributedRun {
     /// Cuts new parts by migration (after a rebuild and the check of the moves since the last cut).
-    pub(crate) fn migrate(&mut self) -> Result<(), DistributedError> {
+    /// `largest_owned`: each rank's largest owned bounding radius after the cut (agreed by every rank).
+    pub(crate) fn migrate(&mut self, largest_owned: Vec<Real>) -> Result<(), DistributedError> {
         let near = self.near();
+        self.part.holding.largest_owned = largest_owned;
         let mut outgoing = self.outgoing(&near)?;
         let mut mine = Some(std::mem::take(&mut outgoing[self.rank]));
         let blocks: Vec<Vec<u8>> = outgoing
@@ -86,28 +92,32 @@ impl DistributedRun {
     }
 
     /// The ranks that can hold a body this rank owns (itself included): those whose subdomain lies within
-    /// the ghost layer plus twice the allowance of this one (a body owned here moved at most the allowance
-    /// from this subdomain). The relation is symmetric, so each rank of a pair sends the other a message.
+    /// the widest ghost layer plus twice the allowance of this one (a body owned here moved at most the
+    /// allowance from this subdomain). The relation is symmetric, so each rank of a pair sends the other a
+    /// message.
     fn near(&self) -> Vec<usize> {
-        let (regions, width) = (&self.part.regions, self.part.ghost_width);
-        let allowance = MOVE_ALLOWANCE_IN_SKINS * self.whole.broad_phase().skin();
-        let within = |q: &usize| gap(&regions[*q], &regions[self.rank]) <= width + 2.0 * allowance;
+        let regions = &self.part.holding.regions;
+        let skin = self.whole.broad_phase().skin();
+        let r_max = self.whole.radii().iter().copied().fold(0.0, Real::max);
+        let reach = ghost_width(r_max, skin) + 2.0 * MOVE_ALLOWANCE_IN_SKINS * skin;
+        let within = |q: &usize| gap(&regions[*q], &regions[self.rank]) <= reach;
         (0..regions.len()).filter(within).collect()
     }
 
     /// What this rank sends each rank (its own entry included, not sent).
     fn outgoing(&self, near: &[usize]) -> Result<Vec<Migrants>, DistributedError> {
         let part = &self.part;
-        let (regions, width) = (&part.regions, part.ghost_width);
+        let holding = &part.holding;
+        let regions = &holding.regions;
         let allowance = MOVE_ALLOWANCE_IN_SKINS * self.whole.broad_phase().skin();
         let (bodies, loads) = (part.world.bodies(), part.world.loads());
         let mut out = vec![Migrants::default(); regions.len()];
         let mut destinations = vec![Vec::new(); part.ids.len()];
         for i in (0..part.ids.len()).filter(|&i| part.owned[i]) {
-            let (gid, x) = (part.ids[i], &bodies[i].position);
+            let (gid, x, r) = (part.ids[i], &bodies[i].position, part.world.radii()[i]);
             let owner = owner_of(regions, x, gid)?;
             for &q in near {
-                if q == owner || regions[q].distance(x) < width {
+                if holding.holds(q, owner, x, r) {
                     out[q].ids.push(gid as u32);
                     let (force, torque) = (&loads.forces()[i], &loads.torques()[i]);
                     pack_ghost(&bodies[i], force, torque, &mut out[q].states);
@@ -198,27 +208,26 @@ impl DistributedRun {
         let world = self
             .whole
             .part_with_contacts(&ids, entries, touched, PartBroadPhase::Unbuilt);
-        let (regions, width) = (self.part.regions.clone(), self.part.ghost_width);
+        let holding = self.part.holding.clone();
         let positions: Vec<Point> = world.bodies().iter().map(|b| b.position).collect();
         let mut owners = Vec::with_capacity(ids.len());
         for (x, &gid) in positions.iter().zip(&ids) {
-            owners.push(owner_of(&regions, x, gid)?);
+            owners.push(owner_of(&holding.regions, x, gid)?);
         }
         let me = self.rank;
         let owned: Vec<bool> = owners.iter().map(|&o| o == me).collect();
         let mut world = self.carry_list_over(world, &ids);
         world.keep_pairs_of_owned(&owned);
-        let (mut sends, mut receives) = (
-            vec![Vec::new(); regions.len()],
-            vec![Vec::new(); regions.len()],
-        );
+        let ranks = holding.regions.len();
+        let (mut sends, mut receives) = (vec![Vec::new(); ranks], vec![Vec::new(); ranks]);
         for i in 0..ids.len() {
             if !owned[i] {
                 receives[owners[i]].push(i);
                 continue;
             }
-            for &q in near {
-                if q != me && regions[q].distance(&positions[i]) < width {
+            let (x, r) = (&positions[i], world.radii()[i]);
+            for &q in near.iter().filter(|&&q| q != me) {
+                if holding.holds(q, me, x, r) {
                     sends[q].push(i);
                 }
             }
@@ -228,7 +237,7 @@ impl DistributedRun {
             .map(|i| positions[i])
             .collect();
         Ok(Part::new(
-            world, ids, owned, sends, receives, regions, width, at_cut,
+            world, ids, owned, sends, receives, holding, at_cut,
         ))
     }
 }

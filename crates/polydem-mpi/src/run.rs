@@ -14,17 +14,17 @@ use mpi::traits::*;
 use polydem::dynamics::RigidBody;
 use polydem::math::{Point, Real, Vector};
 use polydem::world::{
-    step, ContactKey, ContactState, EnergyShare, PartBroadPhase, StepParams, StepReport,
-    StepScratch, TimeStepCheck, Wall, World,
+    evaluate_initial_loads, step, ContactKey, ContactState, EnergyShare, PartBroadPhase,
+    StepParams, StepReport, StepScratch, TimeStepCheck, Wall, World,
 };
 
 use crate::consensus::Consensus;
-use crate::decomposition::Region;
 use crate::error::DistributedError;
 use crate::exchange::{
     all_gather, exchange_ghost_states, pack_ghost, unpack_ghost, RunTraffic, GHOST_WORDS,
 };
-use crate::plan::{Plan, MOVE_ALLOWANCE_IN_SKINS};
+use crate::migrate::owner_of;
+use crate::plan::{Holding, Plan, MOVE_ALLOWANCE_IN_SKINS};
 use crate::wall_sums::{touching_walls, wall_forces};
 
 /// This rank's part: the world it steps and what it exchanges.
@@ -44,10 +44,9 @@ pub(crate) struct Part {
     pub(crate) at_cut: Vec<Point>,
     /// The walls at the cut (the whole world's list is built at them and at the bodies' `at_cut`).
     pub(crate) walls_at_cut: Vec<Wall>,
-    /// Every rank's subdomain, as of the last bisection (kept by the migrations since).
-    pub(crate) regions: Vec<Region>,
-    /// The width (m) of the ghost layer around each subdomain.
-    pub(crate) ghost_width: Real,
+    /// Which ranks hold a body: every rank's subdomain as of the last bisection (kept by the migrations
+    /// since), and the largest body each rank owns since this cut.
+    pub(crate) holding: Holding,
 }
 
 impl Part {
@@ -60,8 +59,7 @@ impl Part {
         owned: Vec<bool>,
         sends: Vec<Vec<usize>>,
         receives: Vec<Vec<usize>>,
-        regions: Vec<Region>,
-        ghost_width: Real,
+        holding: Holding,
         at_cut: Vec<Point>,
     ) -> Self {
         let consensus = Arc::new(Consensus::new(owned.clone()));
@@ -79,10 +77,17 @@ impl Part {
             consensus,
             at_cut,
             walls_at_cut,
-            regions,
-            ghost_width,
+            holding,
         }
     }
+}
+
+/// How the next cut is made.
+enum NextCut {
+    /// Bisect the whole world again.
+    Bisect,
+    /// Migrate bodies within the present subdomains; the largest bounding radius each rank owns after.
+    Migrate { largest_owned: Vec<Real> },
 }
 
 /// A world stepped on every rank of `MPI_COMM_WORLD`.
@@ -107,6 +112,9 @@ pub struct DistributedRun {
     /// Above which imbalance (the largest owned count over the mean) a cut bisects the whole world again
     /// instead of migrating bodies between neighbours.
     pub(crate) rebalance_above: Real,
+    /// Whether the run started from a fresh world (loads not evaluated) and has not stepped yet: the whole
+    /// state is then that world, whose stale loads are what one process shows before its first step.
+    pub(crate) fresh: bool,
 }
 
 /// The imbalance above which a cut bisects again by default: a rank with 10 % more bodies than the
@@ -154,6 +162,7 @@ impl DistributedRun {
             // The ledger so far (a restored world's) is counted once, on rank 0's part.
             part.world.replace_ledger(*world.ledger());
         }
+        let fresh = !world.loads().is_current();
         Ok(Self {
             comm,
             rank,
@@ -166,7 +175,25 @@ impl DistributedRun {
             lists_carried: 0,
             whole_list_held: restored,
             rebalance_above: REBALANCE_ABOVE,
+            fresh,
         })
+    }
+
+    /// The loads of a fresh world's initial state, which one process evaluates at the start of its first
+    /// step (outputs before it show the stale loads, as one process's do). A ghost's loads need its
+    /// neighbours beyond the ghost layer, so each part evaluates its own and then takes its ghosts' loads
+    /// from their owners: every owned body's first step then reads one process's loads for its neighbours
+    /// too.
+    fn evaluate_initial_loads(&mut self) -> Result<(), DistributedError> {
+        let part = &mut self.part;
+        evaluate_initial_loads(&self.params, &mut part.world, &mut part.scratch).map_err(
+            |source| DistributedError::Step {
+                rank: self.rank,
+                source,
+            },
+        )?;
+        self.exchange_ghosts();
+        Ok(())
     }
 
     /// Sets the imbalance (largest owned count over the mean) above which a cut bisects the whole world
@@ -214,6 +241,10 @@ impl DistributedRun {
     /// One step of the whole world; the report is that of this rank's part (its counters count the part's
     /// work, ghosts included).
     pub fn step(&mut self) -> Result<StepReport, DistributedError> {
+        if self.fresh {
+            self.evaluate_initial_loads()?;
+            self.fresh = false;
+        }
         let part = &mut self.part;
         let report = step(&self.params, &mut part.world, &mut part.scratch).map_err(|source| {
             DistributedError::Step {
@@ -222,10 +253,9 @@ impl DistributedRun {
             }
         })?;
         if part.consensus.last_rebuilt() {
-            if self.check_before_cut()? {
-                self.recut()?;
-            } else {
-                self.migrate()?;
+            match self.check_before_cut()? {
+                NextCut::Bisect => self.recut()?,
+                NextCut::Migrate { largest_owned } => self.migrate(largest_owned)?,
             }
         } else {
             self.exchange_ghosts();
@@ -280,18 +310,28 @@ impl DistributedRun {
         }
     }
 
-    /// Before a cut, one all-reduce of two maxima: refuses to go on when a body moved beyond the ghost
-    /// layer's allowance since the last cut, and tells whether the owned counts are too uneven to migrate
-    /// again (every rank answers alike).
-    fn check_before_cut(&self) -> Result<bool, DistributedError> {
+    /// Before a cut, one all-reduce of maxima: refuses to go on when a body moved beyond the ghost layer's
+    /// allowance since the last cut; tells whether the owned counts are too uneven to migrate again (every
+    /// rank answers alike), and, for a migration, each rank's largest owned body after it.
+    fn check_before_cut(&self) -> Result<NextCut, DistributedError> {
         let part = &self.part;
         let owned = (0..part.ids.len()).filter(|&i| part.owned[i]);
         let moved = owned
             .zip(&part.at_cut)
             .map(|(i, then)| (part.world.bodies()[i].position - then).norm())
             .fold(0.0, Real::max);
-        let mine = [moved, part.at_cut.len() as Real];
-        let mut largest = [0.0; 2];
+        let ranks = self.comm.size() as usize;
+        let mut mine = vec![0.0; 2 + ranks];
+        mine[0] = moved;
+        mine[1] = part.at_cut.len() as Real;
+        let regions = &part.holding.regions;
+        for i in (0..part.ids.len()).filter(|&i| part.owned[i]) {
+            // A body without an owner (a non-finite centre) is refused by the migration itself.
+            if let Ok(q) = owner_of(regions, &part.world.bodies()[i].position, part.ids[i]) {
+                mine[2 + q] = Real::max(mine[2 + q], part.world.radii()[i]);
+            }
+        }
+        let mut largest = vec![0.0; mine.len()];
         self.comm
             .all_reduce_into(&mine[..], &mut largest[..], SystemOperation::max());
         let allowance = MOVE_ALLOWANCE_IN_SKINS * self.whole.broad_phase().skin();
@@ -301,8 +341,13 @@ impl DistributedRun {
                 allowance,
             });
         }
-        let mean = self.whole.body_count() as Real / self.comm.size() as Real;
-        Ok(largest[1] > self.rebalance_above * mean)
+        let mean = self.whole.body_count() as Real / ranks as Real;
+        Ok(match largest[1] > self.rebalance_above * mean {
+            true => NextCut::Bisect,
+            false => NextCut::Migrate {
+                largest_owned: largest.split_off(2),
+            },
+        })
     }
 
     /// Gathers the whole state and cuts new parts from it by a new bisection (after a rebuild: the parts'
@@ -334,13 +379,6 @@ impl DistributedRun {
         self.bisections += 1;
         Ok(())
     }
-}
-
-/// Whether `part` has not been stepped yet: the whole state is then the world the run started from (a
-/// fresh world, whose loads are not evaluated: one process's stale loads are its own). Every rank
-/// answers alike, so every rank skips a gather alike.
-pub(crate) fn before_first_step(part: &Part) -> bool {
-    !part.world.loads().is_current()
 }
 
 type OwnedBody = (usize, RigidBody, Vector, Vector);
@@ -422,8 +460,7 @@ fn cut(
         owned,
         sends,
         receives,
-        plan.decomposition.regions,
-        plan.ghost_width,
+        plan.holding,
         at_cut,
     ))
 }
@@ -457,7 +494,7 @@ impl DistributedRun {
     /// process's bit for bit, and so are the walls' forces (summed from the touching entries in key
     /// order, as the step sums them); the energy sums are one process's up to rounding (grouped by part).
     pub fn gather_world(&mut self) -> Result<World, DistributedError> {
-        if before_first_step(&self.part) {
+        if self.fresh {
             return Ok(self.whole.clone());
         }
         let share = self.part.world.energy_share();

@@ -106,6 +106,36 @@ pub fn step(
     Ok(report)
 }
 
+/// Stage 0 alone: the loads of the initial state when they are not current (a fresh world), which the
+/// next step would otherwise evaluate first. A world split over processes evaluates them apart, so that
+/// each part can take its ghosts' loads from their owners before its first step reads them.
+pub fn evaluate_initial_loads(
+    params: &StepParams,
+    world: &mut World,
+    scratch: &mut StepScratch,
+) -> Result<StepReport, StepError> {
+    let mut report = StepReport::default();
+    world.sleep.resize(world.bodies.len());
+    initial_loads(params, world, scratch, &mut report)?;
+    Ok(report)
+}
+
+/// 0. The loads of the initial state (no tangential increment: no time has passed).
+fn initial_loads(
+    params: &StepParams,
+    world: &mut World,
+    scratch: &mut StepScratch,
+    report: &mut StepReport,
+) -> Result<(), StepError> {
+    if !world.loads.current {
+        loads::evaluate(params, world, scratch, report, 0.0, false)?;
+        if world.ledger.initial_total.is_none() {
+            world.ledger.initial_total = Some(world.energy().mechanical());
+        }
+    }
+    Ok(())
+}
+
 /// Stages 0–9 of one step (the module docs).
 fn advance(
     params: &StepParams,
@@ -125,13 +155,7 @@ fn advance(
         // Sleeping switched off: every body wakes.
         report.counters.woken += world.sleep.wake_all() as u64;
     }
-    // 0. The loads of the initial state (no tangential increment: no time has passed).
-    if !world.loads.current {
-        loads::evaluate(params, world, scratch, &mut report, 0.0, false)?;
-        if world.ledger.initial_total.is_none() {
-            world.ledger.initial_total = Some(world.energy().mechanical());
-        }
-    }
+    initial_loads(params, world, scratch, &mut report)?;
     if sphere::applies(params, world) {
         return sphere::step_spheres(params, world, scratch, report);
     }
