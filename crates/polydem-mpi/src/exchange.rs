@@ -40,7 +40,7 @@ impl std::ops::AddAssign for Traffic {
 pub struct RunTraffic {
     /// Ghost states and loads after each step.
     pub ghosts: Traffic,
-    /// The rebuild agreements (four numbers per rank at each stage 3).
+    /// The rebuild agreements (an all-reduce of four numbers at each stage 3).
     pub agreements: Traffic,
     /// The whole state gathered at each cut.
     pub cuts: Traffic,

@@ -97,7 +97,7 @@ impl DistributedRun {
 /// packs them (the mass properties and motion, which do not change, stay behind).
 fn owned_states(part: &Part) -> (Vec<u32>, Vec<Real>) {
     let (bodies, loads) = (part.world.bodies(), part.world.loads());
-    let owned: Vec<usize> = (0..part.ids.len()).filter(|&i| part.owned[i]).collect();
+    let owned: Vec<usize> = (0..part.ids.len()).filter(|&i| part.owns(i)).collect();
     let mut states = Vec::with_capacity(owned.len() * GHOST_WORDS);
     for &i in &owned {
         pack_ghost(

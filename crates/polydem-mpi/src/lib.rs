@@ -70,8 +70,8 @@
 //! - Every rank keeps the whole world's fixed data (shapes, names, radii, materials) for the bodies that
 //!   migrate to it: O(N) memory. A re-bisection gathers the whole state on every rank (O(N) traffic); an
 //!   output step gathers the owned bodies on rank 0 (O(N) there). The ghost exchange and the migration
-//!   are point to point between ranks that share bodies; the rebuild agreement is an all-gather of four
-//!   numbers per rank at every step (O(P)).
+//!   are point to point between ranks that share bodies; the rebuild agreement is one all-reduce of four
+//!   numbers at every step (O(log P)).
 //! - A rank whose step or output fails returns the error; the caller aborts the communicator
 //!   (`polydem run` prints `rank R: error: …` and does), else the others wait in the next collective.
 //! - Subdomains by recursive bisection of the body centres never leave a rank without a body (P larger

@@ -113,7 +113,7 @@ impl DistributedRun {
         let (bodies, loads) = (part.world.bodies(), part.world.loads());
         let mut out = vec![Migrants::default(); regions.len()];
         let mut destinations = vec![Vec::new(); part.ids.len()];
-        for i in (0..part.ids.len()).filter(|&i| part.owned[i]) {
+        for i in (0..part.ids.len()).filter(|&i| part.owns(i)) {
             let (gid, x, r) = (part.ids[i], &bodies[i].position, part.world.radii()[i]);
             let owner = owner_of(regions, x, gid)?;
             for &q in near {

@@ -33,8 +33,6 @@ pub(crate) struct Part {
     pub(crate) scratch: StepScratch,
     /// Global index of each local body (increasing).
     pub(crate) ids: Vec<usize>,
-    /// Whether each local body is owned here.
-    pub(crate) owned: Vec<bool>,
     /// Per rank, the local indices of the owned bodies it holds as ghosts.
     pub(crate) sends: Vec<Vec<usize>>,
     /// Per rank, the local indices of the ghosts it owns.
@@ -50,6 +48,11 @@ pub(crate) struct Part {
 }
 
 impl Part {
+    /// Whether local body `i` is owned here (the bodies the part's world counts as its own).
+    pub(crate) fn owns(&self, i: usize) -> bool {
+        self.world.counts_body(i)
+    }
+
     /// The part holding the bodies `ids` (renumbered in `world`), of which `owned` are this rank's, with
     /// the ghost lists, the subdomains it was cut by, and the owned bodies' positions at the cut.
     #[allow(clippy::too_many_arguments)]
@@ -62,16 +65,15 @@ impl Part {
         holding: Holding,
         at_cut: Vec<Point>,
     ) -> Self {
-        let consensus = Arc::new(Consensus::new(owned.clone()));
+        let consensus = Arc::new(Consensus::default());
         let mut scratch = StepScratch::default();
         scratch.set_rebuild_consensus(Some(consensus.clone()));
-        world.count_only(owned.clone());
+        world.count_only(owned);
         let walls_at_cut = world.walls().to_vec();
         Self {
             world,
             scratch,
             ids,
-            owned,
             sends,
             receives,
             consensus,
@@ -209,8 +211,10 @@ impl DistributedRun {
 
     /// Bodies in this rank's part (owned, ghosts).
     pub fn part_size(&self) -> (usize, usize) {
-        let owned = self.part.owned.iter().filter(|&&o| o).count();
-        (owned, self.part.owned.len() - owned)
+        let owned = (0..self.part.ids.len())
+            .filter(|&i| self.part.owns(i))
+            .count();
+        (owned, self.part.ids.len() - owned)
     }
 
     /// The communicator the run steps on.
@@ -225,7 +229,7 @@ impl DistributedRun {
 
     /// The bodies this rank owns, as a VTK piece labelled by their global indices.
     pub fn owned_piece(&self) -> polydem::io::vtk::BodyPiece {
-        let owned = (0..self.part.ids.len()).filter(|&i| self.part.owned[i]);
+        let owned = (0..self.part.ids.len()).filter(|&i| self.part.owns(i));
         let bodies: Vec<usize> = owned.collect();
         let labels = bodies.iter().map(|&i| self.part.ids[i]).collect();
         polydem::io::vtk::BodyPiece { bodies, labels }
@@ -315,7 +319,7 @@ impl DistributedRun {
     /// rank answers alike), and, for a migration, each rank's largest owned body after it.
     fn check_before_cut(&self) -> Result<NextCut, DistributedError> {
         let part = &self.part;
-        let owned = (0..part.ids.len()).filter(|&i| part.owned[i]);
+        let owned = (0..part.ids.len()).filter(|&i| part.owns(i));
         let moved = owned
             .zip(&part.at_cut)
             .map(|(i, then)| (part.world.bodies()[i].position - then).norm())
@@ -325,7 +329,7 @@ impl DistributedRun {
         mine[0] = moved;
         mine[1] = part.at_cut.len() as Real;
         let regions = &part.holding.regions;
-        for i in (0..part.ids.len()).filter(|&i| part.owned[i]) {
+        for i in (0..part.ids.len()).filter(|&i| part.owns(i)) {
             // A body without an owner (a non-finite centre) is refused by the migration itself.
             if let Ok(q) = owner_of(regions, &part.world.bodies()[i].position, part.ids[i]) {
                 mine[2 + q] = Real::max(mine[2 + q], part.world.radii()[i]);
@@ -386,7 +390,7 @@ type OwnedBody = (usize, RigidBody, Vector, Vector);
 fn owned_bodies(part: &Part) -> Vec<OwnedBody> {
     let (bodies, loads) = (part.world.bodies(), part.world.loads());
     (0..part.ids.len())
-        .filter(|&i| part.owned[i])
+        .filter(|&i| part.owns(i))
         .map(|i| {
             (
                 part.ids[i],
@@ -409,14 +413,14 @@ pub(crate) fn authoritative_contacts(part: &Part) -> Vec<(ContactKey, ContactSta
         .iter()
         .zip(store.states())
         .filter_map(|(key, state)| match *key {
-            ContactKey::Body { a, b } => part.owned[a as usize].then(|| {
+            ContactKey::Body { a, b } => part.owns(a as usize).then(|| {
                 let key = ContactKey::Body {
                     a: global(a),
                     b: global(b),
                 };
                 (key, *state)
             }),
-            ContactKey::Wall { body, wall } => part.owned[body as usize].then(|| {
+            ContactKey::Wall { body, wall } => part.owns(body as usize).then(|| {
                 let key = ContactKey::Wall {
                     body: global(body),
                     wall,
@@ -478,7 +482,7 @@ impl DistributedRun {
         let part = &self.part;
         let local = part.ids.binary_search(&gid).ok();
         let mine = local
-            .filter(|&i| part.owned[i])
+            .filter(|&i| part.owns(i))
             .map(|i| read(&part.world, i));
         let all = all_gather(&self.comm, &mine, &mut self.traffic.gathers)?;
         Ok(all

@@ -41,13 +41,16 @@ pub(super) fn stage(
             forced || (summary.any_far && broad.pairs_may_be_stale(&inputs.centres, &world.walls))
         }
         // A part of a world split over processes takes the decision of the whole world.
-        Some(consensus) => consensus.decide(&RebuildVote {
-            forced,
-            any_far: summary.any_far,
-            centres: &inputs.centres,
-            broad_phase: broad,
-            walls: &world.walls,
-        }),
+        Some(consensus) => {
+            let counted = |i: usize| world.counted.as_ref().is_none_or(|owned| owned[i]);
+            consensus.decide(&RebuildVote {
+                forced,
+                any_far: summary.any_far,
+                largest_moves_sq: broad.largest_moves_sq(&inputs.centres, counted),
+                broad_phase: broad,
+                walls: &world.walls,
+            })
+        }
     };
     clock.serial_end(Section::SerialInputs, profile_inputs);
     if rebuild {

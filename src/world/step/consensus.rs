@@ -2,7 +2,7 @@
 //! together: what one part knows ([`RebuildVote`]) and who decides ([`RebuildConsensus`]). A leaf file,
 //! so that the stage and the scratch that holds the consensus both use it without using each other.
 
-use crate::math::Point;
+use crate::math::Real;
 
 use super::super::broad_phase::BroadPhase;
 use super::super::world::Wall;
@@ -14,8 +14,9 @@ pub struct RebuildVote<'a> {
     pub forced: bool,
     /// Some body of the part moved more than half the skin since the last build.
     pub any_far: bool,
-    /// The part's body centres now.
-    pub centres: &'a [Point],
+    /// The two largest squared moves (m², the largest first) since the last build among the bodies the
+    /// part counts as its own ([`World::count_only`](crate::world::World::count_only); all without it).
+    pub largest_moves_sq: (Real, Real),
     /// The part's broad phase (its build positions and skin).
     pub broad_phase: &'a BroadPhase,
     /// The walls now.

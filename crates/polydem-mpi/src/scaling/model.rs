@@ -8,7 +8,7 @@
 //!
 //! T = t_c (n + g)                                   compute: ghosts are stepped with the owned bodies
 //!   + m α + 152 g / β                               ghost exchange: 19 f64 per ghost, m neighbours
-//!   + ⌈log₂P⌉ α + 32 (P − 1) / β                     rebuild agreement: an all-gather of 4 f64 per rank
+//!   + ⌈log₂P⌉ (α + 32 / β)                          rebuild agreement: an all-reduce of 4 f64, ⌈log₂P⌉ rounds
 //!   + C / k                                         a cut every k steps, costing C:
 //!
 //! - [`Migration::Neighbours`], what the crate does: bodies and contact entries move to the near ranks
@@ -23,7 +23,7 @@ use crate::scaling::record::RunFigures;
 
 /// Bytes per ghost in the exchange after each step (19 f64: `exchange::GHOST_WORDS`).
 pub const GHOST_BYTES: f64 = 152.0;
-/// Bytes each rank contributes to a rebuild agreement (four f64).
+/// Bytes each rank hands to a rebuild agreement's all-reduce (four f64).
 pub const AGREEMENT_BYTES: f64 = 32.0;
 
 /// A network in the α–β model.
@@ -145,7 +145,7 @@ pub fn step_cost_of(
     }
     let (alpha, beta, p) = (net.latency_s, net.bandwidth, ranks as f64);
     let halo = sub.neighbours * alpha + GHOST_BYTES * sub.ghosts / beta;
-    let agreement = rounds(ranks) * alpha + AGREEMENT_BYTES * (p - 1.0) / beta;
+    let agreement = rounds(ranks) * (alpha + AGREEMENT_BYTES / beta);
     let cut = match migration {
         Migration::WholeWorld => {
             rounds(ranks) * alpha

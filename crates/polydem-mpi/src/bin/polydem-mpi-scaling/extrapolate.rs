@@ -29,10 +29,12 @@ pub fn calibrations<'a>(
          neighbours), α–β messages (`polydem_mpi::scaling::model`):\n\n\
          - compute t_c (n + g): the ghosts are integrated with the owned bodies and their pairs with \
          owned bodies evaluated (not the pairs of two ghosts), so a ghost costs less than an owned body: \
-         an upper bound, and the term that limits the efficiency below, since w is 2 r_max + 4 skins \
-         wide;\n\
+         an upper bound, and the term that limits the efficiency below, since w is 2 r + 4 skins wide \
+         for these equal bodies (a rank holds a body within its radius plus the largest radius the \
+         rank owns, plus the skin and the moves' allowance);\n\
          - ghost exchange 26 α + 152 g/β;\n\
-         - rebuild agreement: an all-gather of 4 f64 per rank, ⌈log₂P⌉ α + 32 (P − 1)/β;\n\
+         - rebuild agreement: an all-reduce of 4 f64 (either flag and the two largest moves), \
+         ⌈log₂P⌉ (α + 32/β);\n\
          - a cut every k steps. **Today a cut migrates bodies between near ranks**: each owner sends \
          its bodies and the contact entries it answers for to the ranks that hold them next, one \
          message each way, and each rank assembles its own part: C = 26 α + b g/β + ⌈log₂P⌉ α + \
@@ -255,9 +257,9 @@ fn exadem(page: &mut String, poly: &Calibration) {
          compute per body hides more communication), its ranks are 24-thread processes (fewer, \
          larger subdomains: a smaller halo per core), and our per-body cost is this machine's.\n\n\
          **What the model says about today's code.** The ghost exchange, the compute on ghosts and \
-         the migration scale as a surface; what grows with P is the agreement's all-gather (32 (P − 1) \
-         bytes per rank per step) and the ghost exchange's all-to-all inside MPI; every rank also keeps \
-         the whole world's fixed data (shapes, names), and a re-bisection gathers the whole state. A \
+         the migration scale as a surface (point to point between near ranks); what grows with P is the \
+         agreement's all-reduce, ⌈log₂P⌉ rounds per step; every rank also keeps the whole world's fixed \
+         data (shapes, names), and a re-bisection gathers the whole state. A \
          whole-world cut at every rebuild would receive b N bytes per rank and plan P parts every k \
          steps: at 10⁸ bodies that is the memory column above per rank, beyond a node's.\n",
         100.0 * EXADEM_EFFICIENCY,

@@ -326,8 +326,9 @@ fn traffic(page: &mut String, groups: &[Group]) {
         "## Communication per step\n\n\
          Payload bytes and messages sent per step, summed over the ranks (the median repeat; exact \
          counts, from the sizes of the buffers handed to MPI: MPI's own headers are not counted). \
-         Ghosts: 19 f64 (152 B) per ghost after each step without a cut; agreements: 4 f64 per rank \
-         to every other rank at each rebuild decision; cuts: each owner's bodies and contact entries to \
+         Ghosts: 19 f64 (152 B) per ghost after each step without a cut; agreements: one all-reduce \
+         of 4 f64 per rank at each rebuild decision (the bytes each rank hands to it; messages: the \
+         all-reduces); cuts: each owner's bodies and contact entries to \
          the near ranks that hold them next (postcard), one message each way between near ranks, spread \
          over the steps.\n\n\
          | scene | ranks | bodies | ghosts / bodies | ghost B/step | ghost msg/step | agreement B/step | agreement msg/step | cut B/step | cut msg/step | steps per cut |\n\
