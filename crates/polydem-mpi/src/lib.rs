@@ -2,10 +2,12 @@
 //!
 //! # Design
 //! - **Where the code lives.** This crate holds the decomposition, the exchanges and the distributed step;
-//!   the engine offers three seams (`polydem::world`): [`World::part`](polydem::world::World::part) cuts a
-//!   world down to some bodies, [`World::copy_body_from_owner`](polydem::world::World::copy_body_from_owner)
-//!   writes a ghost's state and loads, and a [`RebuildConsensus`](polydem::world::RebuildConsensus) set on
-//!   the step's scratch takes the broad-phase rebuild decision. A run without MPI takes none of them.
+//!   the engine offers its seams in `polydem::world`: [`World::part`](polydem::world::World::part) cuts a
+//!   world down to some bodies, [`World::count_only`](polydem::world::World::count_only) marks the ones a
+//!   part owns, [`World::copy_body_from_owner`](polydem::world::World::copy_body_from_owner) writes a
+//!   ghost's state and loads, [`evaluate_initial_loads`](polydem::world::evaluate_initial_loads) runs a
+//!   fresh world's stage 0 alone, and a [`RebuildConsensus`](polydem::world::RebuildConsensus) set on the
+//!   step's scratch takes the broad-phase rebuild decision. A run without MPI takes none of them.
 //! - **Subdomains** ([`decomposition`]): recursive coordinate bisection balanced by body count, at the
 //!   start and again when the owned counts drift apart by more than [`run::REBALANCE_ABOVE`]; in between
 //!   the subdomains stay and bodies migrate.

@@ -29,7 +29,7 @@ pub(super) fn stage(
     }
     inputs.summarise();
     let summary = inputs.summary;
-    let broad = &mut world.broad_phase;
+    let broad = &world.broad_phase;
     // A body beyond half the skin does not rebuild by itself: the lists stay valid while the two largest
     // moves sum to less than the skin (`BroadPhase::pairs_may_be_stale`, scanned only then).
     let forced = !params.skips.verlet_skin
@@ -41,17 +41,15 @@ pub(super) fn stage(
             forced || (summary.any_far && broad.pairs_may_be_stale(&inputs.centres, &world.walls))
         }
         // A part of a world split over processes takes the decision of the whole world.
-        Some(consensus) => {
-            let counted = |i: usize| world.counted.as_ref().is_none_or(|owned| owned[i]);
-            consensus.decide(&RebuildVote {
-                forced,
-                any_far: summary.any_far,
-                largest_moves_sq: broad.largest_moves_sq(&inputs.centres, counted),
-                broad_phase: broad,
-                walls: &world.walls,
-            })
-        }
+        Some(consensus) => consensus.decide(&RebuildVote {
+            forced,
+            any_far: summary.any_far,
+            largest_moves_sq: broad.largest_moves_sq(&inputs.centres, |i| world.counts_body(i)),
+            broad_phase: broad,
+            walls: &world.walls,
+        }),
     };
+    let broad = &mut world.broad_phase;
     clock.serial_end(Section::SerialInputs, profile_inputs);
     if rebuild {
         broad.rebuild_with_walls_timed(&inputs.centres, &world.radii, &world.walls, &mut clock);
