@@ -3,8 +3,8 @@
 //! A ghost's state travels as 19 numbers (position, velocity, orientation quaternion, angular momentum,
 //! force, torque), bit for bit; the receiver knows from the plan which ghost each block fills, so no index
 //! travels. At a migration near ranks send each other the bodies and contact entries they take over, point
-//! to point; at a re-bisection every rank gathers those of every other rank. Both are encoded with
-//! postcard, which keeps each f64's bits.
+//! to point (after a re-bisection, from any rank to any rank). They are encoded with postcard, which keeps
+//! each f64's bits.
 
 use mpi::datatype::PartitionMut;
 use mpi::topology::SimpleCommunicator;

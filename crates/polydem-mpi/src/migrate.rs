@@ -5,14 +5,16 @@
 //! whole state. Each part holds what a cut of the whole state with these subdomains would give it, so the
 //! bits stay one process's.
 
+use mpi::traits::*;
 use polydem::math::{Point, Real};
 use polydem::world::{ContactKey, ContactState, PartBroadPhase, World};
 use serde::{Deserialize, Serialize};
 
+use crate::decomposition::bisect;
 use crate::decomposition::Region;
 use crate::error::DistributedError;
-use crate::exchange::{exchange_with_near, pack_ghost, unpack_ghost, GHOST_WORDS};
-use crate::plan::{ghost_width, MOVE_ALLOWANCE_IN_SKINS};
+use crate::exchange::{all_gather, exchange_with_near, pack_ghost, unpack_ghost, GHOST_WORDS};
+use crate::plan::{ghost_width, Holding, MOVE_ALLOWANCE_IN_SKINS};
 use crate::run::{DistributedRun, Part};
 
 /// The most bodies new to a rank for which its part's list is carried over rather than built again: each
@@ -28,6 +30,25 @@ struct Migrants {
     states: Vec<Real>,
     /// The contact entries (global keys) whose lower body is among `ids`.
     entries: Vec<(ContactKey, ContactState)>,
+}
+
+/// Who owns each body after a cut.
+pub(crate) enum NewOwners {
+    /// The rank whose subdomain holds its centre: a migration within the present subdomains.
+    ByRegion,
+    /// The owners a new bisection gave every body, by global index (bodies on a cutting plane split by
+    /// index, as the bisection balances them).
+    Given(Vec<u32>),
+}
+
+impl NewOwners {
+    /// The owner of body `gid` at `x` under `regions`.
+    fn of(&self, regions: &[Region], x: &Point, gid: usize) -> Result<usize, DistributedError> {
+        match self {
+            NewOwners::ByRegion => owner_of(regions, x, gid),
+            NewOwners::Given(owner) => Ok(owner[gid] as usize),
+        }
+    }
 }
 
 /// The rank whose subdomain holds `x` (the lower rank on a boundary).
@@ -53,12 +74,48 @@ fn gap(a: &Region, b: &Region) -> Real {
 }
 
 impl DistributedRun {
-    /// Cuts new parts by migration (after a rebuild and the check of the moves since the last cut).
-    /// `largest_owned`: each rank's largest owned bounding radius after the cut (agreed by every rank).
+    /// Cuts new parts by migration within the present subdomains (after a rebuild and the check of the
+    /// moves since the last cut). `largest_owned`: each rank's largest owned bounding radius after the cut
+    /// (agreed by every rank).
     pub(crate) fn migrate(&mut self, largest_owned: Vec<Real>) -> Result<(), DistributedError> {
         let near = self.near();
         self.part.holding.largest_owned = largest_owned;
-        let mut outgoing = self.outgoing(&near)?;
+        self.migrate_to(&near, &NewOwners::ByRegion)
+    }
+
+    /// Cuts new parts by a new bisection of the owned bodies' centres, gathered on every rank (after a
+    /// rebuild, when the owned counts drifted apart): the bodies then migrate to the new subdomains as
+    /// they do between neighbours, any rank to any rank.
+    pub(crate) fn rebisect(&mut self) -> Result<(), DistributedError> {
+        let part = &self.part;
+        let owned = (0..part.ids.len()).filter(|&i| part.owns(i));
+        let mine: Vec<(u32, [Real; 3])> = owned
+            .map(|i| {
+                let x = part.world.bodies()[i].position;
+                (part.ids[i] as u32, [x.x, x.y, x.z])
+            })
+            .collect();
+        let all = all_gather(&self.comm, &mine, &mut self.traffic.cuts)?;
+        let mut centres = vec![Point::origin(); self.whole.body_count()];
+        for (gid, x) in all.into_iter().flatten() {
+            centres[gid as usize] = Point::new(x[0], x[1], x[2]);
+        }
+        let ranks = self.comm.size() as usize;
+        let decomposition = bisect(&centres, ranks)?;
+        let skin = self.whole.broad_phase().skin();
+        let owner = decomposition.owner;
+        self.part.holding = Holding::new(decomposition.regions, &owner, self.whole.radii(), skin);
+        let everyone: Vec<usize> = (0..ranks).collect();
+        self.migrate_to(&everyone, &NewOwners::Given(owner))?;
+        self.bisections += 1;
+        Ok(())
+    }
+
+    /// Sends each owned body and the entries it answers for to the ranks of `near` that hold it under
+    /// the part's holding rule with owners `owners`, and assembles the new part from what arrives.
+    fn migrate_to(&mut self, near: &[usize], owners: &NewOwners) -> Result<(), DistributedError> {
+        let near = near.to_vec();
+        let mut outgoing = self.outgoing(&near, owners)?;
         let mut mine = Some(std::mem::take(&mut outgoing[self.rank]));
         let blocks: Vec<Vec<u8>> = outgoing
             .iter()
@@ -84,7 +141,7 @@ impl DistributedRun {
         }
         self.traffic.agreements += self.part.consensus.traffic();
         let ledger = *self.part.world.ledger();
-        self.part = self.assemble(all, &near)?;
+        self.part = self.assemble(all, &near, owners)?;
         self.part.world.replace_ledger(ledger);
         self.whole_list_held = false;
         self.cuts += 1;
@@ -105,7 +162,11 @@ impl DistributedRun {
     }
 
     /// What this rank sends each rank (its own entry included, not sent).
-    fn outgoing(&self, near: &[usize]) -> Result<Vec<Migrants>, DistributedError> {
+    fn outgoing(
+        &self,
+        near: &[usize],
+        owners: &NewOwners,
+    ) -> Result<Vec<Migrants>, DistributedError> {
         let part = &self.part;
         let holding = &part.holding;
         let regions = &holding.regions;
@@ -115,7 +176,7 @@ impl DistributedRun {
         let mut destinations = vec![Vec::new(); part.ids.len()];
         for i in (0..part.ids.len()).filter(|&i| part.owns(i)) {
             let (gid, x, r) = (part.ids[i], &bodies[i].position, part.world.radii()[i]);
-            let owner = owner_of(regions, x, gid)?;
+            let owner = owners.of(regions, x, gid)?;
             for &q in near {
                 if holding.holds(q, owner, x, r) {
                     out[q].ids.push(gid as u32);
@@ -181,9 +242,14 @@ impl DistributedRun {
         world
     }
 
-    /// This rank's new part from what every rank sent it (in rank order); `near` as [`Self::near`] (every
-    /// ghost's owner is among them, and every rank that holds a body owned here).
-    fn assemble(&mut self, all: Vec<Migrants>, near: &[usize]) -> Result<Part, DistributedError> {
+    /// This rank's new part from what every rank sent it (in rank order); `near`: the ranks messages were
+    /// exchanged with (every ghost's owner is among them, and every rank that holds a body owned here).
+    fn assemble(
+        &mut self,
+        all: Vec<Migrants>,
+        near: &[usize],
+        owners_rule: &NewOwners,
+    ) -> Result<Part, DistributedError> {
         let mut arrivals: Vec<(usize, &[Real])> = all
             .iter()
             .flat_map(|m| {
@@ -212,7 +278,7 @@ impl DistributedRun {
         let positions: Vec<Point> = world.bodies().iter().map(|b| b.position).collect();
         let mut owners = Vec::with_capacity(ids.len());
         for (x, &gid) in positions.iter().zip(&ids) {
-            owners.push(owner_of(&holding.regions, x, gid)?);
+            owners.push(owners_rule.of(&holding.regions, x, gid)?);
         }
         let me = self.rank;
         let owned: Vec<bool> = owners.iter().map(|&o| o == me).collect();

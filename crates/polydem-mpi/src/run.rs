@@ -2,9 +2,9 @@
 //!
 //! Each step: the part's step (the engine's, with the rebuild decision agreed by every rank), then either
 //! the ghost exchange (each owner sends its ghosts' states and loads) or, after a rebuild, a cut. A cut
-//! migrates bodies between near ranks within the subdomains of the last bisection ([`crate::migrate`]);
+//! migrates bodies between near ranks within the subdomains of the last bisection (`migrate`);
 //! when the owned counts have drifted apart (above [`REBALANCE_ABOVE`]) every rank instead gathers the
-//! whole state (owned bodies, the contact entries each rank is authoritative for) and bisects it again.
+//! owned bodies' centres, bisects them again, and the bodies migrate to the new subdomains.
 
 use std::sync::Arc;
 
@@ -258,7 +258,7 @@ impl DistributedRun {
         })?;
         if part.consensus.last_rebuilt() {
             match self.check_before_cut()? {
-                NextCut::Bisect => self.recut()?,
+                NextCut::Bisect => self.rebisect()?,
                 NextCut::Migrate { largest_owned } => self.migrate(largest_owned)?,
             }
         } else {
@@ -352,36 +352,6 @@ impl DistributedRun {
                 largest_owned: largest.split_off(2),
             },
         })
-    }
-
-    /// Gathers the whole state and cuts new parts from it by a new bisection (after a rebuild: the parts'
-    /// lists are built at these positions, as one process's is).
-    fn recut(&mut self) -> Result<(), DistributedError> {
-        let mine = (owned_bodies(&self.part), authoritative_contacts(&self.part));
-        let all = all_gather(&self.comm, &mine, &mut self.traffic.cuts)?;
-        self.whole.copy_walls_and_clock(&self.part.world);
-        let mut entries = Vec::new();
-        for (bodies, contacts) in all {
-            for (gid, body, force, torque) in bodies {
-                self.whole.copy_body_from_owner(gid, &body, &force, &torque);
-            }
-            entries.extend(contacts);
-        }
-        entries.sort_by_key(|entry| entry.0);
-        let touched = self.part.world.contacts().last_touched();
-        self.whole.replace_contacts(entries, touched);
-        self.traffic.agreements += self.part.consensus.traffic();
-        let rebuilds = self.part.world.broad_phase().rebuilds();
-        let centres: Vec<Point> = self.whole.bodies().iter().map(|b| b.position).collect();
-        let built = PartBroadPhase::Build { rebuilds };
-        let ledger = *self.part.world.ledger();
-        self.part = cut(&self.comm, &self.whole, &centres, built)?;
-        // Each rank keeps booking its share of the ledger: the sum over the ranks stays the whole's.
-        self.part.world.replace_ledger(ledger);
-        self.whole_list_held = false;
-        self.cuts += 1;
-        self.bisections += 1;
-        Ok(())
     }
 }
 

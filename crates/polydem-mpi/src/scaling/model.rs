@@ -14,9 +14,8 @@
 //! - [`Migration::Neighbours`], what the crate does: bodies and contact entries move to the near ranks
 //!   only (one message each way), each rank assembles its own part, and one all-reduce checks the moves
 //!   and the balance: C = m α + b g / β + ⌈log₂P⌉ α + (t_cut + t_plan)(n + g).
-//! - [`Migration::WholeWorld`], a whole-world cut at every rebuild (the crate's first design, and still
-//!   its re-bisection when the owned counts drift apart): every rank gathers the whole state and cuts it
-//!   again, C = ⌈log₂P⌉ α + b N (P − 1)/P / β + t_cut N + t_plan N P. The last term is the plan: every
+//! - [`Migration::WholeWorld`], a whole-world cut at every rebuild (the crate's first design): every rank
+//!   gathers the whole state and cuts it again, C = ⌈log₂P⌉ α + b N (P − 1)/P / β + t_cut N + t_plan N P. The last term is the plan: every
 //!   rank computes every rank's part (P regions × N centres).
 
 use crate::scaling::record::RunFigures;
@@ -62,7 +61,7 @@ pub struct Calibration {
 /// How bodies change ranks at a cut.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Migration {
-    /// Every rank gathers the whole world at every cut (the first design; today's re-bisection).
+    /// Every rank gathers the whole world at every cut (the first design).
     WholeWorld,
     /// Bodies move to neighbouring ranks only (today's cut).
     Neighbours,

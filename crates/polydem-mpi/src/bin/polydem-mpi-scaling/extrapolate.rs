@@ -39,8 +39,9 @@ pub fn calibrations<'a>(
          its bodies and the contact entries it answers for to the ranks that hold them next, one \
          message each way, and each rank assembles its own part: C = 26 α + b g/β + ⌈log₂P⌉ α + \
          (t_cut + t_plan)(n + g) (an all-reduce checks the moves and the balance). A **whole-world \
-         cut** (every rank gathers the whole state and plans every rank's part, the first design and \
-         still the re-bisection when the owned counts drift apart by more than 10 %) costs \
+         cut** (every rank gathers the whole state and plans every rank's part, the first design; a \
+         re-bisection, when the owned counts drift apart by more than 10 %, now gathers the centres only \
+         and migrates) costs \
          C = ⌈log₂P⌉ α + b N (P−1)/P / β + t_cut N + t_plan N P — O(N) traffic, memory and work per \
          rank, O(N P) for the plan. Both are tabled below.\n\n\
          **Calibrated on this machine** (the median repeat of each configuration): t_c, the \
@@ -259,7 +260,7 @@ fn exadem(page: &mut String, poly: &Calibration) {
          **What the model says about today's code.** The ghost exchange, the compute on ghosts and \
          the migration scale as a surface (point to point between near ranks); what grows with P is the \
          agreement's all-reduce, ⌈log₂P⌉ rounds per step; every rank also keeps the whole world's fixed \
-         data (shapes, names), and a re-bisection gathers the whole state. A \
+         data (shapes, names), and a re-bisection gathers every centre. A \
          whole-world cut at every rebuild would receive b N bytes per rank and plan P parts every k \
          steps: at 10⁸ bodies that is the memory column above per rank, beyond a node's.\n",
         100.0 * EXADEM_EFFICIENCY,
