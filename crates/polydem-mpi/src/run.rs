@@ -48,6 +48,13 @@ pub(crate) struct Part {
 }
 
 impl Part {
+    /// Takes the present positions and walls as those of the last cut (one rank, which keeps its part).
+    fn mark_cut(&mut self) {
+        let bodies = self.world.bodies();
+        self.at_cut = bodies.iter().map(|b| b.position).collect();
+        self.walls_at_cut = self.world.walls().to_vec();
+    }
+
     /// Whether local body `i` is owned here (the bodies the part's world counts as its own).
     pub(crate) fn owns(&self, i: usize) -> bool {
         self.world.counts_body(i)
@@ -256,7 +263,12 @@ impl DistributedRun {
                 source,
             }
         })?;
-        if part.consensus.last_rebuilt() {
+        if part.consensus.last_rebuilt() && self.comm.size() == 1 {
+            // One rank's part is the whole world: a cut would rebuild the same part.
+            self.part.mark_cut();
+            self.whole_list_held = false;
+            self.cuts += 1;
+        } else if part.consensus.last_rebuilt() {
             match self.check_before_cut()? {
                 NextCut::Bisect => self.rebisect()?,
                 NextCut::Migrate { largest_owned } => self.migrate(largest_owned)?,
