@@ -71,7 +71,7 @@
 //! - Sleeping is refused ([`DistributedError::Sleeping`]); the time-step check does not run on the parts.
 //! - Every rank keeps the whole world's fixed data (shapes, names, radii, materials) for the bodies that
 //!   migrate to it: O(N) memory. A re-bisection gathers every owned centre on every rank (O(N) traffic,
-//!   16 B per body before encoding) and bisects them there (O(N log N)); the bodies then migrate from any
+//!   28 B per body before encoding) and bisects them there (O(N log N)); the bodies then migrate from any
 //!   rank to any rank (P messages per rank). An output step gathers the owned bodies on rank 0 (O(N)
 //!   there). The ghost exchange and the migration
 //!   are point to point between ranks that share bodies; the rebuild agreement is one all-reduce of four

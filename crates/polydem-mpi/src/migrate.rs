@@ -114,8 +114,7 @@ impl DistributedRun {
     /// Sends each owned body and the entries it answers for to the ranks of `near` that hold it under
     /// the part's holding rule with owners `owners`, and assembles the new part from what arrives.
     fn migrate_to(&mut self, near: &[usize], owners: &NewOwners) -> Result<(), DistributedError> {
-        let near = near.to_vec();
-        let mut outgoing = self.outgoing(&near, owners)?;
+        let mut outgoing = self.outgoing(near, owners)?;
         let mut mine = Some(std::mem::take(&mut outgoing[self.rank]));
         let blocks: Vec<Vec<u8>> = outgoing
             .iter()
@@ -124,7 +123,7 @@ impl DistributedRun {
                 false => postcard::to_allocvec(m).expect("encoding to memory does not fail"),
             })
             .collect();
-        let received = exchange_with_near(&self.comm, &near, &blocks, &mut self.traffic.cuts);
+        let received = exchange_with_near(&self.comm, near, &blocks, &mut self.traffic.cuts);
         let mut all = Vec::with_capacity(received.len());
         for (q, bytes) in received.iter().enumerate() {
             let migrants = match (q == self.rank, bytes.is_empty()) {
@@ -141,7 +140,7 @@ impl DistributedRun {
         }
         self.traffic.agreements += self.part.consensus.traffic();
         let ledger = *self.part.world.ledger();
-        self.part = self.assemble(all, &near, owners)?;
+        self.part = self.assemble(all, near, owners)?;
         self.part.world.replace_ledger(ledger);
         self.whole_list_held = false;
         self.cuts += 1;
