@@ -49,6 +49,13 @@ pub struct Decomposition {
     pub owner: Vec<u32>,
 }
 
+/// The rank whose subdomain holds `x`, body `gid`'s centre (the lower rank on a boundary; a non-finite
+/// centre lies in none).
+pub fn owner_of(regions: &[Region], x: &Point, gid: usize) -> Result<usize, DistributedError> {
+    let inside = regions.iter().position(|r| r.distance(x) == 0.0);
+    inside.ok_or(DistributedError::NotFinite { body: gid })
+}
+
 /// Cuts the bodies at `centres` into `ranks` subdomains of nearly equal body counts.
 pub fn bisect(centres: &[Point], ranks: usize) -> Result<Decomposition, DistributedError> {
     if ranks == 0 || ranks > centres.len().max(1) {

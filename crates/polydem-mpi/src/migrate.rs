@@ -10,8 +10,8 @@ use polydem::math::{Point, Real};
 use polydem::world::{ContactKey, ContactState, PartBroadPhase, World};
 use serde::{Deserialize, Serialize};
 
-use crate::decomposition::bisect;
 use crate::decomposition::Region;
+use crate::decomposition::{bisect, owner_of};
 use crate::error::DistributedError;
 use crate::exchange::{all_gather, exchange_with_near, pack_ghost, unpack_ghost, GHOST_WORDS};
 use crate::plan::{ghost_width, Holding, MOVE_ALLOWANCE_IN_SKINS};
@@ -49,16 +49,6 @@ impl NewOwners {
             NewOwners::Given(owner) => Ok(owner[gid] as usize),
         }
     }
-}
-
-/// The rank whose subdomain holds `x` (the lower rank on a boundary).
-pub(crate) fn owner_of(
-    regions: &[Region],
-    x: &Point,
-    gid: usize,
-) -> Result<usize, DistributedError> {
-    let inside = regions.iter().position(|r| r.distance(x) == 0.0);
-    inside.ok_or(DistributedError::NotFinite { body: gid })
 }
 
 /// The gap (m) between two boxes (0 where they touch or overlap).

@@ -19,11 +19,11 @@ use polydem::world::{
 };
 
 use crate::consensus::Consensus;
+use crate::decomposition::owner_of;
 use crate::error::DistributedError;
 use crate::exchange::{
     all_gather, exchange_ghost_states, pack_ghost, unpack_ghost, RunTraffic, GHOST_WORDS,
 };
-use crate::migrate::owner_of;
 use crate::plan::{Holding, Plan, MOVE_ALLOWANCE_IN_SKINS};
 use crate::wall_sums::{touching_walls, wall_forces};
 
