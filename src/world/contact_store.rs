@@ -269,6 +269,9 @@ impl ContactStore {
         }
         self.next_keys.clear();
         self.next_states.clear();
+        // A store made from entries (a part assembled at a migration) has no spare lists yet.
+        self.next_keys.reserve(candidates.len());
+        self.next_states.reserve(candidates.len());
         let mut counts = SyncCounts::default();
         let mut old = 0;
         for &key in candidates {

@@ -53,19 +53,27 @@ impl World {
     ) -> World {
         debug_assert!(ids.windows(2).all(|w| w[0] < w[1]));
         let local = |i: u32| ids.binary_search(&(i as usize)).ok().map(|k| k as u32);
-        let kept = entries.into_iter().filter_map(|(key, state)| {
-            let renumbered = match key {
-                ContactKey::Body { a, b } => {
-                    let (a, b) = (local(a)?, local(b)?);
-                    ContactKey::Body { a, b }
-                }
-                ContactKey::Wall { body, wall } => ContactKey::Wall {
-                    body: local(body)?,
-                    wall,
-                },
-            };
-            Some((renumbered, state))
-        });
+        let renumbered = |key| match key {
+            ContactKey::Body { a, b } => Some(ContactKey::Body {
+                a: local(a)?,
+                b: local(b)?,
+            }),
+            ContactKey::Wall { body, wall } => Some(ContactKey::Wall {
+                body: local(body)?,
+                wall,
+            }),
+        };
+        let entries = entries.into_iter();
+        let (mut keys, mut states) = (
+            Vec::with_capacity(entries.size_hint().0),
+            Vec::with_capacity(entries.size_hint().0),
+        );
+        for (key, state) in entries {
+            if let Some(key) = renumbered(key) {
+                keys.push(key);
+                states.push(state);
+            }
+        }
         let mut part = World::new(
             self.gravity,
             self.materials.clone(),
@@ -81,7 +89,7 @@ impl World {
         part.walls = self.walls.clone();
         part.time = self.time;
         part.step_index = self.step_index;
-        part.replace_contacts(kept.collect(), last_touched);
+        part.contacts = ContactStore::from_entries(keys, states, last_touched);
         match broad_phase {
             PartBroadPhase::Unbuilt => {}
             PartBroadPhase::Build { rebuilds } => {

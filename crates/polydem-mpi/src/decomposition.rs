@@ -5,10 +5,18 @@
 //! by global index, so every process that cuts the same positions gets the same subdomains. Each rank's
 //! region is a box bounded by its cuts and open to infinity on the sides no cut bounds, so every point of
 //! space belongs to one region (bodies leaving the scene's bounds stay owned).
+//!
+//! A body on a cutting plane (a lattice's layer, or a centre the midpoint rounds onto) belongs to the side
+//! its key (coordinate, global index) sorts into, against the key of the first body above the cut: the
+//! rule the bisection splits by, kept with the region ([`Region::owns`]), so a later migration within the
+//! same subdomains leaves such a body where the bisection put it.
 
 use polydem::math::{Point, Real};
 
 use crate::error::DistributedError;
+
+/// A body's key along one axis: its coordinate (m), then its global index.
+pub type Key = (Real, u32);
 
 /// An axis-aligned box, possibly unbounded (infinite bounds).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -17,6 +25,12 @@ pub struct Region {
     pub min: [Real; 3],
     /// Upper corner (m).
     pub max: [Real; 3],
+    /// Per axis, the key of the first body above the cut at `min` (a body on that plane is inside when
+    /// its key is not below it).
+    pub min_first: [Key; 3],
+    /// Per axis, the key of the first body above the cut at `max` (a body on that plane is inside when
+    /// its key is below it).
+    pub max_first: [Key; 3],
 }
 
 impl Region {
@@ -25,7 +39,20 @@ impl Region {
         Self {
             min: [Real::NEG_INFINITY; 3],
             max: [Real::INFINITY; 3],
+            min_first: [(Real::NEG_INFINITY, 0); 3],
+            max_first: [(Real::INFINITY, 0); 3],
         }
+    }
+
+    /// Whether body `gid` with its centre at `x` belongs to the region (false for a non-finite centre).
+    pub fn owns(&self, x: &Point, gid: u32) -> bool {
+        let below = |x: Real, plane: Real, first: Key| x < plane || x == plane && (x, gid) < first;
+        (0..3).all(|axis| {
+            let x = x[axis];
+            x.is_finite()
+                && !below(x, self.min[axis], self.min_first[axis])
+                && below(x, self.max[axis], self.max_first[axis])
+        })
     }
 
     /// The distance (m) from `p` to the region (0 inside).
@@ -49,10 +76,10 @@ pub struct Decomposition {
     pub owner: Vec<u32>,
 }
 
-/// The rank whose subdomain holds `x`, body `gid`'s centre (the lower rank on a boundary; a non-finite
+/// The rank whose subdomain owns body `gid` with its centre at `x` ([`Region::owns`]; a non-finite
 /// centre lies in none).
 pub fn owner_of(regions: &[Region], x: &Point, gid: usize) -> Result<usize, DistributedError> {
-    let inside = regions.iter().position(|r| r.distance(x) == 0.0);
+    let inside = regions.iter().position(|r| r.owns(x, gid as u32));
     inside.ok_or(DistributedError::NotFinite { body: gid })
 }
 
@@ -107,9 +134,15 @@ fn cut(
         (Some(lo), Some(&hi)) => 0.5 * (centres[lo][axis] + centres[hi][axis]),
         _ => region.min[axis].max(region.max[axis].min(0.0)),
     };
+    // The midpoint lies in [lo, hi], so the bodies below sort below the first above, those above not.
+    let first_above = ids
+        .get(split)
+        .map_or((Real::INFINITY, 0), |&hi| (centres[hi][axis], hi as u32));
     let (mut lower, mut upper) = (region, region);
     lower.max[axis] = plane;
+    lower.max_first[axis] = first_above;
     upper.min[axis] = plane;
+    upper.min_first[axis] = first_above;
     let (below, above) = ids.split_at_mut(split);
     cut(centres, below, first, lower_ranks, lower, regions, owner);
     cut(
@@ -169,6 +202,15 @@ mod tests {
                 assert_eq!(
                     inside, 0.0,
                     "P {ranks}: body {i} at {:?} is outside its region {:?}",
+                    centres[i], d.regions[r as usize]
+                );
+                // The lattice puts whole layers on the cutting planes: the region rule must split them
+                // as the bisection did.
+                let by_rule = owner_of(&d.regions, &centres[i], i).expect("finite centre");
+                assert_eq!(
+                    by_rule, r as usize,
+                    "P {ranks}: body {i} at {:?} (on a plane of {:?}) owned by {r} after the bisection, \
+                     by {by_rule} under the regions' rule",
                     centres[i], d.regions[r as usize]
                 );
             }

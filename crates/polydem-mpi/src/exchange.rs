@@ -52,12 +52,14 @@ pub struct RunTraffic {
 
 /// Appends body `body`'s state with its loads to `out`.
 pub fn pack_ghost(body: &RigidBody, force: &Vector, torque: &Vector, out: &mut Vec<Real>) {
-    out.extend(body.position.coords.iter());
-    out.extend(body.velocity.iter());
-    out.extend(body.orientation.coords.iter());
-    out.extend(body.angular_momentum.iter());
-    out.extend(force.iter());
-    out.extend(torque.iter());
+    let (x, v, l) = (&body.position, &body.velocity, &body.angular_momentum);
+    let q = &body.orientation.coords;
+    // One slice of known length: the vector grows once per body, not once per number.
+    let words: [Real; GHOST_WORDS] = [
+        x.x, x.y, x.z, v.x, v.y, v.z, q[0], q[1], q[2], q[3], l.x, l.y, l.z, force.x, force.y,
+        force.z, torque.x, torque.y, torque.z,
+    ];
+    out.extend_from_slice(&words);
 }
 
 /// The state of `template` (its mass properties and motion kept) with the block `w` written over it, and

@@ -10,8 +10,7 @@ use polydem::math::{Point, Real};
 use polydem::world::{ContactKey, ContactState, PartBroadPhase, World};
 use serde::{Deserialize, Serialize};
 
-use crate::decomposition::Region;
-use crate::decomposition::{bisect, owner_of};
+use crate::decomposition::{bisect, Region};
 use crate::error::DistributedError;
 use crate::exchange::{all_gather, exchange_with_near, pack_ghost, unpack_ghost, GHOST_WORDS};
 use crate::plan::{ghost_width, Holding, MOVE_ALLOWANCE_IN_SKINS};
@@ -26,29 +25,12 @@ const MAX_NEWCOMERS_CARRIED: usize = 128;
 struct Migrants {
     /// Global indices of the bodies, increasing.
     ids: Vec<u32>,
+    /// The owner of each body after the cut (found once, by the rank that owned it before).
+    owners: Vec<u32>,
     /// Their states and loads, [`GHOST_WORDS`] numbers each.
     states: Vec<Real>,
     /// The contact entries (global keys) whose lower body is among `ids`.
     entries: Vec<(ContactKey, ContactState)>,
-}
-
-/// Who owns each body after a cut.
-pub(crate) enum NewOwners {
-    /// The rank whose subdomain holds its centre: a migration within the present subdomains.
-    ByRegion,
-    /// The owners a new bisection gave every body, by global index (bodies on a cutting plane split by
-    /// index, as the bisection balances them).
-    Given(Vec<u32>),
-}
-
-impl NewOwners {
-    /// The owner of body `gid` at `x` under `regions`.
-    fn of(&self, regions: &[Region], x: &Point, gid: usize) -> Result<usize, DistributedError> {
-        match self {
-            NewOwners::ByRegion => owner_of(regions, x, gid),
-            NewOwners::Given(owner) => Ok(owner[gid] as usize),
-        }
-    }
 }
 
 /// The gap (m) between two boxes (0 where they touch or overlap).
@@ -63,14 +45,56 @@ fn gap(a: &Region, b: &Region) -> Real {
     sq.sqrt()
 }
 
+/// The ranks each body of a part goes to at a migration, body after body in one list (a vector per body
+/// cost an allocation per body).
+struct Destinations {
+    /// Where each body's ranks start in `ranks` (one more entry than bodies).
+    starts: Vec<u32>,
+    ranks: Vec<u32>,
+}
+
+impl Destinations {
+    fn with_bodies(count: usize) -> Self {
+        Self {
+            starts: Vec::with_capacity(count + 1),
+            ranks: Vec::with_capacity(count),
+        }
+    }
+
+    /// Opens the next body's ranks (and, after the last body, closes the list).
+    fn next_body(&mut self) {
+        self.starts.push(self.ranks.len() as u32);
+    }
+
+    /// Adds rank `q` to the open body's.
+    fn add(&mut self, q: usize) {
+        self.ranks.push(q as u32);
+    }
+
+    /// The ranks of body `i` (the open body's so far).
+    fn of(&self, i: usize) -> &[u32] {
+        let start = self.starts[i] as usize;
+        let end = self
+            .starts
+            .get(i + 1)
+            .map_or(self.ranks.len(), |&e| e as usize);
+        &self.ranks[start..end]
+    }
+}
+
 impl DistributedRun {
     /// Cuts new parts by migration within the present subdomains (after a rebuild and the check of the
     /// moves since the last cut). `largest_owned`: each rank's largest owned bounding radius after the cut
-    /// (agreed by every rank).
-    pub(crate) fn migrate(&mut self, largest_owned: Vec<Real>) -> Result<(), DistributedError> {
-        let near = self.near();
+    /// (agreed by every rank); `owners`: the owner after the cut of each body this rank owns, in local
+    /// order.
+    pub(crate) fn migrate(
+        &mut self,
+        largest_owned: Vec<Real>,
+        owners: Vec<u32>,
+    ) -> Result<(), DistributedError> {
         self.part.holding.largest_owned = largest_owned;
-        self.migrate_to(&near, &NewOwners::ByRegion)
+        let near = self.near();
+        self.migrate_to(&near, &owners)
     }
 
     /// Cuts new parts by a new bisection of the owned bodies' centres, gathered on every rank (after a
@@ -95,15 +119,21 @@ impl DistributedRun {
         let skin = self.whole.broad_phase().skin();
         let owner = decomposition.owner;
         self.part.holding = Holding::new(decomposition.regions, &owner, self.whole.radii(), skin);
+        let part = &self.part;
+        let owners: Vec<u32> = (0..part.ids.len())
+            .filter(|&i| part.owns(i))
+            .map(|i| owner[part.ids[i]])
+            .collect();
         let everyone: Vec<usize> = (0..ranks).collect();
-        self.migrate_to(&everyone, &NewOwners::Given(owner))?;
+        self.migrate_to(&everyone, &owners)?;
         self.bisections += 1;
         Ok(())
     }
 
-    /// Sends each owned body and the entries it answers for to the ranks of `near` that hold it under
-    /// the part's holding rule with owners `owners`, and assembles the new part from what arrives.
-    fn migrate_to(&mut self, near: &[usize], owners: &NewOwners) -> Result<(), DistributedError> {
+    /// Sends each owned body (with its new owner, of `owners` in local order) and the entries it answers
+    /// for to the ranks of `near` that hold it under the part's holding rule, and assembles the new part
+    /// from what arrives.
+    fn migrate_to(&mut self, near: &[usize], owners: &[u32]) -> Result<(), DistributedError> {
         let mut outgoing = self.outgoing(near, owners)?;
         let mut mine = Some(std::mem::take(&mut outgoing[self.rank]));
         let blocks: Vec<Vec<u8>> = outgoing
@@ -130,7 +160,7 @@ impl DistributedRun {
         }
         self.traffic.agreements += self.part.consensus.traffic();
         let ledger = *self.part.world.ledger();
-        self.part = self.assemble(all, near, owners)?;
+        self.part = self.assemble(all, near);
         self.part.world.replace_ledger(ledger);
         self.whole_list_held = false;
         self.cuts += 1;
@@ -140,47 +170,21 @@ impl DistributedRun {
     /// The ranks that can hold a body this rank owns (itself included): those whose subdomain lies within
     /// the widest ghost layer plus twice the allowance of this one (a body owned here moved at most the
     /// allowance from this subdomain). The relation is symmetric, so each rank of a pair sends the other a
-    /// message.
+    /// message. The largest body is the largest any rank owns after the cut (O(P), not O(N)).
     fn near(&self) -> Vec<usize> {
-        let regions = &self.part.holding.regions;
+        let holding = &self.part.holding;
+        let regions = &holding.regions;
         let skin = self.whole.broad_phase().skin();
-        let r_max = self.whole.radii().iter().copied().fold(0.0, Real::max);
+        let r_max = holding.largest_owned.iter().copied().fold(0.0, Real::max);
         let reach = ghost_width(r_max, skin) + 2.0 * MOVE_ALLOWANCE_IN_SKINS * skin;
         let within = |q: &usize| gap(&regions[*q], &regions[self.rank]) <= reach;
         (0..regions.len()).filter(within).collect()
     }
 
     /// What this rank sends each rank (its own entry included, not sent).
-    fn outgoing(
-        &self,
-        near: &[usize],
-        owners: &NewOwners,
-    ) -> Result<Vec<Migrants>, DistributedError> {
+    fn outgoing(&self, near: &[usize], owners: &[u32]) -> Result<Vec<Migrants>, DistributedError> {
+        let (mut out, destinations) = self.outgoing_bodies(near, owners)?;
         let part = &self.part;
-        let holding = &part.holding;
-        let regions = &holding.regions;
-        let allowance = MOVE_ALLOWANCE_IN_SKINS * self.whole.broad_phase().skin();
-        let (bodies, loads) = (part.world.bodies(), part.world.loads());
-        let mut out = vec![Migrants::default(); regions.len()];
-        let mut destinations = vec![Vec::new(); part.ids.len()];
-        for i in (0..part.ids.len()).filter(|&i| part.owns(i)) {
-            let (gid, x, r) = (part.ids[i], &bodies[i].position, part.world.radii()[i]);
-            let owner = owners.of(regions, x, gid)?;
-            for &q in near {
-                if holding.holds(q, owner, x, r) {
-                    out[q].ids.push(gid as u32);
-                    let (force, torque) = (&loads.forces()[i], &loads.torques()[i]);
-                    pack_ghost(&bodies[i], force, torque, &mut out[q].states);
-                    destinations[i].push(q);
-                }
-            }
-            if !destinations[i].contains(&owner) {
-                return Err(DistributedError::HaloExceeded {
-                    moved: regions[self.rank].distance(x),
-                    allowance,
-                });
-            }
-        }
         let store = part.world.contacts();
         let global = |i: u32| part.ids[i as usize] as u32;
         for (key, state) in store.keys().iter().zip(store.states()) {
@@ -200,11 +204,50 @@ impl DistributedRun {
                     },
                 ),
             };
-            for &q in &destinations[lower as usize] {
-                out[q].entries.push((key, *state));
+            for &q in destinations.of(lower as usize) {
+                out[q as usize].entries.push((key, *state));
             }
         }
         Ok(out)
+    }
+
+    /// The bodies this rank sends each rank, and the ranks each of its bodies goes to.
+    fn outgoing_bodies(
+        &self,
+        near: &[usize],
+        owners: &[u32],
+    ) -> Result<(Vec<Migrants>, Destinations), DistributedError> {
+        let part = &self.part;
+        let holding = &part.holding;
+        let (bodies, loads) = (part.world.bodies(), part.world.loads());
+        let mut out = vec![Migrants::default(); holding.regions.len()];
+        let mut destinations = Destinations::with_bodies(part.ids.len());
+        let mut owners = owners.iter();
+        for i in 0..part.ids.len() {
+            destinations.next_body();
+            if !part.owns(i) {
+                continue;
+            }
+            let owner = *owners.next().expect("one owner per owned body") as usize;
+            let (gid, x, r) = (part.ids[i], &bodies[i].position, part.world.radii()[i]);
+            for &q in near.iter().filter(|&&q| holding.holds(q, owner, x, r)) {
+                let to = &mut out[q];
+                to.ids.push(gid as u32);
+                to.owners.push(owner as u32);
+                let (force, torque) = (&loads.forces()[i], &loads.torques()[i]);
+                pack_ghost(&bodies[i], force, torque, &mut to.states);
+                destinations.add(q);
+            }
+            if !destinations.of(i).contains(&(owner as u32)) {
+                let allowance = MOVE_ALLOWANCE_IN_SKINS * self.whole.broad_phase().skin();
+                return Err(DistributedError::HaloExceeded {
+                    moved: holding.regions[self.rank].distance(x),
+                    allowance,
+                });
+            }
+        }
+        destinations.next_body();
+        Ok((out, destinations))
     }
 
     /// The new part `world` (of global bodies `ids`) with the list one process built in this step: the
@@ -233,31 +276,29 @@ impl DistributedRun {
 
     /// This rank's new part from what every rank sent it (in rank order); `near`: the ranks messages were
     /// exchanged with (every ghost's owner is among them, and every rank that holds a body owned here).
-    fn assemble(
-        &mut self,
-        all: Vec<Migrants>,
-        near: &[usize],
-        owners_rule: &NewOwners,
-    ) -> Result<Part, DistributedError> {
-        let mut arrivals: Vec<(usize, &[Real])> = all
-            .iter()
-            .flat_map(|m| {
-                let ids = m.ids.iter().map(|&gid| gid as usize);
-                ids.zip(m.states.chunks_exact(GHOST_WORDS))
-            })
-            .collect();
+    fn assemble(&mut self, all: Vec<Migrants>, near: &[usize]) -> Part {
+        let count = all.iter().map(|m| m.ids.len()).sum();
+        let mut arrivals: Vec<(usize, u32, &[Real])> = Vec::with_capacity(count);
+        for m in &all {
+            let states = m.states.chunks_exact(GHOST_WORDS);
+            let bodies = m.ids.iter().zip(&m.owners).zip(states);
+            arrivals.extend(bodies.map(|((&gid, &owner), w)| (gid as usize, owner, w)));
+        }
         // Each rank's bodies and entries come in increasing order: a stable sort merges the runs.
-        arrivals.sort_by_key(|(gid, _)| *gid);
+        arrivals.sort_by_key(|(gid, _, _)| *gid);
         // The whole world is the template of the part (shapes, materials, names); its bodies are written
         // only where this rank holds them.
         self.whole.copy_walls_and_clock(&self.part.world);
-        for &(gid, w) in &arrivals {
+        for &(gid, _, w) in &arrivals {
             let (body, force, torque) = unpack_ghost(&self.whole.bodies()[gid], w);
             self.whole.copy_body_from_owner(gid, &body, &force, &torque);
         }
-        let ids: Vec<usize> = arrivals.iter().map(|(gid, _)| *gid).collect();
-        let mut entries: Vec<(ContactKey, ContactState)> =
-            all.into_iter().flat_map(|m| m.entries).collect();
+        let ids: Vec<usize> = arrivals.iter().map(|(gid, _, _)| *gid).collect();
+        let owners: Vec<usize> = arrivals.iter().map(|(_, o, _)| *o as usize).collect();
+        let mut entries = Vec::with_capacity(all.iter().map(|m| m.entries.len()).sum());
+        for m in all {
+            entries.extend(m.entries);
+        }
         entries.sort_by_key(|entry| entry.0);
         let touched = self.part.world.contacts().last_touched();
         let world = self
@@ -265,10 +306,6 @@ impl DistributedRun {
             .part_with_contacts(&ids, entries, touched, PartBroadPhase::Unbuilt);
         let holding = self.part.holding.clone();
         let positions: Vec<Point> = world.bodies().iter().map(|b| b.position).collect();
-        let mut owners = Vec::with_capacity(ids.len());
-        for (x, &gid) in positions.iter().zip(&ids) {
-            owners.push(owners_rule.of(&holding.regions, x, gid)?);
-        }
         let me = self.rank;
         let owned: Vec<bool> = owners.iter().map(|&o| o == me).collect();
         let mut world = self.carry_list_over(world, &ids);
@@ -291,8 +328,6 @@ impl DistributedRun {
             .filter(|&i| owned[i])
             .map(|i| positions[i])
             .collect();
-        Ok(Part::new(
-            world, ids, owned, sends, receives, holding, at_cut,
-        ))
+        Part::new(world, ids, owned, sends, receives, holding, at_cut)
     }
 }

@@ -95,8 +95,12 @@ impl Part {
 enum NextCut {
     /// Bisect the whole world again.
     Bisect,
-    /// Migrate bodies within the present subdomains; the largest bounding radius each rank owns after.
-    Migrate { largest_owned: Vec<Real> },
+    /// Migrate bodies within the present subdomains: the largest bounding radius each rank owns after,
+    /// and the new owner of each body this rank owns, in local order.
+    Migrate {
+        largest_owned: Vec<Real>,
+        owners: Vec<u32>,
+    },
 }
 
 /// A world stepped on every rank of `MPI_COMM_WORLD`.
@@ -271,7 +275,10 @@ impl DistributedRun {
         } else if part.consensus.last_rebuilt() {
             match self.check_before_cut()? {
                 NextCut::Bisect => self.rebisect()?,
-                NextCut::Migrate { largest_owned } => self.migrate(largest_owned)?,
+                NextCut::Migrate {
+                    largest_owned,
+                    owners,
+                } => self.migrate(largest_owned, owners)?,
             }
         } else {
             self.exchange_ghosts();
@@ -328,7 +335,8 @@ impl DistributedRun {
 
     /// Before a cut, one all-reduce of maxima: refuses to go on when a body moved beyond the ghost layer's
     /// allowance since the last cut; tells whether the owned counts are too uneven to migrate again (every
-    /// rank answers alike), and, for a migration, each rank's largest owned body after it.
+    /// rank answers alike), and, for a migration, each rank's largest owned body after it and the new
+    /// owners of this rank's bodies (found here once, and sent with the bodies).
     fn check_before_cut(&self) -> Result<NextCut, DistributedError> {
         let part = &self.part;
         let owned = (0..part.ids.len()).filter(|&i| part.owns(i));
@@ -341,15 +349,24 @@ impl DistributedRun {
         mine[0] = moved;
         mine[1] = part.at_cut.len() as Real;
         let regions = &part.holding.regions;
+        let mut owners = Vec::with_capacity(part.at_cut.len());
+        let mut unowned = None;
         for i in (0..part.ids.len()).filter(|&i| part.owns(i)) {
-            // A body without an owner (a non-finite centre) is refused by the migration itself.
-            if let Ok(q) = owner_of(regions, &part.world.bodies()[i].position, part.ids[i]) {
-                mine[2 + q] = Real::max(mine[2 + q], part.world.radii()[i]);
+            match owner_of(regions, &part.world.bodies()[i].position, part.ids[i]) {
+                Ok(q) => {
+                    mine[2 + q] = Real::max(mine[2 + q], part.world.radii()[i]);
+                    owners.push(q as u32);
+                }
+                // Refused after the all-reduce, which every rank must join.
+                Err(e) => unowned = unowned.or(Some(e)),
             }
         }
         let mut largest = vec![0.0; mine.len()];
         self.comm
             .all_reduce_into(&mine[..], &mut largest[..], SystemOperation::max());
+        if let Some(e) = unowned {
+            return Err(e);
+        }
         let allowance = MOVE_ALLOWANCE_IN_SKINS * self.whole.broad_phase().skin();
         if largest[0] > allowance {
             return Err(DistributedError::HaloExceeded {
@@ -362,6 +379,7 @@ impl DistributedRun {
             true => NextCut::Bisect,
             false => NextCut::Migrate {
                 largest_owned: largest.split_off(2),
+                owners,
             },
         })
     }
