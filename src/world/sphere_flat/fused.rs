@@ -115,20 +115,12 @@ impl SphereSim {
         let stale_test = self.list.stale_test(&self.planes);
         let list = &mut self.list;
         let blocks = &self.blocks;
+        let two_ended =
+            |ranges: &[Range<usize>]| ranges.iter().cloned().map(TwoEnded::new).collect();
         let job = Job {
-            middles: blocks.middles.iter().cloned().map(TwoEnded::new).collect(),
-            kick_middles: blocks
-                .kick_middles
-                .iter()
-                .cloned()
-                .map(TwoEnded::new)
-                .collect(),
-            drift_middles: blocks
-                .drift_middles
-                .iter()
-                .cloned()
-                .map(TwoEnded::new)
-                .collect(),
+            middles: two_ended(&blocks.middles),
+            kick_middles: two_ended(&blocks.kick_middles),
+            drift_middles: two_ended(&blocks.drift_middles),
             blocks,
             kin: PhaseSlice::new(&mut self.kin),
             spin: PhaseSlice::new(&mut self.spin),
@@ -179,13 +171,7 @@ impl SphereSim {
             _ => rayon::broadcast(|ctx| job.run(ctx.index())),
         };
 
-        // Stage timers as thread 0 saw the phases end.
-        let end = Instant::now();
-        let (drift_end, pairs_end) = ends
-            .first()
-            .map_or((end, end), |e| (e.drift_end, e.pairs_end));
-        report.counters.integrate += (drift_end - start) + (end - pairs_end);
-        report.counters.narrow += pairs_end.saturating_duration_since(drift_end);
+        record_stage_times(&ends, start, report);
         let mut stepped = Vec::with_capacity(ends.len());
         for (k, e) in ends.iter().enumerate() {
             if let (Some(seconds), Some(&weight)) = (e.block_seconds, blocks.block_weights.get(k)) {
@@ -206,22 +192,40 @@ impl SphereSim {
             .into_inner()
             .unwrap_or_else(|e| e.into_inner());
         self.outs_valid = true;
-        let mut non_finite: Option<(usize, &str)> = None;
-        let mut found = Found::default();
-        for (f, nf) in stepped {
-            found = found.merge(f);
-            // The lowest sphere's (see `Job::kick`).
-            non_finite = match (non_finite, nf) {
-                (Some(a), Some(b)) if b.0 < a.0 => Some(b),
-                (a, b) => a.or(b),
-            };
-        }
+        let (found, non_finite) = merged(stepped);
         Some(Fused::Stepped {
             found,
             non_finite,
             walls,
         })
     }
+}
+
+/// The stage timers of a fused step that began at `start`, as thread 0 saw its phases end.
+fn record_stage_times(ends: &[ThreadEnd], start: Instant, report: &mut StepReport) {
+    let end = Instant::now();
+    let (drift_end, pairs_end) = ends
+        .first()
+        .map_or((end, end), |e| (e.drift_end, e.pairs_end));
+    report.counters.integrate += (drift_end - start) + (end - pairs_end);
+    report.counters.narrow += pairs_end.saturating_duration_since(drift_end);
+}
+
+/// The threads' blocks of the pair loop merged, and the lowest sphere's first non-finite quantity (see
+/// `Job::kick`).
+fn merged(
+    stepped: Vec<(Found, Option<(usize, &'static str)>)>,
+) -> (Found, Option<(usize, &'static str)>) {
+    let mut non_finite: Option<(usize, &str)> = None;
+    let mut found = Found::default();
+    for (f, nf) in stepped {
+        found = found.merge(f);
+        non_finite = match (non_finite, nf) {
+            (Some(a), Some(b)) if b.0 < a.0 => Some(b),
+            (a, b) => a.or(b),
+        };
+    }
+    (found, non_finite)
 }
 
 /// One fused job: the arrays its phases share (see the module docs' table), the inputs they read, and

@@ -325,6 +325,34 @@ pub(super) struct BlockPart<'a> {
     pub(super) ledger: LedgerPart<'a>,
 }
 
+impl<'a> BlockPart<'a> {
+    /// The arrays of the first `pairs` pairs, `walls` body–wall pairs and `bodies` spheres, split off the
+    /// front.
+    pub(super) fn split_front(
+        &mut self,
+        pairs: usize,
+        walls: usize,
+        bodies: usize,
+    ) -> BlockPart<'a> {
+        fn front<'a, T>(slots: &mut &'a mut [T], n: usize) -> &'a mut [T] {
+            let (head, tail) = std::mem::take(slots).split_at_mut(n);
+            *slots = tail;
+            head
+        }
+        BlockPart {
+            histories: front(&mut self.histories, pairs),
+            in_contact: front(&mut self.in_contact, pairs),
+            outs: front(&mut self.outs, pairs),
+            wall_histories: front(&mut self.wall_histories, walls),
+            wall_in_contact: front(&mut self.wall_in_contact, walls),
+            wall_outs: front(&mut self.wall_outs, walls),
+            force: front(&mut self.force, bodies),
+            torque: front(&mut self.torque, bodies),
+            ledger: self.ledger.split_front(pairs, walls),
+        }
+    }
+}
+
 /// The ledger's slots of a run of pairs and of body–wall pairs ([`super::ledger::PairLedger`]).
 #[derive(Default)]
 pub(super) struct LedgerPart<'a> {
@@ -443,34 +471,45 @@ impl PairBlocks<'_> {
     /// The pair loop of one block, summing the loads of the spheres `own` names, in two halves per
     /// chunk of pairs ([`PairChunks`]); with `LEDGER`, booking each evaluated pair's ledger terms in its
     /// slot of `part.ledger` (one build of the loop per value, so that the loop without the ledger has
-    /// no test of it).
+    /// no test of it). The body pairs first, then the body–wall pairs; a pair without a law ends the loop.
     #[inline(always)]
     fn run_summing<const LEDGER: bool>(
         &self,
         first: usize,
-        part: BlockPart<'_>,
+        mut part: BlockPart<'_>,
         own: impl Fn(usize) -> bool,
     ) -> Found {
+        let mut found = Found::scattered();
+        part.force.fill(Vector::zeros());
+        part.torque.fill(Vector::zeros());
+        self.sum_body_pairs::<LEDGER>(first, &mut part, &own, &mut found);
+        if found.error.is_none() {
+            self.sum_wall_pairs::<LEDGER>(first, &mut part, &own, &mut found);
+        }
+        found
+    }
+
+    /// The body pairs of [`Self::run_summing`]; stops at the first pair without a law (`found.error`).
+    #[inline(always)]
+    fn sum_body_pairs<const LEDGER: bool>(
+        &self,
+        first: usize,
+        part: &mut BlockPart<'_>,
+        own: &impl Fn(usize) -> bool,
+        found: &mut Found,
+    ) {
         let BlockPart {
             histories,
             in_contact,
             outs,
-            wall_histories,
-            wall_in_contact,
-            wall_outs,
             force,
             torque,
             ledger,
+            ..
         } = part;
-        let (p0, q0) = (
-            self.row_start[first] as usize,
-            self.wall_start[first] as usize,
-        );
-        let mut found = Found::scattered();
+        let p0 = self.row_start[first] as usize;
         // A pair's terms when the loop sums them in pair order (`ledger.in_order`).
         let mut work = ContactWork::default();
-        force.fill(Vector::zeros());
-        torque.fill(Vector::zeros());
         let ctx = &self.ctx;
         let pairs = p0..p0 + histories.len();
         let (a, b, reach) = (
@@ -486,22 +525,16 @@ impl PairBlocks<'_> {
                 | u64::from(in_contact[k])
         }) {
             for k in listed {
-                let p = p0 + k;
                 let (i, j) = (a[k] as usize, b[k] as usize);
-                let (c, out) = (&self.constants[p], &mut outs[k]);
+                let (c, out) = (&self.constants[p0 + k], &mut outs[k]);
                 let (history, flag) = (&mut histories[k], &mut in_contact[k]);
-                let slot = if LEDGER {
-                    Some(LedgerSlot {
-                        last: &mut ledger.last[k],
-                        work: if ledger.in_order {
-                            &mut work
-                        } else {
-                            &mut ledger.work[k]
-                        },
-                    })
-                } else {
-                    None
-                };
+                let slot = LEDGER.then(|| LedgerSlot {
+                    last: &mut ledger.last[k],
+                    work: match ledger.in_order {
+                        true => &mut work,
+                        false => &mut ledger.work[k],
+                    },
+                });
                 let evaluated = ctx.body_pair(i, j, reach[k], c, history, flag, out, slot);
                 if LEDGER && ledger.in_order {
                     found.add_work(&std::mem::take(&mut work));
@@ -522,11 +555,35 @@ impl PairBlocks<'_> {
                     }
                     Err(e) => {
                         found.error = Some(e);
-                        return found;
+                        return;
                     }
                 }
             }
         }
+    }
+
+    /// The body–wall pairs of [`Self::run_summing`]; stops at the first pair without a law
+    /// (`found.wall_error`).
+    #[inline(always)]
+    fn sum_wall_pairs<const LEDGER: bool>(
+        &self,
+        first: usize,
+        part: &mut BlockPart<'_>,
+        own: &impl Fn(usize) -> bool,
+        found: &mut Found,
+    ) {
+        let BlockPart {
+            wall_histories,
+            wall_in_contact,
+            wall_outs,
+            force,
+            torque,
+            ledger,
+            ..
+        } = part;
+        let q0 = self.wall_start[first] as usize;
+        let mut work = ContactWork::default();
+        let ctx = &self.ctx;
         let walls = q0..q0 + wall_histories.len();
         let (wall_body, wall_of) = (&self.wall_body[walls.clone()], &self.wall_of[walls.clone()]);
         let wall_constants = &self.wall_constants[walls];
@@ -539,18 +596,13 @@ impl PairBlocks<'_> {
                 let (body, wall) = (wall_body[k], wall_of[k]);
                 let (i, c, out) = (body as usize, &wall_constants[k], &mut wall_outs[k]);
                 let (history, flag) = (&mut wall_histories[k], &mut wall_in_contact[k]);
-                let slot = if LEDGER {
-                    Some(LedgerSlot {
-                        last: &mut ledger.wall_last[k],
-                        work: if ledger.in_order {
-                            &mut work
-                        } else {
-                            &mut ledger.wall_work[k]
-                        },
-                    })
-                } else {
-                    None
-                };
+                let slot = LEDGER.then(|| LedgerSlot {
+                    last: &mut ledger.wall_last[k],
+                    work: match ledger.in_order {
+                        true => &mut work,
+                        false => &mut ledger.wall_work[k],
+                    },
+                });
                 let evaluated = ctx.wall_pair(wall as usize, i, c, history, flag, out, slot);
                 if LEDGER && ledger.in_order {
                     found.add_work(&std::mem::take(&mut work));
@@ -567,12 +619,11 @@ impl PairBlocks<'_> {
                     }
                     Err(e) => {
                         found.wall_error = Some(e);
-                        return found;
+                        return;
                     }
                 }
             }
         }
-        found
     }
 }
 

@@ -358,86 +358,55 @@ impl SphereSim {
             ledger: self.params.energy_ledger,
         };
         let pl = &mut self.pair_ledger;
-        if blocks.bodies.len() == 1 {
-            // One block of every sphere: the same pass without the test of which spheres it sums; it
-            // visits the pairs in pair order, so it sums the ledger's terms itself.
-            let ledger = LedgerPart {
+        let one_block = blocks.bodies.len() == 1;
+        // One block visits the pairs in pair order, so it sums the ledger's terms itself.
+        let ledger = match one_block {
+            true => LedgerPart {
                 in_order: true,
                 last: &mut pl.last,
                 wall_last: &mut pl.wall_last,
                 ..LedgerPart::default()
-            };
-            let found = pass.run_all(BlockPart {
-                histories: &mut list.histories,
-                in_contact: &mut list.in_contact,
-                outs: &mut self.out,
-                wall_histories: &mut list.wall_histories,
-                wall_in_contact: &mut list.wall_in_contact,
-                wall_outs: &mut self.wall_out,
-                force: &mut self.force,
-                torque: &mut self.torque,
-                ledger,
-            });
+            },
+            false => LedgerPart {
+                in_order: false,
+                last: &mut pl.last,
+                work: &mut pl.work,
+                wall_last: &mut pl.wall_last,
+                wall_work: &mut pl.wall_work,
+            },
+        };
+        let mut whole = BlockPart {
+            histories: &mut list.histories,
+            in_contact: &mut list.in_contact,
+            outs: &mut self.out,
+            wall_histories: &mut list.wall_histories,
+            wall_in_contact: &mut list.wall_in_contact,
+            wall_outs: &mut self.wall_out,
+            force: &mut self.force,
+            torque: &mut self.torque,
+            ledger,
+        };
+        if one_block {
+            // One block of every sphere: the same pass without the test of which spheres it sums.
+            let found = pass.run_all(whole);
             pl.summed = Some(found.work);
             self.outs_valid = true;
             // The wall warnings join the list here too: a step on one block reports its overlap
             // warnings against walls like any other.
             return found.finish();
         }
-        let mut ledger = LedgerPart {
-            in_order: false,
-            last: &mut pl.last,
-            work: &mut pl.work,
-            wall_last: &mut pl.wall_last,
-            wall_work: &mut pl.wall_work,
-        };
         // Split every array at the boundaries of the blocks and middles; thread k runs block k, then
         // the middle after it (the whole middle: no sharing out when the passes run one by one).
         let mut parts: Vec<Vec<(usize, BlockPart)>> =
             blocks.bodies.iter().map(|_| Vec::new()).collect();
-        {
-            let (mut h, mut c, mut o) = (
-                &mut list.histories[..],
-                &mut list.in_contact[..],
-                &mut self.out[..],
-            );
-            let (mut wh, mut wc, mut wo) = (
-                &mut list.wall_histories[..],
-                &mut list.wall_in_contact[..],
-                &mut self.wall_out[..],
-            );
-            let (mut f, mut t) = (&mut self.force[..], &mut self.torque[..]);
-            let mut thread = 0;
-            for (s, range) in blocks.segments().enumerate() {
-                let (first, last) = (range.start, range.end);
-                let pairs = (pass.row_start[last] - pass.row_start[first]) as usize;
-                let walls = (pass.wall_start[last] - pass.wall_start[first]) as usize;
-                let (h1, h2) = std::mem::take(&mut h).split_at_mut(pairs);
-                let (c1, c2) = std::mem::take(&mut c).split_at_mut(pairs);
-                let (o1, o2) = std::mem::take(&mut o).split_at_mut(pairs);
-                let (wh1, wh2) = std::mem::take(&mut wh).split_at_mut(walls);
-                let (wc1, wc2) = std::mem::take(&mut wc).split_at_mut(walls);
-                let (wo1, wo2) = std::mem::take(&mut wo).split_at_mut(walls);
-                let (f1, f2) = std::mem::take(&mut f).split_at_mut(last - first);
-                let (t1, t2) = std::mem::take(&mut t).split_at_mut(last - first);
-                (h, c, o, wh, wc, wo, f, t) = (h2, c2, o2, wh2, wc2, wo2, f2, t2);
-                parts[thread].push((
-                    first,
-                    BlockPart {
-                        histories: h1,
-                        in_contact: c1,
-                        outs: o1,
-                        wall_histories: wh1,
-                        wall_in_contact: wc1,
-                        wall_outs: wo1,
-                        force: f1,
-                        torque: t1,
-                        ledger: ledger.split_front(pairs, walls),
-                    },
-                ));
-                // Segments alternate block, middle: a middle closes its thread's list.
-                thread += s % 2;
-            }
+        let mut thread = 0;
+        for (s, range) in blocks.segments().enumerate() {
+            let (first, last) = (range.start, range.end);
+            let pairs = (pass.row_start[last] - pass.row_start[first]) as usize;
+            let walls = (pass.wall_start[last] - pass.wall_start[first]) as usize;
+            parts[thread].push((first, whole.split_front(pairs, walls, last - first)));
+            // Segments alternate block, middle: a middle closes its thread's list.
+            thread += s % 2;
         }
         let run = |segments: Vec<(usize, BlockPart)>| {
             segments

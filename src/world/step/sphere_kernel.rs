@@ -33,7 +33,7 @@ use rayon::prelude::*;
 use super::super::contact_store::{ContactKey, ContactState};
 use super::super::parallel::Worker;
 use super::super::skips;
-use super::super::world::World;
+use super::super::world::{Wall, World};
 use super::laws::{contact_law, overlap_law, Evaluated, PairInputs};
 use super::params::StepParams;
 use super::report::StepError;
@@ -149,130 +149,168 @@ pub(super) fn evaluate(
     out: &mut Evaluated,
     worker: &mut Worker,
 ) -> Option<Result<(), StepError>> {
-    let tol = &params.tolerances;
+    let at = Evaluation {
+        params,
+        pair,
+        previous_point,
+    };
     let counters = &mut worker.query;
     match key {
         ContactKey::Body { a, b } => {
             let (sa, sb) = (&spheres[a as usize], &spheres[b as usize]);
-            if !(sa.sphere && sb.sphere) {
-                return None;
-            }
-            let rejected = if params.skips.bounding_spheres {
-                skips::reject_by_bounding_spheres(
-                    &sa.position,
-                    sa.bound,
-                    &sb.position,
-                    sb.bound,
-                    sa.length_scale.max(sb.length_scale),
-                    tol,
-                    counters,
-                )
-            } else {
-                None
-            };
-            state.geometry = rejected_or(rejected, counters, |c| {
-                c.sphere_sphere += 1;
-                contact_sphere_sphere(&sa.position, sa.radius, &sb.position, sb.radius, tol)
-            });
-            if state.geometry.kind != ContactKind::Overlap {
-                return Some(separated_law(pair, key, state, previous_point, out));
-            }
-            let model = match pair.model(sa.material, sb.material) {
-                Ok(m) => m.for_contact_radii(Some(sa.radius), Some(sb.radius)),
-                Err(e) => return Some(Err(e)),
-            };
-            let effective_mass = match (sa.dynamic, sb.dynamic) {
-                (true, true) => sa.mass * sb.mass / (sa.mass + sb.mass),
-                (true, false) => sa.mass,
-                _ => sb.mass,
-            };
-            let point = &state.geometry.point;
-            let kinematics = ContactKinematics {
-                relative_velocity: sb.velocity_at(point) - sa.velocity_at(point),
-                effective_mass,
-                center_a: sa.position,
-                center_b: sb.position,
-                dt: pair.dt,
-            };
-            let scale = sa.length_scale.min(sb.length_scale);
-            if !pair.ledger {
-                lean_overlap_law(state, &model, &kinematics, scale, out);
-                return Some(Ok(()));
-            }
-            let dt = pair.dt;
-            overlap_law(
-                pair,
-                state,
-                || {
-                    sb.velocity_back_at(previous_point, dt)
-                        - sa.velocity_back_at(previous_point, dt)
-                },
-                &model,
-                &kinematics,
-                scale,
-                out,
-            );
-            Some(Ok(()))
+            (sa.sphere && sb.sphere).then(|| at.sphere_pair(key, sa, sb, state, out, counters))
         }
         ContactKey::Wall { body, wall } => {
             let s = &spheres[body as usize];
-            if !s.sphere {
-                return None;
-            }
             let w = &pair.world.walls[wall as usize];
-            let rejected = if params.skips.bounding_spheres {
-                skips::reject_wall_by_bounding_sphere(
-                    w.signed_distance(&s.position),
-                    &w.normal_world(),
-                    &s.position,
-                    s.bound,
-                    counters,
-                )
-            } else {
-                None
-            };
-            state.geometry = rejected_or(rejected, counters, |c| {
-                c.sphere_plane += 1;
-                contact_plane_sphere(
-                    &w.pose,
-                    w.plane.normal(),
-                    w.plane.offset(),
-                    &s.position,
-                    s.radius,
-                    tol,
-                )
-            });
-            if state.geometry.kind != ContactKind::Overlap {
-                return Some(separated_law(pair, key, state, previous_point, out));
-            }
-            let model = match pair.model(w.material, s.material) {
-                Ok(m) => m.for_contact_radii(None, Some(s.radius)),
-                Err(e) => return Some(Err(e)),
-            };
-            let g = &state.geometry;
-            let kinematics = ContactKinematics {
-                relative_velocity: s.velocity_at(&g.point) - w.velocity,
-                effective_mass: s.mass,
-                center_a: g.point_a,
-                center_b: s.position,
-                dt: pair.dt,
-            };
-            if !pair.ledger {
-                lean_overlap_law(state, &model, &kinematics, s.length_scale, out);
-                return Some(Ok(()));
-            }
-            let dt = pair.dt;
-            overlap_law(
-                pair,
-                state,
-                || s.velocity_back_at(previous_point, dt) - w.velocity,
-                &model,
-                &kinematics,
-                s.length_scale,
-                out,
-            );
-            Some(Ok(()))
+            s.sphere
+                .then(|| at.sphere_wall(key, w, s, state, out, counters))
         }
+    }
+}
+
+/// What every sphere pair of a step's evaluation reads: the step's parameters, the pair inputs and the
+/// pair's last contact point.
+struct Evaluation<'a> {
+    params: &'a StepParams,
+    pair: &'a PairInputs<'a>,
+    previous_point: &'a Point,
+}
+
+impl Evaluation<'_> {
+    /// [`evaluate`] for a pair of spheres `sa`, `sb`.
+    #[inline(always)]
+    fn sphere_pair(
+        &self,
+        key: ContactKey,
+        sa: &SphereBody,
+        sb: &SphereBody,
+        state: &mut ContactState,
+        out: &mut Evaluated,
+        counters: &mut QueryCounters,
+    ) -> Result<(), StepError> {
+        let (params, pair, previous_point) = (self.params, self.pair, self.previous_point);
+        let tol = &params.tolerances;
+        let rejected = if params.skips.bounding_spheres {
+            skips::reject_by_bounding_spheres(
+                &sa.position,
+                sa.bound,
+                &sb.position,
+                sb.bound,
+                sa.length_scale.max(sb.length_scale),
+                tol,
+                counters,
+            )
+        } else {
+            None
+        };
+        state.geometry = rejected_or(rejected, counters, |c| {
+            c.sphere_sphere += 1;
+            contact_sphere_sphere(&sa.position, sa.radius, &sb.position, sb.radius, tol)
+        });
+        if state.geometry.kind != ContactKind::Overlap {
+            return separated_law(pair, key, state, previous_point, out);
+        }
+        let model = match pair.model(sa.material, sb.material) {
+            Ok(m) => m.for_contact_radii(Some(sa.radius), Some(sb.radius)),
+            Err(e) => return Err(e),
+        };
+        let effective_mass = match (sa.dynamic, sb.dynamic) {
+            (true, true) => sa.mass * sb.mass / (sa.mass + sb.mass),
+            (true, false) => sa.mass,
+            _ => sb.mass,
+        };
+        let point = &state.geometry.point;
+        let kinematics = ContactKinematics {
+            relative_velocity: sb.velocity_at(point) - sa.velocity_at(point),
+            effective_mass,
+            center_a: sa.position,
+            center_b: sb.position,
+            dt: pair.dt,
+        };
+        let scale = sa.length_scale.min(sb.length_scale);
+        if !pair.ledger {
+            lean_overlap_law(state, &model, &kinematics, scale, out);
+            return Ok(());
+        }
+        let dt = pair.dt;
+        overlap_law(
+            pair,
+            state,
+            || sb.velocity_back_at(previous_point, dt) - sa.velocity_back_at(previous_point, dt),
+            &model,
+            &kinematics,
+            scale,
+            out,
+        );
+        Ok(())
+    }
+
+    /// [`evaluate`] for wall `w` and sphere `s`.
+    #[inline(always)]
+    fn sphere_wall(
+        &self,
+        key: ContactKey,
+        w: &Wall,
+        s: &SphereBody,
+        state: &mut ContactState,
+        out: &mut Evaluated,
+        counters: &mut QueryCounters,
+    ) -> Result<(), StepError> {
+        let (params, pair, previous_point) = (self.params, self.pair, self.previous_point);
+        let tol = &params.tolerances;
+        let rejected = if params.skips.bounding_spheres {
+            skips::reject_wall_by_bounding_sphere(
+                w.signed_distance(&s.position),
+                &w.normal_world(),
+                &s.position,
+                s.bound,
+                counters,
+            )
+        } else {
+            None
+        };
+        state.geometry = rejected_or(rejected, counters, |c| {
+            c.sphere_plane += 1;
+            contact_plane_sphere(
+                &w.pose,
+                w.plane.normal(),
+                w.plane.offset(),
+                &s.position,
+                s.radius,
+                tol,
+            )
+        });
+        if state.geometry.kind != ContactKind::Overlap {
+            return separated_law(pair, key, state, previous_point, out);
+        }
+        let model = match pair.model(w.material, s.material) {
+            Ok(m) => m.for_contact_radii(None, Some(s.radius)),
+            Err(e) => return Err(e),
+        };
+        let g = &state.geometry;
+        let kinematics = ContactKinematics {
+            relative_velocity: s.velocity_at(&g.point) - w.velocity,
+            effective_mass: s.mass,
+            center_a: g.point_a,
+            center_b: s.position,
+            dt: pair.dt,
+        };
+        if !pair.ledger {
+            lean_overlap_law(state, &model, &kinematics, s.length_scale, out);
+            return Ok(());
+        }
+        let dt = pair.dt;
+        overlap_law(
+            pair,
+            state,
+            || s.velocity_back_at(previous_point, dt) - w.velocity,
+            &model,
+            &kinematics,
+            s.length_scale,
+            out,
+        );
+        Ok(())
     }
 }
 
