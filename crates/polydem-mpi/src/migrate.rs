@@ -10,7 +10,7 @@ use polydem::math::{Point, Real};
 use polydem::world::{ContactKey, ContactState, PartBroadPhase, World};
 use serde::{Deserialize, Serialize};
 
-use crate::decomposition::{bisect, Region};
+use crate::decomposition::{bisect, owner_of, Region};
 use crate::error::DistributedError;
 use crate::exchange::{all_gather, exchange_with_near, pack_ghost, unpack_ghost, GHOST_WORDS};
 use crate::plan::{ghost_width, Holding, MOVE_ALLOWANCE_IN_SKINS};
@@ -79,6 +79,37 @@ impl Destinations {
             .get(i + 1)
             .map_or(self.ranks.len(), |&e| e as usize);
         &self.ranks[start..end]
+    }
+}
+
+/// The owner after a cut of each body of a part: given for the bodies it owns (in local order), found
+/// under the part's regions for its ghosts when first asked (the rule every rank applies alike).
+struct NewOwners {
+    owner: Vec<Option<u32>>,
+    known: Vec<bool>,
+}
+
+impl NewOwners {
+    fn new(part: &Part, owners: &[u32]) -> Self {
+        let mut owner = vec![None; part.ids.len()];
+        let owned = (0..part.ids.len()).filter(|&i| part.owns(i));
+        for (i, &o) in owned.zip(owners) {
+            owner[i] = Some(o);
+        }
+        let known = (0..part.ids.len()).map(|i| part.owns(i)).collect();
+        Self { owner, known }
+    }
+
+    /// The new owner of local body `i` (`None` for a non-finite centre, which its owner refuses).
+    fn of(&mut self, part: &Part, i: usize) -> Option<u32> {
+        if !self.known[i] {
+            let x = &part.world.bodies()[i].position;
+            self.owner[i] = owner_of(&part.holding.regions, x, part.ids[i])
+                .ok()
+                .map(|q| q as u32);
+            self.known[i] = true;
+        }
+        self.owner[i]
     }
 }
 
@@ -181,16 +212,21 @@ impl DistributedRun {
         (0..regions.len()).filter(within).collect()
     }
 
-    /// What this rank sends each rank (its own entry included, not sent).
+    /// What this rank sends each rank (its own entry included, not sent). A contact entry goes to the
+    /// new owners of its bodies only, among the ranks its lower body goes to: a part evaluates the pairs
+    /// of the bodies it owns ([`World::keep_pairs_of_owned`]), and its store drops any other entry at its
+    /// next step.
     fn outgoing(&self, near: &[usize], owners: &[u32]) -> Result<Vec<Migrants>, DistributedError> {
         let (mut out, destinations) = self.outgoing_bodies(near, owners)?;
         let part = &self.part;
+        let mut new_owner = NewOwners::new(part, owners);
         let store = part.world.contacts();
         let global = |i: u32| part.ids[i as usize] as u32;
         for (key, state) in store.keys().iter().zip(store.states()) {
-            let (lower, key) = match *key {
+            let (lower, upper, key) = match *key {
                 ContactKey::Body { a, b } => (
                     a,
+                    Some(b),
                     ContactKey::Body {
                         a: global(a),
                         b: global(b),
@@ -198,14 +234,18 @@ impl DistributedRun {
                 ),
                 ContactKey::Wall { body, wall } => (
                     body,
+                    None,
                     ContactKey::Wall {
                         body: global(body),
                         wall,
                     },
                 ),
             };
+            let upper_owner = upper.and_then(|b| new_owner.of(part, b as usize));
             for &q in destinations.of(lower as usize) {
-                out[q as usize].entries.push((key, *state));
+                if Some(q) == new_owner.of(part, lower as usize) || Some(q) == upper_owner {
+                    out[q as usize].entries.push((key, *state));
+                }
             }
         }
         Ok(out)
