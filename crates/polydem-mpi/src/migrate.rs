@@ -263,19 +263,19 @@ impl DistributedRun {
         let mut out = vec![Migrants::default(); holding.regions.len()];
         let mut destinations = Destinations::with_bodies(part.ids.len());
         let mut owners = owners.iter();
-        for i in 0..part.ids.len() {
+        for (i, (&gid, body)) in part.ids.iter().zip(bodies).enumerate() {
             destinations.next_body();
             if !part.owns(i) {
                 continue;
             }
             let owner = *owners.next().expect("one owner per owned body") as usize;
-            let (gid, x, r) = (part.ids[i], &bodies[i].position, part.world.radii()[i]);
+            let (x, r) = (&body.position, part.world.radii()[i]);
             for &q in near.iter().filter(|&&q| holding.holds(q, owner, x, r)) {
                 let to = &mut out[q];
                 to.ids.push(gid as u32);
                 to.owners.push(owner as u32);
                 let (force, torque) = (&loads.forces()[i], &loads.torques()[i]);
-                pack_ghost(&bodies[i], force, torque, &mut to.states);
+                pack_ghost(body, force, torque, &mut to.states);
                 destinations.add(q);
             }
             if !destinations.of(i).contains(&(owner as u32)) {
