@@ -25,8 +25,8 @@
 //! - **Rebuilds** are agreed ([`consensus`]): the two largest moves of the whole world decide, as in one
 //!   process. After a rebuild the parts are cut again by migration (`migrate`): each owner sends its
 //!   bodies to the near ranks that hold them next (the owner of the subdomain the centre lies in, the
-//!   ranks whose ghost layer it lies in), with the contact entries it answers for (tangential springs,
-//!   solver caches), one message each way between near ranks. A part takes over the list its step just
+//!   ranks whose ghost layer it lies in), and the contact entries it answers for (tangential springs,
+//!   solver caches) to the new owners of their bodies, one message each way between near ranks. A part takes over the list its step just
 //!   built where few bodies are new to it, and drops the pairs of two ghosts (they only move ghosts).
 //!
 //! - **Restarts** ([`DistributedRun::new`]): a world restored from a checkpoint (written by any number of

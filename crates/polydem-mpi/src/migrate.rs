@@ -1,9 +1,9 @@
 //! A cut by migration: after a rebuild, each rank sends each body it owns to the ranks that hold it next
 //! (its new owner, the rank whose subdomain holds its centre, and the ranks whose ghost layer it lies in),
-//! and each contact entry it answers for to the ranks that receive the entry's lower body. The subdomains
-//! stay those of the last bisection, so a rank exchanges with its neighbours only and no rank holds the
-//! whole state. Each part holds what a cut of the whole state with these subdomains would give it, so the
-//! bits stay one process's.
+//! and each contact entry it answers for to the new owners of the entry's bodies (the ranks that evaluate
+//! the pair). The subdomains stay those of the last bisection, so a rank exchanges with its neighbours
+//! only and no rank holds the whole state. Each part holds the bodies a cut of the whole state with these
+//! subdomains would give it and the entries of every pair it evaluates, so the bits stay one process's.
 
 use mpi::traits::*;
 use polydem::math::{Point, Real};

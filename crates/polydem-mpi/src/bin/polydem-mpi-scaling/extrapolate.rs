@@ -36,8 +36,8 @@ pub fn calibrations<'a>(
          - rebuild agreement: an all-reduce of 4 f64 (either flag and the two largest moves), \
          ⌈log₂P⌉ (α + 32/β);\n\
          - a cut every k steps. **Today a cut migrates bodies between near ranks**: each owner sends \
-         its bodies and the contact entries it answers for to the ranks that hold them next, one \
-         message each way, and each rank assembles its own part: C = 26 α + b g/β + ⌈log₂P⌉ α + \
+         its bodies to the ranks that hold them next and the contact entries it answers for to the \
+         new owners of their bodies, one message each way, and each rank assembles its own part: C = 26 α + b g/β + ⌈log₂P⌉ α + \
          (t_cut + t_plan)(n + g) (an all-reduce checks the moves and the balance). A **whole-world \
          cut** (every rank gathers the whole state and plans every rank's part, the first design; a \
          re-bisection, when the owned counts drift apart by more than 10 %, now gathers the centres only \
