@@ -72,15 +72,54 @@ impl Region {
 pub struct Decomposition {
     /// Region of each rank.
     pub regions: Vec<Region>,
+    /// The cuts that made the regions, to find a point's owner in O(log P).
+    pub cuts: Cuts,
     /// Owning rank of each body (by global index).
     pub owner: Vec<u32>,
 }
 
-/// The rank whose subdomain owns body `gid` with its centre at `x` ([`Region::owns`]; a non-finite
-/// centre lies in none).
-pub fn owner_of(regions: &[Region], x: &Point, gid: usize) -> Result<usize, DistributedError> {
-    let inside = regions.iter().position(|r| r.owns(x, gid as u32));
-    inside.ok_or(DistributedError::NotFinite { body: gid })
+/// One cut of the bisection: the bodies whose key along `axis` sorts below `first_above` go to the
+/// lower ⌈count/2⌉ of the node's ranks.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Cut {
+    axis: usize,
+    plane: Real,
+    first_above: Key,
+}
+
+/// The bisection's cuts in pre-order (a node, its lower subtree, its upper subtree): P − 1 cuts for P
+/// ranks. The owner of a point is found by walking down them, the same rule as [`Region::owns`] asked
+/// of every region, in O(log P) instead of O(P).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Cuts {
+    nodes: Vec<Cut>,
+}
+
+impl Cuts {
+    /// The rank that owns body `gid` with its centre at `x` (a non-finite centre lies in no region).
+    pub fn owner_of(&self, x: &Point, gid: usize) -> Result<usize, DistributedError> {
+        if !(0..3).all(|axis| x[axis].is_finite()) {
+            return Err(DistributedError::NotFinite { body: gid });
+        }
+        let (mut node, mut first, mut count) = (0, 0, self.nodes.len() + 1);
+        while count > 1 {
+            let cut = &self.nodes[node];
+            let lower_ranks = count.div_ceil(2);
+            let coordinate = x[cut.axis];
+            let below = coordinate < cut.plane
+                || coordinate == cut.plane && (coordinate, gid as u32) < cut.first_above;
+            if below {
+                node += 1;
+                count = lower_ranks;
+            } else {
+                // The lower subtree has lower_ranks − 1 cuts.
+                node += lower_ranks;
+                first += lower_ranks;
+                count -= lower_ranks;
+            }
+        }
+        Ok(first)
+    }
 }
 
 /// Cuts the bodies at `centres` into `ranks` subdomains of nearly equal body counts.
@@ -91,35 +130,30 @@ pub fn bisect(centres: &[Point], ranks: usize) -> Result<Decomposition, Distribu
             bodies: centres.len(),
         });
     }
-    let mut regions = vec![Region::everything(); ranks];
-    let mut owner = vec![0u32; centres.len()];
     let mut ids: Vec<usize> = (0..centres.len()).collect();
-    cut(
-        centres,
-        &mut ids,
-        0,
-        ranks,
-        Region::everything(),
-        &mut regions,
-        &mut owner,
-    );
-    Ok(Decomposition { regions, owner })
+    let mut made = Decomposition {
+        regions: vec![Region::everything(); ranks],
+        cuts: Cuts::default(),
+        owner: vec![0u32; centres.len()],
+    };
+    cut(centres, &mut ids, 0, ranks, Region::everything(), &mut made);
+    Ok(made)
 }
 
-/// Cuts the bodies `ids` inside `region` among ranks `first..first + count`.
+/// Cuts the bodies `ids` inside `region` among ranks `first..first + count`, adding the regions, cuts
+/// and owners to `made`.
 fn cut(
     centres: &[Point],
     ids: &mut [usize],
     first: usize,
     count: usize,
     region: Region,
-    regions: &mut [Region],
-    owner: &mut [u32],
+    made: &mut Decomposition,
 ) {
     if count == 1 {
-        regions[first] = region;
+        made.regions[first] = region;
         for &i in ids.iter() {
-            owner[i] = first as u32;
+            made.owner[i] = first as u32;
         }
         return;
     }
@@ -138,21 +172,26 @@ fn cut(
     let first_above = ids
         .get(split)
         .map_or((Real::INFINITY, 0), |&hi| (centres[hi][axis], hi as u32));
+    made.cuts.nodes.push(Cut {
+        axis,
+        plane,
+        first_above,
+    });
     let (mut lower, mut upper) = (region, region);
     lower.max[axis] = plane;
     lower.max_first[axis] = first_above;
     upper.min[axis] = plane;
     upper.min_first[axis] = first_above;
     let (below, above) = ids.split_at_mut(split);
-    cut(centres, below, first, lower_ranks, lower, regions, owner);
+    cut(centres, below, first, lower_ranks, lower, made);
+    let upper_ranks = count - lower_ranks;
     cut(
         centres,
         above,
         first + lower_ranks,
-        count - lower_ranks,
+        upper_ranks,
         upper,
-        regions,
-        owner,
+        made,
     );
 }
 
@@ -206,12 +245,20 @@ mod tests {
                 );
                 // The lattice puts whole layers on the cutting planes: the region rule must split them
                 // as the bisection did.
-                let by_rule = owner_of(&d.regions, &centres[i], i).expect("finite centre");
+                let by_rule = owner_by_regions(&d.regions, &centres[i], i);
                 assert_eq!(
-                    by_rule, r as usize,
+                    by_rule,
+                    Some(r as usize),
                     "P {ranks}: body {i} at {:?} (on a plane of {:?}) owned by {r} after the bisection, \
-                     by {by_rule} under the regions' rule",
+                     by {by_rule:?} under the regions' rule",
                     centres[i], d.regions[r as usize]
+                );
+                let by_cuts = d.cuts.owner_of(&centres[i], i).expect("finite centre");
+                assert_eq!(
+                    by_cuts, r as usize,
+                    "P {ranks}: body {i} at {:?} owned by {r} after the bisection, by {by_cuts} down \
+                     the cuts {:?}",
+                    centres[i], d.cuts
                 );
             }
             let (lo, hi) = (counts.iter().min().unwrap(), counts.iter().max().unwrap());
@@ -221,6 +268,62 @@ mod tests {
                 centres.len(),
                 1 + centres.len() / 32
             );
+        }
+    }
+
+    /// The regions' rule asked of every region: the rank of the one region that owns the body.
+    fn owner_by_regions(regions: &[Region], x: &Point, gid: usize) -> Option<usize> {
+        let owning: Vec<usize> = (0..regions.len())
+            .filter(|&q| regions[q].owns(x, gid as u32))
+            .collect();
+        assert!(
+            owning.len() <= 1,
+            "body {gid} at {x:?} lies in regions {owning:?}"
+        );
+        owning.first().copied()
+    }
+
+    /// Walking down the cuts gives the rank the regions' rule gives, for any point of space: on the
+    /// lattice's planes (any global index), between them, far outside the bodies; and no rank for a
+    /// non-finite centre.
+    #[test]
+    fn the_cuts_find_the_owner_the_regions_give() {
+        let centres = lattice(7);
+        let probes = [-1e9, -0.5, 0.0, 1.0, 2.5, 3.0, 3.5, 6.0, 1e9];
+        for ranks in 1..=7 {
+            let d = bisect(&centres, ranks).expect("P ≤ bodies");
+            assert_eq!(
+                d.cuts.nodes.len(),
+                ranks - 1,
+                "P {ranks}: cuts {:?}",
+                d.cuts
+            );
+            let mut points = Vec::new();
+            for &x in &probes {
+                for &y in &probes {
+                    points.extend(probes.iter().map(|&z| Point::new(x, y, z)));
+                }
+            }
+            for (k, x) in points.into_iter().enumerate() {
+                for gid in [0, k % 343, 171, 342, 1000] {
+                    let by_cuts = d.cuts.owner_of(&x, gid).ok();
+                    let by_rule = owner_by_regions(&d.regions, &x, gid);
+                    assert_eq!(
+                        by_cuts, by_rule,
+                        "P {ranks}: body {gid} at {x:?}: {by_cuts:?} down the cuts {:?}, {by_rule:?} \
+                         under the regions {:?}",
+                        d.cuts, d.regions
+                    );
+                }
+            }
+            for bad in [Real::NAN, Real::INFINITY] {
+                let x = Point::new(1.0, bad, 2.0);
+                let err = d.cuts.owner_of(&x, 5).expect_err("non-finite centre");
+                assert!(
+                    matches!(err, DistributedError::NotFinite { body: 5 }),
+                    "{err}"
+                );
+            }
         }
     }
 

@@ -10,7 +10,7 @@ use polydem::math::{Point, Real};
 use polydem::world::{ContactKey, ContactState, PartBroadPhase, World};
 use serde::{Deserialize, Serialize};
 
-use crate::decomposition::{bisect, owner_of, Region};
+use crate::decomposition::{bisect, Region};
 use crate::error::DistributedError;
 use crate::exchange::{all_gather, exchange_with_near, pack_ghost, unpack_ghost, GHOST_WORDS};
 use crate::plan::{ghost_width, Holding, MOVE_ALLOWANCE_IN_SKINS};
@@ -83,33 +83,43 @@ impl Destinations {
 }
 
 /// The owner after a cut of each body of a part: given for the bodies it owns (in local order), found
-/// under the part's regions for its ghosts when first asked (the rule every rank applies alike).
+/// under the part's cuts for its ghosts when first asked (the rule every rank applies alike).
 struct NewOwners {
-    owner: Vec<Option<u32>>,
-    known: Vec<bool>,
+    owner: Vec<NewOwner>,
+}
+
+#[derive(Clone, Copy, PartialEq)]
+enum NewOwner {
+    /// A ghost not asked about yet.
+    Unknown,
+    Rank(u32),
+    /// A ghost whose centre is not finite (its owner refuses it).
+    Nowhere,
 }
 
 impl NewOwners {
     fn new(part: &Part, owners: &[u32]) -> Self {
-        let mut owner = vec![None; part.ids.len()];
+        let mut owner = vec![NewOwner::Unknown; part.ids.len()];
         let owned = (0..part.ids.len()).filter(|&i| part.owns(i));
         for (i, &o) in owned.zip(owners) {
-            owner[i] = Some(o);
+            owner[i] = NewOwner::Rank(o);
         }
-        let known = (0..part.ids.len()).map(|i| part.owns(i)).collect();
-        Self { owner, known }
+        Self { owner }
     }
 
-    /// The new owner of local body `i` (`None` for a non-finite centre, which its owner refuses).
+    /// The new owner of local body `i` (`None` for a non-finite centre).
     fn of(&mut self, part: &Part, i: usize) -> Option<u32> {
-        if !self.known[i] {
+        if self.owner[i] == NewOwner::Unknown {
             let x = &part.world.bodies()[i].position;
-            self.owner[i] = owner_of(&part.holding.regions, x, part.ids[i])
-                .ok()
-                .map(|q| q as u32);
-            self.known[i] = true;
+            self.owner[i] = match part.holding.cuts.owner_of(x, part.ids[i]) {
+                Ok(q) => NewOwner::Rank(q as u32),
+                Err(_) => NewOwner::Nowhere,
+            };
         }
-        self.owner[i]
+        match self.owner[i] {
+            NewOwner::Rank(q) => Some(q),
+            _ => None,
+        }
     }
 }
 
@@ -148,8 +158,8 @@ impl DistributedRun {
         let ranks = self.comm.size() as usize;
         let decomposition = bisect(&centres, ranks)?;
         let skin = self.whole.broad_phase().skin();
+        self.part.holding = Holding::new(&decomposition, self.whole.radii(), skin);
         let owner = decomposition.owner;
-        self.part.holding = Holding::new(decomposition.regions, &owner, self.whole.radii(), skin);
         let part = &self.part;
         let owners: Vec<u32> = (0..part.ids.len())
             .filter(|&i| part.owns(i))

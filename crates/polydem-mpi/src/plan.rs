@@ -11,7 +11,7 @@
 
 use polydem::math::{Point, Real};
 
-use crate::decomposition::{bisect, Decomposition, Region};
+use crate::decomposition::{bisect, Cuts, Decomposition, Region};
 use crate::error::DistributedError;
 
 /// The move (in skins) a body may make between two cuts of the subdomains.
@@ -34,6 +34,8 @@ fn margin(skin: Real) -> Real {
 pub struct Holding {
     /// Every rank's subdomain.
     pub regions: Vec<Region>,
+    /// The cuts that made them: the owner of a point in O(log P).
+    pub cuts: Cuts,
     /// Per rank, the largest bounding radius (m) of the bodies it owns (0 when it owns none).
     pub largest_owned: Vec<Real>,
     /// The skin (m) of the world's list.
@@ -41,15 +43,22 @@ pub struct Holding {
 }
 
 impl Holding {
-    /// The rule for the owners `owner` (rank of each body) of bodies of bounding radii `radii`.
-    pub fn new(regions: Vec<Region>, owner: &[u32], radii: &[Real], skin: Real) -> Self {
+    /// The rule for the subdomains of `decomposition`, with its owners of bodies of bounding radii
+    /// `radii`.
+    pub fn new(decomposition: &Decomposition, radii: &[Real], skin: Real) -> Self {
+        let Decomposition {
+            regions,
+            cuts,
+            owner,
+        } = decomposition;
         let mut largest_owned = vec![0.0; regions.len()];
         for (&o, &r) in owner.iter().zip(radii) {
             let largest = &mut largest_owned[o as usize];
             *largest = Real::max(*largest, r);
         }
         Self {
-            regions,
+            regions: regions.clone(),
+            cuts: cuts.clone(),
             largest_owned,
             skin,
         }
@@ -87,7 +96,7 @@ impl Plan {
     ) -> Result<Self, DistributedError> {
         let decomposition = bisect(centres, ranks)?;
         let owner = &decomposition.owner;
-        let holding = Holding::new(decomposition.regions.clone(), owner, radii, skin);
+        let holding = Holding::new(&decomposition, radii, skin);
         let parts = (0..ranks)
             .map(|rank| {
                 let held =

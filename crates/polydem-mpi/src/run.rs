@@ -19,7 +19,6 @@ use polydem::world::{
 };
 
 use crate::consensus::Consensus;
-use crate::decomposition::owner_of;
 use crate::error::DistributedError;
 use crate::exchange::{
     all_gather, exchange_ghost_states, pack_ghost, unpack_ghost, RunTraffic, GHOST_WORDS,
@@ -348,11 +347,11 @@ impl DistributedRun {
         let mut mine = vec![0.0; 2 + ranks];
         mine[0] = moved;
         mine[1] = part.at_cut.len() as Real;
-        let regions = &part.holding.regions;
+        let cuts = &part.holding.cuts;
         let mut owners = Vec::with_capacity(part.at_cut.len());
         let mut unowned = None;
         for i in (0..part.ids.len()).filter(|&i| part.owns(i)) {
-            match owner_of(regions, &part.world.bodies()[i].position, part.ids[i]) {
+            match cuts.owner_of(&part.world.bodies()[i].position, part.ids[i]) {
                 Ok(q) => {
                     mine[2 + q] = Real::max(mine[2 + q], part.world.radii()[i]);
                     owners.push(q as u32);
