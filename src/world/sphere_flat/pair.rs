@@ -339,29 +339,20 @@ impl PairContext<'_> {
         let (point_a, point_b) =
             sphere_sphere_points(&ka.position, c.radius_a, &kb.position, c.radius_b, &normal);
         let point = nalgebra::center(&point_a, &point_b);
-        let relative_velocity = kb.velocity_at(&point) - ka.velocity_at(&point);
-        let previous = ledger.as_ref().map(|slot| slot.previous(history));
-        let response = law.respond(
+        let overlapping = Overlapping {
             depth,
-            &normal,
-            &point,
-            &relative_velocity,
-            &ka.position,
-            &kb.position,
-            self.dt,
-            history,
-        );
-        if let (Some(slot), Some(previous)) = (ledger, previous) {
-            let v = &relative_velocity;
-            slot.book(&previous, velocity_back, &normal, point, &response, v, dt);
-        }
-        *out = PairOut::overlapping(&response, depth);
-        *in_contact = true;
+            normal,
+            point,
+            relative_velocity: kb.velocity_at(&point) - ka.velocity_at(&point),
+            center_a: ka.position,
+            center_b: kb.position,
+        };
+        overlapping.respond(law, dt, history, in_contact, out, ledger, velocity_back);
         Ok(Some(depth / c.scale))
     }
 
-    /// Whether the centre of sphere `i` is at least its radius above wall `w`: the first test of
-    /// [`PairContext::wall_pair`], asked ahead of it as [`PairContext::centres_apart`].
+    /// Whether the centre of sphere `i` is at least its radius above wall `w`: a pair that
+    /// [`PairContext::wall_pair`] finds separated, asked ahead of it as [`PairContext::centres_apart`].
     #[inline(always)]
     pub(crate) fn wall_apart(&self, w: usize, i: usize) -> bool {
         self.walls[w].height(&self.kin[i].position) >= self.props[i].radius
@@ -386,18 +377,8 @@ impl PairContext<'_> {
         let dt = self.dt;
         let velocity_back = |x: &Point| k.velocity_back_at(x, dt) - wall.velocity;
         let height = wall.height(&k.position);
-        if height >= p.radius {
-            separated(
-                history,
-                in_contact,
-                ledger,
-                c.law.as_ref(),
-                velocity_back,
-                dt,
-            );
-            return Ok(None);
-        }
         let depth = p.radius - height;
+        // At or above the radius (depth ≤ 0), or an overlap within the touching band: separated.
         if !(depth > c.touch && depth > 0.0) {
             separated(
                 history,
@@ -415,25 +396,71 @@ impl PairContext<'_> {
         let n = wall.normal;
         let (point_a, point_b) = plane_sphere_points(&k.position, p.radius, &n, height);
         let point = nalgebra::center(&point_a, &point_b);
-        let relative_velocity = k.velocity_at(&point) - wall.velocity;
-        let previous = ledger.as_ref().map(|slot| slot.previous(history));
-        let response = law.respond(
+        let overlapping = Overlapping {
             depth,
-            &n,
-            &point,
-            &relative_velocity,
-            &point_a,
-            &k.position,
-            self.dt,
+            normal: n,
+            point,
+            relative_velocity: k.velocity_at(&point) - wall.velocity,
+            center_a: point_a,
+            center_b: k.position,
+        };
+        overlapping.respond(law, dt, history, in_contact, out, ledger, velocity_back);
+        Ok(Some(depth / (2.0 * p.radius)))
+    }
+}
+
+/// An overlapping candidate as its law takes it: overlap (m), normal (A to B), contact point, the
+/// velocity of B relative to A there, and the points the torques on A and B are taken about.
+struct Overlapping {
+    depth: Real,
+    normal: Vector,
+    point: Point,
+    relative_velocity: Vector,
+    center_a: Point,
+    center_b: Point,
+}
+
+impl Overlapping {
+    /// The law's response written to `out` ([`PreparedModel::respond`], the spring `history` advanced
+    /// over `dt`), the pair flagged in contact; with `ledger`, its terms booked ([`LedgerSlot::book`],
+    /// `velocity_back` as there).
+    #[allow(clippy::too_many_arguments)]
+    #[inline(always)]
+    fn respond(
+        &self,
+        law: &PreparedModel,
+        dt: Real,
+        history: &mut TangentialHistory,
+        in_contact: &mut bool,
+        out: &mut PairOut,
+        ledger: Option<LedgerSlot<'_>>,
+        velocity_back: impl FnOnce(&Point) -> Vector,
+    ) {
+        let previous = ledger.as_ref().map(|slot| slot.previous(history));
+        let (normal, v) = (&self.normal, &self.relative_velocity);
+        let response = law.respond(
+            self.depth,
+            normal,
+            &self.point,
+            v,
+            &self.center_a,
+            &self.center_b,
+            dt,
             history,
         );
         if let (Some(slot), Some(previous)) = (ledger, previous) {
-            let v = &relative_velocity;
-            slot.book(&previous, velocity_back, &n, point, &response, v, dt);
+            slot.book(
+                &previous,
+                velocity_back,
+                normal,
+                self.point,
+                &response,
+                v,
+                dt,
+            );
         }
-        *out = PairOut::overlapping(&response, depth);
+        *out = PairOut::overlapping(&response, self.depth);
         *in_contact = true;
-        Ok(Some(depth / (2.0 * p.radius)))
     }
 }
 

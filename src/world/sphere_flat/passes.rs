@@ -476,155 +476,283 @@ impl PairBlocks<'_> {
     fn run_summing<const LEDGER: bool>(
         &self,
         first: usize,
-        mut part: BlockPart<'_>,
+        part: BlockPart<'_>,
         own: impl Fn(usize) -> bool,
     ) -> Found {
         let mut found = Found::scattered();
-        part.force.fill(Vector::zeros());
-        part.torque.fill(Vector::zeros());
-        self.sum_body_pairs::<LEDGER>(first, &mut part, &own, &mut found);
-        if found.error.is_none() {
-            self.sum_wall_pairs::<LEDGER>(first, &mut part, &own, &mut found);
-        }
-        found
-    }
-
-    /// The body pairs of [`Self::run_summing`]; stops at the first pair without a law (`found.error`).
-    #[inline(always)]
-    fn sum_body_pairs<const LEDGER: bool>(
-        &self,
-        first: usize,
-        part: &mut BlockPart<'_>,
-        own: &impl Fn(usize) -> bool,
-        found: &mut Found,
-    ) {
         let BlockPart {
             histories,
             in_contact,
             outs,
-            force,
-            torque,
-            ledger,
-            ..
-        } = part;
-        let p0 = self.row_start[first] as usize;
-        // A pair's terms when the loop sums them in pair order (`ledger.in_order`).
-        let mut work = ContactWork::default();
-        let ctx = &self.ctx;
-        let pairs = p0..p0 + histories.len();
-        let (a, b, reach) = (
-            &self.a[pairs.clone()],
-            &self.b[pairs.clone()],
-            &self.reach[pairs],
-        );
-        let mut chunks = PairChunks::new(histories.len());
-        while let Some(listed) = chunks.next(|k| {
-            // Not apart, or in contact until now (its spring is released by `body_pair`): as
-            // integers, so that no branch is taken on either.
-            u64::from(!ctx.centres_apart(a[k] as usize, b[k] as usize, reach[k]))
-                | u64::from(in_contact[k])
-        }) {
-            for k in listed {
-                let (i, j) = (a[k] as usize, b[k] as usize);
-                let (c, out) = (&self.constants[p0 + k], &mut outs[k]);
-                let (history, flag) = (&mut histories[k], &mut in_contact[k]);
-                let slot = LEDGER.then(|| LedgerSlot {
-                    last: &mut ledger.last[k],
-                    work: match ledger.in_order {
-                        true => &mut work,
-                        false => &mut ledger.work[k],
-                    },
-                });
-                let evaluated = ctx.body_pair(i, j, reach[k], c, history, flag, out, slot);
-                if LEDGER && ledger.in_order {
-                    found.add_work(&std::mem::take(&mut work));
-                }
-                match evaluated {
-                    Ok(None) => {}
-                    Ok(Some(ratio)) => {
-                        if own(i) {
-                            force[i - first] -= out.force_on_b;
-                            torque[i - first] += out.torque_on_a;
-                        }
-                        if own(j) {
-                            force[j - first] += out.force_on_b;
-                            torque[j - first] += out.torque_on_b;
-                        }
-                        let key = ContactKey::Body { a: a[k], b: b[k] };
-                        found.note(out.depth, ratio, key, self.fraction);
-                    }
-                    Err(e) => {
-                        found.error = Some(e);
-                        return;
-                    }
-                }
-            }
-        }
-    }
-
-    /// The body–wall pairs of [`Self::run_summing`]; stops at the first pair without a law
-    /// (`found.wall_error`).
-    #[inline(always)]
-    fn sum_wall_pairs<const LEDGER: bool>(
-        &self,
-        first: usize,
-        part: &mut BlockPart<'_>,
-        own: &impl Fn(usize) -> bool,
-        found: &mut Found,
-    ) {
-        let BlockPart {
             wall_histories,
             wall_in_contact,
             wall_outs,
             force,
             torque,
             ledger,
-            ..
         } = part;
+        force.fill(Vector::zeros());
+        torque.fill(Vector::zeros());
+        let mut sums = BlockSums {
+            first,
+            own,
+            force,
+            torque,
+            fraction: self.fraction,
+            found: &mut found,
+        };
+        let p0 = self.row_start[first] as usize;
+        let pairs = p0..p0 + histories.len();
+        let bodies = BodyPairs {
+            ctx: &self.ctx,
+            a: &self.a[pairs.clone()],
+            b: &self.b[pairs.clone()],
+            reach: &self.reach[pairs.clone()],
+            constants: &self.constants[pairs],
+        };
+        let slots = PairSlots {
+            histories,
+            in_contact,
+            outs,
+            last: ledger.last,
+            work: ledger.work,
+            in_order: ledger.in_order,
+        };
+        if let Err(e) = sum_pairs::<LEDGER>(&bodies, slots, &mut sums) {
+            found.error = Some(e);
+            return found;
+        }
         let q0 = self.wall_start[first] as usize;
-        let mut work = ContactWork::default();
-        let ctx = &self.ctx;
         let walls = q0..q0 + wall_histories.len();
-        let (wall_body, wall_of) = (&self.wall_body[walls.clone()], &self.wall_of[walls.clone()]);
-        let wall_constants = &self.wall_constants[walls];
-        let mut chunks = PairChunks::new(wall_histories.len());
-        while let Some(listed) = chunks.next(|k| {
-            u64::from(!ctx.wall_apart(wall_of[k] as usize, wall_body[k] as usize))
-                | u64::from(wall_in_contact[k])
-        }) {
-            for k in listed {
-                let (body, wall) = (wall_body[k], wall_of[k]);
-                let (i, c, out) = (body as usize, &wall_constants[k], &mut wall_outs[k]);
-                let (history, flag) = (&mut wall_histories[k], &mut wall_in_contact[k]);
-                let slot = LEDGER.then(|| LedgerSlot {
-                    last: &mut ledger.wall_last[k],
-                    work: match ledger.in_order {
-                        true => &mut work,
-                        false => &mut ledger.wall_work[k],
-                    },
-                });
-                let evaluated = ctx.wall_pair(wall as usize, i, c, history, flag, out, slot);
-                if LEDGER && ledger.in_order {
-                    found.add_work(&std::mem::take(&mut work));
-                }
-                match evaluated {
-                    Ok(None) => {}
-                    Ok(Some(ratio)) => {
-                        if own(i) {
-                            force[i - first] += out.force_on_b;
-                            torque[i - first] += out.torque_on_b;
-                        }
-                        let key = ContactKey::Wall { body, wall };
-                        found.note(out.depth, ratio, key, self.fraction);
-                    }
-                    Err(e) => {
-                        found.wall_error = Some(e);
-                        return;
-                    }
-                }
+        let walls = WallPairs {
+            ctx: &self.ctx,
+            body: &self.wall_body[walls.clone()],
+            wall: &self.wall_of[walls.clone()],
+            constants: &self.wall_constants[walls],
+        };
+        let slots = PairSlots {
+            histories: wall_histories,
+            in_contact: wall_in_contact,
+            outs: wall_outs,
+            last: ledger.wall_last,
+            work: ledger.wall_work,
+            in_order: ledger.in_order,
+        };
+        if let Err(e) = sum_pairs::<LEDGER>(&walls, slots, &mut sums) {
+            found.wall_error = Some(e);
+        }
+        found
+    }
+}
+
+/// The per-pair slots of one kind of listed pair of a block: springs, flags, outputs and the ledger's
+/// slots (empty when the ledger is off).
+struct PairSlots<'p> {
+    histories: &'p mut [TangentialHistory],
+    in_contact: &'p mut [bool],
+    outs: &'p mut [PairOut],
+    last: &'p mut [LastContact],
+    work: &'p mut [ContactWork],
+    /// Whether the terms are summed in pair order as the loop goes ([`LedgerPart::in_order`]).
+    in_order: bool,
+}
+
+/// Where a block's pair loop sums: the loads of the spheres `own` names (block-local from `first`),
+/// and what it found.
+struct BlockSums<'s, Own> {
+    first: usize,
+    own: Own,
+    force: &'s mut [Vector],
+    torque: &'s mut [Vector],
+    /// The overlap ratio above which a contact is warned about.
+    fraction: Real,
+    found: &'s mut Found,
+}
+
+impl<Own: Fn(usize) -> bool> BlockSums<'_, Own> {
+    /// Adds `force` and `torque` to sphere `i` if the block sums its loads.
+    #[inline(always)]
+    fn add(&mut self, i: usize, force: Vector, torque: Vector) {
+        if (self.own)(i) {
+            self.force[i - self.first] += force;
+            self.torque[i - self.first] += torque;
+        }
+    }
+
+    /// Adds the reaction to `force` (−force) and `torque` to sphere `i` if the block sums its loads.
+    #[inline(always)]
+    fn add_reaction(&mut self, i: usize, force: Vector, torque: Vector) {
+        if (self.own)(i) {
+            self.force[i - self.first] -= force;
+            self.torque[i - self.first] += torque;
+        }
+    }
+}
+
+/// One kind of listed pair (sphere–sphere, wall–sphere) of a block, as [`sum_pairs`] walks it.
+trait ListedPairs {
+    /// 1 when pair `k` must be evaluated: its bodies are not apart, or it was in contact until now (its
+    /// spring is then released); as an integer, so that no branch is taken on it.
+    fn must_evaluate(&self, k: usize, in_contact: bool) -> u64;
+
+    /// Pair `k` with its slots: `Some(overlap ratio)` when it overlaps ([`PairContext::body_pair`]).
+    fn evaluate(
+        &self,
+        k: usize,
+        history: &mut TangentialHistory,
+        in_contact: &mut bool,
+        out: &mut PairOut,
+        ledger: Option<LedgerSlot<'_>>,
+    ) -> Result<Option<Real>, StepError>;
+
+    /// Adds the loads `out` of overlapping pair `k` to its spheres in `sums`.
+    fn add_loads<Own: Fn(usize) -> bool>(&self, k: usize, out: &PairOut, sums: &mut BlockSums<Own>);
+
+    fn key(&self, k: usize) -> ContactKey;
+}
+
+/// The sphere pairs of a block.
+struct BodyPairs<'a> {
+    ctx: &'a PairContext<'a>,
+    a: &'a [u32],
+    b: &'a [u32],
+    reach: &'a [Real],
+    constants: &'a [PairConstants],
+}
+
+impl ListedPairs for BodyPairs<'_> {
+    #[inline(always)]
+    fn must_evaluate(&self, k: usize, in_contact: bool) -> u64 {
+        let (a, b) = (self.a[k] as usize, self.b[k] as usize);
+        u64::from(!self.ctx.centres_apart(a, b, self.reach[k])) | u64::from(in_contact)
+    }
+
+    #[inline(always)]
+    fn evaluate(
+        &self,
+        k: usize,
+        history: &mut TangentialHistory,
+        in_contact: &mut bool,
+        out: &mut PairOut,
+        ledger: Option<LedgerSlot<'_>>,
+    ) -> Result<Option<Real>, StepError> {
+        let (a, b) = (self.a[k] as usize, self.b[k] as usize);
+        let c = &self.constants[k];
+        self.ctx
+            .body_pair(a, b, self.reach[k], c, history, in_contact, out, ledger)
+    }
+
+    #[inline(always)]
+    fn add_loads<Own: Fn(usize) -> bool>(
+        &self,
+        k: usize,
+        out: &PairOut,
+        sums: &mut BlockSums<Own>,
+    ) {
+        sums.add_reaction(self.a[k] as usize, out.force_on_b, out.torque_on_a);
+        sums.add(self.b[k] as usize, out.force_on_b, out.torque_on_b);
+    }
+
+    #[inline(always)]
+    fn key(&self, k: usize) -> ContactKey {
+        ContactKey::Body {
+            a: self.a[k],
+            b: self.b[k],
+        }
+    }
+}
+
+/// The wall–sphere pairs of a block.
+struct WallPairs<'a> {
+    ctx: &'a PairContext<'a>,
+    body: &'a [u32],
+    wall: &'a [u32],
+    constants: &'a [WallConstants],
+}
+
+impl ListedPairs for WallPairs<'_> {
+    #[inline(always)]
+    fn must_evaluate(&self, k: usize, in_contact: bool) -> u64 {
+        let (w, i) = (self.wall[k] as usize, self.body[k] as usize);
+        u64::from(!self.ctx.wall_apart(w, i)) | u64::from(in_contact)
+    }
+
+    #[inline(always)]
+    fn evaluate(
+        &self,
+        k: usize,
+        history: &mut TangentialHistory,
+        in_contact: &mut bool,
+        out: &mut PairOut,
+        ledger: Option<LedgerSlot<'_>>,
+    ) -> Result<Option<Real>, StepError> {
+        let (w, i) = (self.wall[k] as usize, self.body[k] as usize);
+        let c = &self.constants[k];
+        self.ctx
+            .wall_pair(w, i, c, history, in_contact, out, ledger)
+    }
+
+    #[inline(always)]
+    fn add_loads<Own: Fn(usize) -> bool>(
+        &self,
+        k: usize,
+        out: &PairOut,
+        sums: &mut BlockSums<Own>,
+    ) {
+        sums.add(self.body[k] as usize, out.force_on_b, out.torque_on_b);
+    }
+
+    #[inline(always)]
+    fn key(&self, k: usize) -> ContactKey {
+        ContactKey::Wall {
+            body: self.body[k],
+            wall: self.wall[k],
+        }
+    }
+}
+
+/// The pair loop over one kind of listed pair: the pairs each chunk must evaluate ([`PairChunks`]),
+/// in pair order, their loads summed and their contacts noted in `sums`; with `LEDGER`, each pair's
+/// terms booked in its slot (or summed in pair order). Stops at the first pair without a law.
+#[inline(always)]
+fn sum_pairs<const LEDGER: bool>(
+    pairs: &impl ListedPairs,
+    slots: PairSlots<'_>,
+    sums: &mut BlockSums<impl Fn(usize) -> bool>,
+) -> Result<(), StepError> {
+    let PairSlots {
+        histories,
+        in_contact,
+        outs,
+        last,
+        work: works,
+        in_order,
+    } = slots;
+    // A pair's terms when the loop sums them in pair order (`in_order`).
+    let mut work = ContactWork::default();
+    let mut chunks = PairChunks::new(histories.len());
+    while let Some(listed) = chunks.next(|k| pairs.must_evaluate(k, in_contact[k])) {
+        for k in listed {
+            let slot = LEDGER.then(|| LedgerSlot {
+                last: &mut last[k],
+                work: match in_order {
+                    true => &mut work,
+                    false => &mut works[k],
+                },
+            });
+            let out = &mut outs[k];
+            let evaluated = pairs.evaluate(k, &mut histories[k], &mut in_contact[k], out, slot);
+            if LEDGER && in_order {
+                sums.found.add_work(&std::mem::take(&mut work));
+            }
+            if let Some(ratio) = evaluated? {
+                pairs.add_loads(k, out, sums);
+                let fraction = sums.fraction;
+                sums.found.note(out.depth, ratio, pairs.key(k), fraction);
             }
         }
     }
+    Ok(())
 }
 
 /// The pairs of a block in chunks of 64, listing the pairs of each chunk that the pair loop must
