@@ -229,15 +229,13 @@ impl Evaluation<'_> {
             dt: pair.dt,
         };
         let scale = sa.length_scale.min(sb.length_scale);
-        if !pair.ledger {
-            lean_overlap_law(state, &model, &kinematics, scale, out);
-            return Ok(());
-        }
         let dt = pair.dt;
-        overlap_law(
+        let previous_velocity =
+            || sb.velocity_back_at(previous_point, dt) - sa.velocity_back_at(previous_point, dt);
+        sphere_overlap_law(
             pair,
             state,
-            || sb.velocity_back_at(previous_point, dt) - sa.velocity_back_at(previous_point, dt),
+            previous_velocity,
             &model,
             &kinematics,
             scale,
@@ -296,18 +294,16 @@ impl Evaluation<'_> {
             center_b: s.position,
             dt: pair.dt,
         };
-        if !pair.ledger {
-            lean_overlap_law(state, &model, &kinematics, s.length_scale, out);
-            return Ok(());
-        }
         let dt = pair.dt;
-        overlap_law(
+        let previous_velocity = || s.velocity_back_at(previous_point, dt) - w.velocity;
+        let scale = s.length_scale;
+        sphere_overlap_law(
             pair,
             state,
-            || s.velocity_back_at(previous_point, dt) - w.velocity,
+            previous_velocity,
             &model,
             &kinematics,
-            s.length_scale,
+            scale,
             out,
         );
         Ok(())
@@ -336,6 +332,33 @@ fn separated_law(
     state.damping_force = Vector::zeros();
     out.clear_separated();
     Ok(())
+}
+
+/// The end of stage 5 for an overlapping sphere candidate: [`overlap_law`] with the ledger on, else
+/// [`lean_overlap_law`] (arguments as [`overlap_law`]'s).
+#[inline(always)]
+fn sphere_overlap_law(
+    pair: &PairInputs,
+    state: &mut ContactState,
+    previous_velocity: impl FnOnce() -> Vector,
+    model: &ContactModel,
+    kinematics: &ContactKinematics,
+    scale: Real,
+    out: &mut Evaluated,
+) {
+    if pair.ledger {
+        overlap_law(
+            pair,
+            state,
+            previous_velocity,
+            model,
+            kinematics,
+            scale,
+            out,
+        );
+    } else {
+        lean_overlap_law(state, model, kinematics, scale, out);
+    }
 }
 
 /// The end of stage 5 for an overlapping sphere candidate when the ledger is off: [`overlap_law`] without
