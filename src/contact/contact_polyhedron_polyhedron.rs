@@ -55,6 +55,19 @@ pub struct PairCache {
     pub has_face: bool,
 }
 
+impl PairCache {
+    /// Keeps EPA's terminal face (`normal`, frame 1, and its vertex pairs) of an overlap `depth`, and the
+    /// search vector the next query starts GJK from: the normal scaled by the depth, at least the
+    /// touching band `touch`.
+    #[inline(always)]
+    fn keep_face(&mut self, depth: Real, normal: &Vector, face: [[u32; 2]; 3], touch: Real) {
+        self.dir = -normal * depth.abs().max(touch);
+        self.normal = *normal;
+        self.face = face;
+        self.has_face = true;
+    }
+}
+
 /// Converts frame-1 features to a world-frame [`ContactGeometry`].
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn geometry_to_world(
@@ -157,16 +170,12 @@ where
             normal,
             point_a,
             point_b,
-        } => geometry_to_world(
-            pos1,
-            ContactKind::Separated,
-            0.0,
-            distance,
-            &normal,
-            &point_a,
-            &point_b,
-            SolverStatus::Converged,
-        ),
+        } => {
+            let (kind, status) = (ContactKind::Separated, SolverStatus::Converged);
+            geometry_to_world(
+                pos1, kind, 0.0, distance, &normal, &point_a, &point_b, status,
+            )
+        }
         GjkOutcome::Contact => {
             let er = epa(pair, &simplex, scale, tol, scratch);
             counters.epa_runs += 1;
@@ -179,25 +188,14 @@ where
                     point_b,
                     face,
                 } => {
-                    cache.dir = -normal * depth.abs().max(touch);
-                    cache.normal = normal;
-                    cache.face = face;
-                    cache.has_face = true;
+                    cache.keep_face(depth, &normal, face, touch);
                     let (kind, d) = if depth > touch {
                         (ContactKind::Overlap, depth)
                     } else {
                         (ContactKind::Touching, 0.0)
                     };
-                    geometry_to_world(
-                        pos1,
-                        kind,
-                        d,
-                        0.0,
-                        &normal,
-                        &point_a,
-                        &point_b,
-                        SolverStatus::Converged,
-                    )
+                    let status = SolverStatus::Converged;
+                    geometry_to_world(pos1, kind, d, 0.0, &normal, &point_a, &point_b, status)
                 }
                 EpaOutcome::MaxIterations => fallback(SolverStatus::FallbackAfterMaxIterations),
                 EpaOutcome::Degenerate(_why) => {

@@ -506,46 +506,51 @@ fn mesh_vtu<M: MeshView + ?Sized>(
     format: VtkEncoding,
     items: &[(usize, usize, &M)],
 ) -> PieceCounts {
-    let bodies: Vec<usize> = items.iter().map(|(i, _, _)| *i).collect();
-    let position: std::collections::HashMap<usize, usize> =
-        bodies.iter().enumerate().map(|(k, &i)| (i, k)).collect();
-    let poly = |i: usize| items[position[&i]].2;
-    let label = |i: usize| items[position[&i]].1;
-    let points: usize = bodies.iter().map(|&i| poly(i).vertices().len()).sum();
-    let cells: usize = bodies.iter().map(|&i| poly(i).num_faces()).sum();
+    let points: usize = items.iter().map(|(_, _, m)| m.vertices().len()).sum();
+    let cells: usize = items.iter().map(|(_, _, m)| m.num_faces()).sum();
     let counts = PieceCounts { points, cells };
     begin_piece(out, counts, format);
-
     out.push_str("      <Points>\n");
     data_array(out, format, "Points", "Real", 3, |s| {
-        for &i in &bodies {
+        for &(i, _, mesh) in items {
             let pose = world.pose(i);
-            for v in poly(i).vertices() {
+            for v in mesh.vertices() {
                 s.vec(&(pose * v).coords);
             }
         }
     });
     out.push_str("      </Points>\n");
+    mesh_cells(out, format, items, cells);
+    mesh_cell_data(out, world, format, items);
+    mesh_point_data(out, world, format, items);
+    end_piece(out);
+    counts
+}
 
+/// The `<Cells>` of [`mesh_vtu`]: one polygon per face, `cells` in all.
+fn mesh_cells<M: MeshView + ?Sized>(
+    out: &mut String,
+    format: VtkEncoding,
+    items: &[(usize, usize, &M)],
+    cells: usize,
+) {
     out.push_str("      <Cells>\n");
     data_array(out, format, "connectivity", "Int32", 1, |s| {
         let mut base = 0usize;
-        for &i in &bodies {
-            let p = poly(i);
-            for f in 0..p.num_faces() {
-                for &v in p.face_vertices(f) {
+        for &(_, _, mesh) in items {
+            for f in 0..mesh.num_faces() {
+                for &v in mesh.face_vertices(f) {
                     s.int(base + v as usize);
                 }
             }
-            base += p.vertices().len();
+            base += mesh.vertices().len();
         }
     });
     data_array(out, format, "offsets", "Int32", 1, |s| {
         let mut end = 0usize;
-        for &i in &bodies {
-            let p = poly(i);
-            for f in 0..p.num_faces() {
-                end += p.face_vertices(f).len();
+        for &(_, _, mesh) in items {
+            for f in 0..mesh.num_faces() {
+                end += mesh.face_vertices(f).len();
                 s.int(end);
             }
         }
@@ -556,49 +561,62 @@ fn mesh_vtu<M: MeshView + ?Sized>(
         }
     });
     out.push_str("      </Cells>\n");
+}
 
-    // Per-body values repeated on each face of the body.
-    let faces = |i: usize| poly(i).num_faces();
+/// The `<CellData>` of [`mesh_vtu`]: per-body values repeated on each face of the body.
+fn mesh_cell_data<M: MeshView + ?Sized>(
+    out: &mut String,
+    world: &World,
+    format: VtkEncoding,
+    items: &[(usize, usize, &M)],
+) {
     out.push_str("      <CellData Scalars=\"body\" Vectors=\"velocity\">\n");
     data_array(out, format, "body", "Int32", 1, |s| {
-        for &i in &bodies {
-            for _ in 0..faces(i) {
-                s.int(label(i));
+        for &(_, label, mesh) in items {
+            for _ in 0..mesh.num_faces() {
+                s.int(label);
             }
         }
     });
     for (name, value) in body_vectors() {
         data_array(out, format, name, "Real", 3, |s| {
-            for &i in &bodies {
+            for &(i, _, mesh) in items {
                 let v = value(world, i);
-                for _ in 0..faces(i) {
+                for _ in 0..mesh.num_faces() {
                     s.vec(&v);
                 }
             }
         });
     }
     out.push_str("      </CellData>\n");
+}
 
+/// The `<PointData>` of [`mesh_vtu`]: the body label and the velocity of the material point at each
+/// vertex.
+fn mesh_point_data<M: MeshView + ?Sized>(
+    out: &mut String,
+    world: &World,
+    format: VtkEncoding,
+    items: &[(usize, usize, &M)],
+) {
     out.push_str("      <PointData Scalars=\"body\" Vectors=\"point_velocity\">\n");
     data_array(out, format, "body", "Int32", 1, |s| {
-        for &i in &bodies {
-            for _ in poly(i).vertices() {
-                s.int(label(i));
+        for &(_, label, mesh) in items {
+            for _ in mesh.vertices() {
+                s.int(label);
             }
         }
     });
     data_array(out, format, "point_velocity", "Real", 3, |s| {
-        for &i in &bodies {
+        for &(i, _, mesh) in items {
             let pose = world.pose(i);
             let body = &world.bodies()[i];
-            for v in poly(i).vertices() {
+            for v in mesh.vertices() {
                 s.vec(&body.velocity_at(&(pose * v)));
             }
         }
     });
     out.push_str("      </PointData>\n");
-    end_piece(out);
-    counts
 }
 
 /// The `.vtu` text of the spherical bodies (see the module docs).

@@ -201,81 +201,14 @@ impl ConvexPolyhedron {
         faces: &[Vec<u32>],
         extent: Real,
     ) -> Result<(ConvexPolyhedron, Pose), ShapeError> {
-        let mass = polyhedron_mass_properties(vertices, faces);
-        // Volume distinguishable from the round-off of the tetrahedral sums (~ε·extent³).
-        let volume_tol = VOLUME_ROUNDOFF_FACTOR * Real::EPSILON * extent.powi(3);
-        if mass.volume.is_nan() || mass.volume <= volume_tol {
-            return Err(ShapeError::ZeroVolume {
-                volume: mass.volume,
-                tolerance: volume_tol,
-            });
-        }
-        // First estimate of the principal frame, then one refinement computed in that frame, where the
-        // solid is centred and axis-aligned: it removes the residual centroid offset and off-diagonal
-        // inertia of the first pass (measured: local centroid of a 1e-3-thin needle 5e-15 L instead of
-        // 3e-13 L). Thin solids stay ill-conditioned at ε·L⁴/V whatever the frame.
-        let first = Pose::from_parts(mass.centroid.coords.into(), mass.principal_axes);
-        let local: Vec<Point> = vertices
-            .iter()
-            .map(|v| first.inverse_transform_point(v))
-            .collect();
-        let refined = polyhedron_mass_properties(&local, faces);
-        let pose = first * Pose::from_parts(refined.centroid.coords.into(), refined.principal_axes);
+        let (pose, mass) = refined_principal_frame(vertices, faces, extent)?;
         let local: Vec<Point> = vertices
             .iter()
             .map(|v| pose.inverse_transform_point(v))
             .collect();
-        let mass = refined;
-
-        let mut face_starts = Vec::with_capacity(faces.len() + 1);
-        let mut face_indices = Vec::new();
-        let mut face_normals = Vec::with_capacity(faces.len());
-        let mut face_offsets = Vec::with_capacity(faces.len());
-        face_starts.push(0);
-        for (f, face) in faces.iter().enumerate() {
-            let Some((normal, offset)) = supporting_plane(&local, face) else {
-                return Err(ShapeError::MalformedFace {
-                    face: f,
-                    reason: "zero area".to_string(),
-                });
-            };
-            face_indices.extend_from_slice(face);
-            face_starts.push(face_indices.len() as u32);
-            face_normals.push(normal);
-            face_offsets.push(offset);
-        }
-
-        let mut edges: Vec<[u32; 2]> = Vec::with_capacity(face_indices.len() / 2);
-        for face in faces {
-            for k in 0..face.len() {
-                let (a, b) = (face[k], face[(k + 1) % face.len()]);
-                if a < b {
-                    edges.push([a, b]);
-                }
-            }
-        }
-        edges.sort_unstable();
-        edges.dedup();
-
-        let mut degree = vec![0u32; local.len()];
-        for &[a, b] in &edges {
-            degree[a as usize] += 1;
-            degree[b as usize] += 1;
-        }
-        let mut adjacency_starts = Vec::with_capacity(local.len() + 1);
-        adjacency_starts.push(0u32);
-        for d in &degree {
-            adjacency_starts.push(adjacency_starts.last().copied().unwrap_or(0) + d);
-        }
-        let mut fill: Vec<u32> = adjacency_starts[..local.len()].to_vec();
-        let mut adjacency = vec![0u32; 2 * edges.len()];
-        for &[a, b] in &edges {
-            adjacency[fill[a as usize] as usize] = b;
-            fill[a as usize] += 1;
-            adjacency[fill[b as usize] as usize] = a;
-            fill[b as usize] += 1;
-        }
-
+        let planes = FacePlanes::of(&local, faces)?;
+        let edges = edges_of(faces);
+        let (adjacency_starts, adjacency) = vertex_adjacency(local.len(), &edges);
         let bounding_radius = local.iter().map(|v| v.coords.norm()).fold(0.0, Real::max);
         let mass_properties = MassProperties {
             volume: mass.volume,
@@ -287,10 +220,10 @@ impl ConvexPolyhedron {
         let shape = ConvexPolyhedron {
             columns: VertexColumns::new(&local),
             vertices: local,
-            face_starts,
-            face_indices,
-            face_normals,
-            face_offsets,
+            face_starts: planes.starts,
+            face_indices: planes.indices,
+            face_normals: planes.normals,
+            face_offsets: planes.offsets,
             edges,
             adjacency_starts,
             adjacency,
@@ -542,6 +475,110 @@ fn validate_topology(num_vertices: usize, faces: &[Vec<u32>]) -> Result<(), Shap
         });
     }
     Ok(())
+}
+
+/// The principal frame of the solid with these `vertices` and `faces` (pose of the frame in the input
+/// frame) and its mass properties in that frame; refused when its volume is not distinguishable from
+/// round-off at size `extent`.
+fn refined_principal_frame(
+    vertices: &[Point],
+    faces: &[Vec<u32>],
+    extent: Real,
+) -> Result<(Pose, MassProperties), ShapeError> {
+    let mass = polyhedron_mass_properties(vertices, faces);
+    // Volume distinguishable from the round-off of the tetrahedral sums (~ε·extent³).
+    let volume_tol = VOLUME_ROUNDOFF_FACTOR * Real::EPSILON * extent.powi(3);
+    if mass.volume.is_nan() || mass.volume <= volume_tol {
+        return Err(ShapeError::ZeroVolume {
+            volume: mass.volume,
+            tolerance: volume_tol,
+        });
+    }
+    // First estimate of the principal frame, then one refinement computed in that frame, where the
+    // solid is centred and axis-aligned: it removes the residual centroid offset and off-diagonal
+    // inertia of the first pass (measured: local centroid of a 1e-3-thin needle 5e-15 L instead of
+    // 3e-13 L). Thin solids stay ill-conditioned at ε·L⁴/V whatever the frame.
+    let first = Pose::from_parts(mass.centroid.coords.into(), mass.principal_axes);
+    let local: Vec<Point> = vertices
+        .iter()
+        .map(|v| first.inverse_transform_point(v))
+        .collect();
+    let refined = polyhedron_mass_properties(&local, faces);
+    let pose = first * Pose::from_parts(refined.centroid.coords.into(), refined.principal_axes);
+    Ok((pose, refined))
+}
+
+/// The faces as index lists with offsets (CSR) and their outward planes.
+struct FacePlanes {
+    starts: Vec<u32>,
+    indices: Vec<u32>,
+    normals: Vec<Vector>,
+    offsets: Vec<Real>,
+}
+
+impl FacePlanes {
+    /// The planes of `faces` over the vertices `local`; a face of zero area is refused.
+    fn of(local: &[Point], faces: &[Vec<u32>]) -> Result<Self, ShapeError> {
+        let mut planes = FacePlanes {
+            starts: Vec::with_capacity(faces.len() + 1),
+            indices: Vec::new(),
+            normals: Vec::with_capacity(faces.len()),
+            offsets: Vec::with_capacity(faces.len()),
+        };
+        planes.starts.push(0);
+        for (f, face) in faces.iter().enumerate() {
+            let Some((normal, offset)) = supporting_plane(local, face) else {
+                return Err(ShapeError::MalformedFace {
+                    face: f,
+                    reason: "zero area".to_string(),
+                });
+            };
+            planes.indices.extend_from_slice(face);
+            planes.starts.push(planes.indices.len() as u32);
+            planes.normals.push(normal);
+            planes.offsets.push(offset);
+        }
+        Ok(planes)
+    }
+}
+
+/// The edges of `faces` as sorted vertex pairs [a, b], a < b, each once.
+fn edges_of(faces: &[Vec<u32>]) -> Vec<[u32; 2]> {
+    let mut edges: Vec<[u32; 2]> = Vec::new();
+    for face in faces {
+        for k in 0..face.len() {
+            let (a, b) = (face[k], face[(k + 1) % face.len()]);
+            if a < b {
+                edges.push([a, b]);
+            }
+        }
+    }
+    edges.sort_unstable();
+    edges.dedup();
+    edges
+}
+
+/// The neighbours of each of `vertex_count` vertices along `edges`, as offsets and a flat list (CSR).
+fn vertex_adjacency(vertex_count: usize, edges: &[[u32; 2]]) -> (Vec<u32>, Vec<u32>) {
+    let mut degree = vec![0u32; vertex_count];
+    for &[a, b] in edges {
+        degree[a as usize] += 1;
+        degree[b as usize] += 1;
+    }
+    let mut starts = Vec::with_capacity(vertex_count + 1);
+    starts.push(0u32);
+    for d in &degree {
+        starts.push(starts.last().copied().unwrap_or(0) + d);
+    }
+    let mut fill: Vec<u32> = starts[..vertex_count].to_vec();
+    let mut adjacency = vec![0u32; 2 * edges.len()];
+    for &[a, b] in edges {
+        adjacency[fill[a as usize] as usize] = b;
+        fill[a as usize] += 1;
+        adjacency[fill[b as usize] as usize] = a;
+        fill[b as usize] += 1;
+    }
+    (starts, adjacency)
 }
 
 #[cfg(test)]
