@@ -31,7 +31,7 @@ use super::pair_smoothing::{smooth_pair_overlap, PairSmoothing};
 use super::tolerances::ContactTolerances;
 use super::{ContactGeometry, ContactKind};
 use crate::math::{Point, Pose};
-use crate::shape::{ConvexPolyhedron, ConvexShape, Shape};
+use crate::shape::{ConvexPolyhedron, ConvexShape, Plane, Shape};
 
 /// A query that has no meaning.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
@@ -126,50 +126,44 @@ pub fn query_with(
             counters.record(&g);
             g
         }
-        (Shape::Plane(p), Shape::Sphere(s)) => {
-            counters.sphere_plane += 1;
-            let g =
-                contact_plane_sphere(pos1, p.normal(), p.offset(), &centre(pos2), s.radius(), tol);
-            counters.record(&g);
-            g
-        }
-        (Shape::Sphere(s), Shape::Plane(p)) => {
-            counters.sphere_plane += 1;
-            let g =
-                contact_plane_sphere(pos2, p.normal(), p.offset(), &centre(pos1), s.radius(), tol);
-            counters.record(&g);
-            swap_pair(&g)
-        }
-        (Shape::Plane(p), Shape::Polyhedron(b)) => {
-            counters.polyhedron_plane += 1;
-            let g = contact_plane_polytope(pos1, p.normal(), p.offset(), pos2, b.as_ref(), tol);
-            counters.record(&g);
-            g
-        }
-        (Shape::Polyhedron(a), Shape::Plane(p)) => {
-            counters.polyhedron_plane += 1;
-            let g = contact_plane_polytope(pos2, p.normal(), p.offset(), pos1, a.as_ref(), tol);
-            counters.record(&g);
-            swap_pair(&g)
-        }
         (Shape::Plane(_), Shape::Plane(_)) => return Err(ContactError::PlanePlane),
-        (Shape::Plane(p), b) => {
-            counters.convex_plane += 1;
-            let g = contact_plane_convex(pos1, p.normal(), p.offset(), pos2, bounded(b)?, tol);
-            counters.record(&g);
-            g
-        }
-        (a, Shape::Plane(p)) => {
-            counters.convex_plane += 1;
-            let g = contact_plane_convex(pos2, p.normal(), p.offset(), pos1, bounded(a)?, tol);
-            counters.record(&g);
-            swap_pair(&g)
-        }
+        (Shape::Plane(p), other) => plane_contact(pos1, p, pos2, other, tol, counters)?,
+        (other, Shape::Plane(p)) => swap_pair(&plane_contact(pos2, p, pos1, other, tol, counters)?),
         (a, b) => {
             let (a, b) = (bounded(a)?, bounded(b)?);
             contact_support_maps(pos1, a, pos2, b, tol, cache, scratch, counters).geometry
         }
     };
+    Ok(g)
+}
+
+/// The contact of the wall `plane` at `pos_plane` (A) with the solid `other` at `pos_other` (B), counted:
+/// the closed forms for a sphere and a polyhedron, the convex–plane form for any other solid.
+fn plane_contact(
+    pos_plane: &Pose,
+    plane: &Plane,
+    pos_other: &Pose,
+    other: &Shape,
+    tol: &ContactTolerances,
+    counters: &mut QueryCounters,
+) -> Result<ContactGeometry, ContactError> {
+    let (normal, offset) = (plane.normal(), plane.offset());
+    let g = match other {
+        Shape::Sphere(s) => {
+            counters.sphere_plane += 1;
+            let centre = Point::from(pos_other.translation.vector);
+            contact_plane_sphere(pos_plane, normal, offset, &centre, s.radius(), tol)
+        }
+        Shape::Polyhedron(b) => {
+            counters.polyhedron_plane += 1;
+            contact_plane_polytope(pos_plane, normal, offset, pos_other, b.as_ref(), tol)
+        }
+        other => {
+            counters.convex_plane += 1;
+            contact_plane_convex(pos_plane, normal, offset, pos_other, bounded(other)?, tol)
+        }
+    };
+    counters.record(&g);
     Ok(g)
 }
 

@@ -149,14 +149,21 @@ pub fn gjk<A: SupportMap + ?Sized, B: SupportMap + ?Sized>(
             v,
         };
     }
-    let (distance, normal) = feature_normal(simplex, &v, distance);
+    separated(simplex, &v, distance, iterations)
+}
+
+/// The result of a run that stopped apart: distance and normal from the terminal feature, the witness
+/// points from the simplex's barycentric weights, made to obey point_b − point_a = distance · normal
+/// exactly (they differ from it by round-off).
+#[inline(always)]
+fn separated(simplex: &Simplex, v: &Vector, distance: Real, iterations: u32) -> GjkResult {
+    let (distance, normal) = feature_normal(simplex, v, distance);
     let mut pa = Vector::zeros();
     let mut pb = Vector::zeros();
     for i in 0..simplex.len {
         pa += simplex.pts[i].a * simplex.bary[i];
         pb += simplex.pts[i].b * simplex.bary[i];
     }
-    // Make the witnesses obey point_b − point_a = distance · normal exactly (they differ from it by round-off).
     let mid = (pa + pb) * 0.5;
     let half = normal * (0.5 * distance);
     GjkResult {
@@ -167,7 +174,7 @@ pub fn gjk<A: SupportMap + ?Sized, B: SupportMap + ?Sized>(
             point_b: mid + half,
         },
         iterations,
-        v,
+        v: *v,
     }
 }
 
