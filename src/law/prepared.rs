@@ -10,7 +10,9 @@
 use super::damping::PreparedDamping;
 use super::model::{ContactModel, ContactResponse};
 use super::normal::NormalLaw;
-use super::tangential::{incremental_spring_damped, TangentialHistory, TangentialLaw};
+use super::tangential::{
+    incremental_spring_damped, TangentialHistory, TangentialLaw, TangentialResponse,
+};
 use crate::math::{Point, Real, Vector};
 
 /// A [`ContactModel`] with the constants of one contact (its effective mass) formed.
@@ -79,73 +81,64 @@ impl PreparedModel {
         }
         let normal_force = elastic + damping;
 
-        let (
-            tangential_force,
-            tangential_potential,
-            friction_dissipation,
-            sliding,
-            tangential_power,
-            dashpot_force,
-            tangential_stiffness_work,
-            previous_displacement,
-        ) = match self.tangential {
-            TangentialLaw::None => (
-                Vector::zeros(),
-                0.0,
-                0.0,
-                false,
-                0.0,
-                Vector::zeros(),
-                0.0,
-                None,
-            ),
+        let (t, previous_displacement) = match self.tangential {
+            TangentialLaw::None => (TangentialResponse::NONE, None),
             law => {
-                let (stiffness, friction) = law.stiffness_and_friction(overlap);
-                let dashpot = match law {
-                    TangentialLaw::DampedMindlin { .. } => {
-                        self.tangential_dashpot * overlap.max(0.0).sqrt().sqrt()
-                    }
-                    _ => 0.0,
-                };
-                let v_t = v - n * v.dot(&n);
-                let r = incremental_spring_damped(
-                    law.rotation(),
-                    stiffness,
-                    friction,
-                    dashpot,
-                    &n,
-                    normal_force,
-                    &v_t,
-                    dt,
-                    history,
-                );
-                (
-                    r.force,
-                    r.spring_energy,
-                    r.friction_dissipation,
-                    r.sliding,
-                    r.damping_power,
-                    r.damping_force,
-                    r.stiffness_work,
-                    Some(r.previous_displacement),
-                )
+                let r = self.tangential_response(law, overlap, &n, &v, normal_force, dt, history);
+                (r, Some(r.previous_displacement))
             }
         };
-        let force_on_b = n * normal_force + tangential_force;
+        let force_on_b = n * normal_force + t.force;
         ContactResponse {
             force_on_b,
             torque_on_a: (point - center_a).cross(&(-force_on_b)),
             torque_on_b: (point - center_b).cross(&force_on_b),
             normal_force,
-            tangential_force,
+            tangential_force: t.force,
             normal_potential: self.normal.potential(overlap),
-            tangential_potential,
-            damping_power: damping * overlap_rate + tangential_power,
-            damping_force: n * damping + dashpot_force,
-            friction_dissipation,
-            tangential_stiffness_work,
-            sliding,
+            tangential_potential: t.spring_energy,
+            damping_power: damping * overlap_rate + t.damping_power,
+            damping_force: n * damping + t.damping_force,
+            friction_dissipation: t.friction_dissipation,
+            tangential_stiffness_work: t.stiffness_work,
+            sliding: t.sliding,
             previous_displacement,
         }
+    }
+
+    /// The tangential slot `law` (not [`TangentialLaw::None`]) at overlap δ with unit normal `n`,
+    /// relative velocity `v` and normal force `normal_force`: the spring `history` advanced over `dt`
+    /// with the law's stiffness, Coulomb cap and dashpot at δ.
+    #[allow(clippy::too_many_arguments)]
+    #[inline(always)]
+    fn tangential_response(
+        &self,
+        law: TangentialLaw,
+        overlap: Real,
+        n: &Vector,
+        v: &Vector,
+        normal_force: Real,
+        dt: Real,
+        history: &mut TangentialHistory,
+    ) -> TangentialResponse {
+        let (stiffness, friction) = law.stiffness_and_friction(overlap);
+        let dashpot = match law {
+            TangentialLaw::DampedMindlin { .. } => {
+                self.tangential_dashpot * overlap.max(0.0).sqrt().sqrt()
+            }
+            _ => 0.0,
+        };
+        let v_t = v - n * v.dot(n);
+        incremental_spring_damped(
+            law.rotation(),
+            stiffness,
+            friction,
+            dashpot,
+            n,
+            normal_force,
+            &v_t,
+            dt,
+            history,
+        )
     }
 }

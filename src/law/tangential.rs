@@ -255,6 +255,20 @@ pub struct TangentialResponse {
     pub previous_displacement: Vector,
 }
 
+impl TangentialResponse {
+    /// The response of a contact without a tangential law: no force, no spring, no work.
+    pub const NONE: TangentialResponse = TangentialResponse {
+        force: Vector::new(0.0, 0.0, 0.0),
+        sliding: false,
+        friction_dissipation: 0.0,
+        spring_energy: 0.0,
+        damping_power: 0.0,
+        damping_force: Vector::new(0.0, 0.0, 0.0),
+        stiffness_work: 0.0,
+        previous_displacement: Vector::new(0.0, 0.0, 0.0),
+    };
+}
+
 /// Rotates the displacement `u` expressed against `old_normal` into the plane perpendicular to `new_normal`
 /// (smallest rotation taking one normal to the other), keeping its length. A zero `old_normal` (new contact)
 /// only projects.
