@@ -14,7 +14,7 @@ use super::super::energy::ContactWork;
 use super::super::step::{first_non_finite, OverlapWarning, StepError};
 use super::super::world::Wall;
 use super::super::ContactKey;
-use super::ledger::LastContact;
+use super::ledger::{LastContact, PairLedger};
 use super::neighbours::TopTwo;
 use super::pair::{
     Kinematic, LedgerSlot, PairConstants, PairContext, PairOut, Props, WallConstants,
@@ -366,6 +366,22 @@ pub(super) struct LedgerPart<'a> {
 }
 
 impl<'a> LedgerPart<'a> {
+    /// The slots of every pair of `ledger`; `in_order` when one block visits all the pairs in pair order
+    /// and sums their terms itself (then it has no work slots).
+    pub(super) fn whole(ledger: &'a mut PairLedger, in_order: bool) -> Self {
+        let (work, wall_work): (&mut [ContactWork], &mut [ContactWork]) = match in_order {
+            true => (&mut [], &mut []),
+            false => (&mut ledger.work, &mut ledger.wall_work),
+        };
+        LedgerPart {
+            in_order,
+            last: &mut ledger.last,
+            work,
+            wall_last: &mut ledger.wall_last,
+            wall_work,
+        }
+    }
+
     /// The slots of the first `pairs` pairs and `walls` wall pairs, split off the front (the slots are
     /// empty when the ledger is off: then nothing is split off).
     pub(super) fn split_front(&mut self, pairs: usize, walls: usize) -> LedgerPart<'a> {

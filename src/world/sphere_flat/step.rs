@@ -360,22 +360,8 @@ impl SphereSim {
         let pl = &mut self.pair_ledger;
         let one_block = blocks.bodies.len() == 1;
         // One block visits the pairs in pair order, so it sums the ledger's terms itself.
-        let ledger = match one_block {
-            true => LedgerPart {
-                in_order: true,
-                last: &mut pl.last,
-                wall_last: &mut pl.wall_last,
-                ..LedgerPart::default()
-            },
-            false => LedgerPart {
-                in_order: false,
-                last: &mut pl.last,
-                work: &mut pl.work,
-                wall_last: &mut pl.wall_last,
-                wall_work: &mut pl.wall_work,
-            },
-        };
-        let mut whole = BlockPart {
+        let ledger = LedgerPart::whole(pl, one_block);
+        let whole = BlockPart {
             histories: &mut list.histories,
             in_contact: &mut list.in_contact,
             outs: &mut self.out,
@@ -395,35 +381,7 @@ impl SphereSim {
             // warnings against walls like any other.
             return found.finish();
         }
-        // Split every array at the boundaries of the blocks and middles; thread k runs block k, then
-        // the middle after it (the whole middle: no sharing out when the passes run one by one).
-        let mut parts: Vec<Vec<(usize, BlockPart)>> =
-            blocks.bodies.iter().map(|_| Vec::new()).collect();
-        let mut thread = 0;
-        for (s, range) in blocks.segments().enumerate() {
-            let (first, last) = (range.start, range.end);
-            let pairs = (pass.row_start[last] - pass.row_start[first]) as usize;
-            let walls = (pass.wall_start[last] - pass.wall_start[first]) as usize;
-            parts[thread].push((first, whole.split_front(pairs, walls, last - first)));
-            // Segments alternate block, middle: a middle closes its thread's list.
-            thread += s % 2;
-        }
-        let run = |segments: Vec<(usize, BlockPart)>| {
-            segments
-                .into_iter()
-                .map(|(first, part)| pass.run(first, part))
-                .fold(Found::default(), Found::merge)
-        };
-        let found = if parts.len() > 1 && rayon::current_num_threads() > 1 {
-            for_each_part(parts, |_, segments| run(segments))
-                .into_iter()
-                .fold(Found::default(), Found::merge)
-        } else {
-            parts
-                .into_iter()
-                .map(run)
-                .fold(Found::default(), Found::merge)
-        };
+        let found = run_blocks(&pass, blocks, whole);
         self.outs_valid = true;
         found.finish()
     }
@@ -452,5 +410,38 @@ impl SphereSim {
             &self.walls,
             &mut self.wall_forces,
         );
+    }
+}
+
+/// The pair loop on several blocks: every array split at the boundaries of the blocks and middles
+/// ([`Blocks::segments`]); thread k runs block k, then the middle after it (the whole middle: no
+/// sharing out when the passes run one by one). What each segment found, merged in segment order.
+fn run_blocks(pass: &PairBlocks<'_>, blocks: &Blocks, mut whole: BlockPart<'_>) -> Found {
+    let mut parts: Vec<Vec<(usize, BlockPart)>> =
+        blocks.bodies.iter().map(|_| Vec::new()).collect();
+    let mut thread = 0;
+    for (s, range) in blocks.segments().enumerate() {
+        let (first, last) = (range.start, range.end);
+        let pairs = (pass.row_start[last] - pass.row_start[first]) as usize;
+        let walls = (pass.wall_start[last] - pass.wall_start[first]) as usize;
+        parts[thread].push((first, whole.split_front(pairs, walls, last - first)));
+        // Segments alternate block, middle: a middle closes its thread's list.
+        thread += s % 2;
+    }
+    let run = |segments: Vec<(usize, BlockPart)>| {
+        segments
+            .into_iter()
+            .map(|(first, part)| pass.run(first, part))
+            .fold(Found::default(), Found::merge)
+    };
+    if parts.len() > 1 && rayon::current_num_threads() > 1 {
+        for_each_part(parts, |_, segments| run(segments))
+            .into_iter()
+            .fold(Found::default(), Found::merge)
+    } else {
+        parts
+            .into_iter()
+            .map(run)
+            .fold(Found::default(), Found::merge)
     }
 }
