@@ -77,7 +77,7 @@ mod step;
 mod team;
 
 use super::step::guard::Guard;
-use crate::contact::{contact_plane_sphere, contact_sphere_sphere, QueryCounters};
+use crate::contact::QueryCounters;
 use crate::dynamics::rotation::{is_isotropic, SubRotation};
 use crate::dynamics::{Motion, RotationScheme, ViscousDamping};
 use crate::law::ContactModel;
@@ -88,8 +88,9 @@ use rayon::prelude::*;
 use super::broad_phase::BroadPhase;
 use super::contact_store::{ContactKey, ContactState, ContactStore};
 use super::energy::{ContactWork, EnergyLedger};
-use super::skips;
-use super::step::{effective_models, StepError, StepParams};
+use super::step::{
+    effective_models, sphere_pair_geometry, wall_sphere_geometry, StepError, StepParams,
+};
 use super::world::{Wall, World};
 
 pub use blocks::TeamSplit;
@@ -605,20 +606,7 @@ impl SphereSim {
                     let (a, b) = (a as usize, b as usize);
                     let (xa, xb) = (&self.kin[a].position, &self.kin[b].position);
                     let (ra, rb) = (self.props[a].radius, self.props[b].radius);
-                    let rejected = bounding
-                        .then(|| {
-                            skips::reject_by_bounding_spheres(
-                                xa,
-                                ra,
-                                xb,
-                                rb,
-                                (2.0 * ra).max(2.0 * rb),
-                                tol,
-                                &mut counters,
-                            )
-                        })
-                        .flatten();
-                    rejected.unwrap_or_else(|| contact_sphere_sphere(xa, ra, xb, rb, tol))
+                    sphere_pair_geometry(xa, ra, xb, rb, bounding, tol, &mut counters)
                 }
                 ContactKey::Wall { body, wall } => {
                     let (x, r) = (
@@ -626,20 +614,7 @@ impl SphereSim {
                         self.props[body as usize].radius,
                     );
                     let w = &self.walls[wall as usize];
-                    let rejected = bounding
-                        .then(|| {
-                            skips::reject_wall_by_bounding_sphere(
-                                w.signed_distance(x),
-                                &w.normal_world(),
-                                x,
-                                r,
-                                &mut counters,
-                            )
-                        })
-                        .flatten();
-                    rejected.unwrap_or_else(|| {
-                        contact_plane_sphere(&w.pose, w.plane.normal(), w.plane.offset(), x, r, tol)
-                    })
+                    wall_sphere_geometry(w, x, r, bounding, tol, &mut counters)
                 }
             };
             let (force_on_b, damping_force) = if in_contact {

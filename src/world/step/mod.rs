@@ -67,6 +67,7 @@ pub use scratch::StepScratch;
 
 pub(crate) use checks::first_non_finite;
 pub(crate) use laws::effective_models;
+pub(in crate::world) use sphere_kernel::{sphere_pair_geometry, wall_sphere_geometry};
 
 use super::sleeping;
 use super::world::World;

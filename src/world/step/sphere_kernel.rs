@@ -21,7 +21,8 @@
 //! (`tests/world_sphere_fast_paths.rs`, `tests/world_skips.rs`).
 
 use crate::contact::{
-    contact_plane_sphere, contact_sphere_sphere, ContactGeometry, ContactKind, QueryCounters,
+    contact_plane_sphere, contact_sphere_sphere, ContactGeometry, ContactKind, ContactTolerances,
+    QueryCounters,
 };
 use crate::dynamics::body::RigidBody;
 use crate::dynamics::rotation::is_isotropic;
@@ -48,8 +49,6 @@ pub(super) struct SphereBody {
     omega: Vector,
     /// Radius of the sphere (m); zero for another shape.
     radius: Real,
-    /// Bounding radius (`World::radii`, m).
-    bound: Real,
     /// Length scale of the shape (the diameter, m).
     length_scale: Real,
     mass: Real,
@@ -85,7 +84,6 @@ pub(super) fn gather(
             velocity: body.velocity,
             omega,
             radius: sphere.radius(),
-            bound: world.radii[i],
             length_scale: sphere.length_scale(),
             mass: body.mass,
             material: world.material_of[i],
@@ -117,6 +115,52 @@ impl SphereBody {
     fn velocity_back_at(&self, point: &Point, back: Real) -> Vector {
         self.velocity_at(&(point + back * self.velocity))
     }
+}
+
+/// Stage 4's geometry of the spheres at `xa` and `xb` (radii `ra`, `rb`): the bounding-sphere
+/// rejection's when `bounding` (the skip) is on and rejects the pair, else the closed form of
+/// [`contact_sphere_sphere`]; counted in `counters`.
+#[inline(always)]
+pub(in crate::world) fn sphere_pair_geometry(
+    xa: &Point,
+    ra: Real,
+    xb: &Point,
+    rb: Real,
+    bounding: bool,
+    tol: &ContactTolerances,
+    counters: &mut QueryCounters,
+) -> ContactGeometry {
+    let scale = (2.0 * ra).max(2.0 * rb);
+    let rejected = bounding
+        .then(|| skips::reject_by_bounding_spheres(xa, ra, xb, rb, scale, tol, counters))
+        .flatten();
+    rejected_or(rejected, counters, |c| {
+        c.sphere_sphere += 1;
+        contact_sphere_sphere(xa, ra, xb, rb, tol)
+    })
+}
+
+/// Stage 4's geometry of wall `w` and the sphere at `x` (radius `r`), as [`sphere_pair_geometry`]
+/// (the closed form of [`contact_plane_sphere`]).
+#[inline(always)]
+pub(in crate::world) fn wall_sphere_geometry(
+    w: &Wall,
+    x: &Point,
+    r: Real,
+    bounding: bool,
+    tol: &ContactTolerances,
+    counters: &mut QueryCounters,
+) -> ContactGeometry {
+    let rejected = bounding
+        .then(|| {
+            let height = w.signed_distance(x);
+            skips::reject_wall_by_bounding_sphere(height, &w.normal_world(), x, r, counters)
+        })
+        .flatten();
+    rejected_or(rejected, counters, |c| {
+        c.sphere_plane += 1;
+        contact_plane_sphere(&w.pose, w.plane.normal(), w.plane.offset(), x, r, tol)
+    })
 }
 
 /// A candidate's geometry: the bounding-sphere rejection's when there is one, else the closed form's
@@ -190,24 +234,9 @@ impl Evaluation<'_> {
         counters: &mut QueryCounters,
     ) -> Result<(), StepError> {
         let (params, pair, previous_point) = (self.params, self.pair, self.previous_point);
-        let tol = &params.tolerances;
-        let rejected = if params.skips.bounding_spheres {
-            skips::reject_by_bounding_spheres(
-                &sa.position,
-                sa.bound,
-                &sb.position,
-                sb.bound,
-                sa.length_scale.max(sb.length_scale),
-                tol,
-                counters,
-            )
-        } else {
-            None
-        };
-        state.geometry = rejected_or(rejected, counters, |c| {
-            c.sphere_sphere += 1;
-            contact_sphere_sphere(&sa.position, sa.radius, &sb.position, sb.radius, tol)
-        });
+        let (tol, bounding) = (&params.tolerances, params.skips.bounding_spheres);
+        let (xa, ra, xb, rb) = (&sa.position, sa.radius, &sb.position, sb.radius);
+        state.geometry = sphere_pair_geometry(xa, ra, xb, rb, bounding, tol, counters);
         if state.geometry.kind != ContactKind::Overlap {
             return separated_law(pair, key, state, previous_point, out);
         }
@@ -256,29 +285,8 @@ impl Evaluation<'_> {
         counters: &mut QueryCounters,
     ) -> Result<(), StepError> {
         let (params, pair, previous_point) = (self.params, self.pair, self.previous_point);
-        let tol = &params.tolerances;
-        let rejected = if params.skips.bounding_spheres {
-            skips::reject_wall_by_bounding_sphere(
-                w.signed_distance(&s.position),
-                &w.normal_world(),
-                &s.position,
-                s.bound,
-                counters,
-            )
-        } else {
-            None
-        };
-        state.geometry = rejected_or(rejected, counters, |c| {
-            c.sphere_plane += 1;
-            contact_plane_sphere(
-                &w.pose,
-                w.plane.normal(),
-                w.plane.offset(),
-                &s.position,
-                s.radius,
-                tol,
-            )
-        });
+        let (tol, bounding) = (&params.tolerances, params.skips.bounding_spheres);
+        state.geometry = wall_sphere_geometry(w, &s.position, s.radius, bounding, tol, counters);
         if state.geometry.kind != ContactKind::Overlap {
             return separated_law(pair, key, state, previous_point, out);
         }
