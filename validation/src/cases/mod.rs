@@ -12,6 +12,7 @@ pub mod polyhedra_box;
 pub mod precession;
 pub mod projectile_history;
 pub mod restitution;
+mod restitution_bound;
 pub mod rockfill;
 mod rockfill_dt_spread;
 pub mod single_contact_energy;
