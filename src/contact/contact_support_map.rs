@@ -73,47 +73,7 @@ pub fn contact_support_maps<A: ConvexShape + ?Sized, B: ConvexShape + ?Sized>(
     };
     let pos12 = pos1.inv_mul(pos2);
     let mut pair = MinkowskiPair::new(a, b, &pos12, cache.hint_a, cache.hint_b);
-    let v_init = if cache.dir.norm_squared() > 0.0 {
-        cache.dir
-    } else {
-        -pos12.translation.vector
-    };
-    let mut simplex = Simplex::default();
-    let gr = gjk(
-        &mut pair,
-        &v_init,
-        scale,
-        &curved,
-        GjkMode::Distance,
-        &mut simplex,
-    );
-    counters.gjk_runs += 1;
-    counters.gjk_iterations += gr.iterations as u64;
-    let f = match gr.outcome {
-        GjkOutcome::Separated {
-            distance,
-            normal,
-            point_a,
-            point_b,
-        } => {
-            let upper = pair.overlap_along(&normal).0;
-            Frame1 {
-                signed: -distance,
-                bounds: [-distance, upper.max(-distance)],
-                normal,
-                point_a,
-                point_b,
-                status: SolverStatus::Converged,
-            }
-        }
-        GjkOutcome::Contact => {
-            let er = epa(&mut pair, &simplex, scale, &curved, scratch);
-            counters.epa_runs += 1;
-            counters.epa_iterations += er.iterations as u64;
-            overlap_features(&mut pair, er.outcome, scratch, touch)
-        }
-        GjkOutcome::MaxIterations | GjkOutcome::SeparatingAxis => unconverged_gjk(&mut pair, &gr.v),
-    };
+    let f = features(&mut pair, &pos12, scale, &curved, cache, scratch, counters);
     cache.dir = -f.normal * f.signed.abs().max(touch);
     cache.hint_a = pair.hint_a;
     cache.hint_b = pair.hint_b;
@@ -137,6 +97,61 @@ pub fn contact_support_maps<A: ConvexShape + ?Sized, B: ConvexShape + ?Sized>(
         bounds: f.bounds,
         converged,
         tolerance: gap,
+    }
+}
+
+/// The pair's features in frame 1: GJK from the cached direction (else from B's centre towards A's), then
+/// EPA if the shapes overlap.
+fn features<A: SupportMap + ?Sized, B: SupportMap + ?Sized>(
+    pair: &mut MinkowskiPair<'_, A, B>,
+    pos12: &Pose,
+    scale: Real,
+    curved: &ContactTolerances,
+    cache: &PairCache,
+    scratch: &mut EpaScratch,
+    counters: &mut QueryCounters,
+) -> Frame1 {
+    let v_init = if cache.dir.norm_squared() > 0.0 {
+        cache.dir
+    } else {
+        -pos12.translation.vector
+    };
+    let mut simplex = Simplex::default();
+    let gr = gjk(
+        pair,
+        &v_init,
+        scale,
+        curved,
+        GjkMode::Distance,
+        &mut simplex,
+    );
+    counters.gjk_runs += 1;
+    counters.gjk_iterations += gr.iterations as u64;
+    match gr.outcome {
+        GjkOutcome::Separated {
+            distance,
+            normal,
+            point_a,
+            point_b,
+        } => {
+            let upper = pair.overlap_along(&normal).0;
+            Frame1 {
+                signed: -distance,
+                bounds: [-distance, upper.max(-distance)],
+                normal,
+                point_a,
+                point_b,
+                status: SolverStatus::Converged,
+            }
+        }
+        GjkOutcome::Contact => {
+            let er = epa(pair, &simplex, scale, curved, scratch);
+            counters.epa_runs += 1;
+            counters.epa_iterations += er.iterations as u64;
+            let touch = curved.touching * scale;
+            overlap_features(pair, er.outcome, scratch, touch)
+        }
+        GjkOutcome::MaxIterations | GjkOutcome::SeparatingAxis => unconverged_gjk(pair, &gr.v),
     }
 }
 

@@ -133,6 +133,60 @@ pub struct AsymmetricTop {
     frame: Rotation,
 }
 
+/// One regime's solution of Euler's equations: ω̄ = (a₁ cn, s a₂ sn, s a₃ dn) about axis 3, or
+/// (s a₁ dn, s a₂ sn, a₃ cn) about axis 1, of τ = λ t + τ₀ with parameter m; `phase_sn`, `phase_cn` give
+/// the initial amplitude of τ₀.
+struct Circulation {
+    regime: Regime,
+    amplitudes: Vector,
+    frequency: Real,
+    parameter: Real,
+    sign: Real,
+    phase_sn: Real,
+    phase_cn: Real,
+}
+
+impl Circulation {
+    /// The regime of moments J̄₁ < J̄₂ < J̄₃ and initial body-frame ω̄₀, from 2EJ₃ − M² (`upper`),
+    /// M² − 2EJ₁ (`lower`) and whether M² > 2EJ₂ (`about_axis3`).
+    fn of(inertia: Vector, omega0: Vector, upper: Real, lower: Real, about_axis3: bool) -> Self {
+        let (j1, j2, j3) = (inertia[0], inertia[1], inertia[2]);
+        if about_axis3 {
+            let a = Vector::new(
+                (upper / (j1 * (j3 - j1))).sqrt(),
+                (upper / (j2 * (j3 - j2))).sqrt(),
+                (lower / (j3 * (j3 - j1))).sqrt(),
+            );
+            let s = omega0[2].signum();
+            Self {
+                regime: Regime::AboutAxis3,
+                amplitudes: a,
+                frequency: ((j3 - j2) * lower / (j1 * j2 * j3)).sqrt(),
+                parameter: (j2 - j1) * upper / ((j3 - j2) * lower),
+                sign: s,
+                phase_sn: s * omega0[1] / a[1],
+                phase_cn: omega0[0] / a[0],
+            }
+        } else {
+            let a = Vector::new(
+                (upper / (j1 * (j3 - j1))).sqrt(),
+                (lower / (j2 * (j2 - j1))).sqrt(),
+                (lower / (j3 * (j3 - j1))).sqrt(),
+            );
+            let s = omega0[0].signum();
+            Self {
+                regime: Regime::AboutAxis1,
+                amplitudes: a,
+                frequency: ((j2 - j1) * upper / (j1 * j2 * j3)).sqrt(),
+                parameter: (j3 - j2) * lower / ((j2 - j1) * upper),
+                sign: s,
+                phase_sn: s * omega0[1] / a[1],
+                phase_cn: omega0[2] / a[2],
+            }
+        }
+    }
+}
+
 impl AsymmetricTop {
     /// The motion from the principal moments `inertia` (kg·m², ordered J̄₁ < J̄₂ < J̄₃), the initial body-frame
     /// angular velocity `omega_body0` (rad/s) and the initial orientation `orientation0` (body to world).
@@ -168,44 +222,15 @@ impl AsymmetricTop {
                 reason: "on the separatrix M² = 2EJ₂",
             });
         }
-        let (regime, amplitudes, frequency, parameter, sign, phase_sn, phase_cn) =
-            if separatrix > 0.0 {
-                let a = Vector::new(
-                    (upper / (j1 * (j3 - j1))).sqrt(),
-                    (upper / (j2 * (j3 - j2))).sqrt(),
-                    (lower / (j3 * (j3 - j1))).sqrt(),
-                );
-                let lambda = ((j3 - j2) * lower / (j1 * j2 * j3)).sqrt();
-                let m = (j2 - j1) * upper / ((j3 - j2) * lower);
-                let s = omega_body0[2].signum();
-                (
-                    Regime::AboutAxis3,
-                    a,
-                    lambda,
-                    m,
-                    s,
-                    s * omega_body0[1] / a[1],
-                    omega_body0[0] / a[0],
-                )
-            } else {
-                let a = Vector::new(
-                    (upper / (j1 * (j3 - j1))).sqrt(),
-                    (lower / (j2 * (j2 - j1))).sqrt(),
-                    (lower / (j3 * (j3 - j1))).sqrt(),
-                );
-                let lambda = ((j2 - j1) * upper / (j1 * j2 * j3)).sqrt();
-                let m = (j3 - j2) * lower / ((j2 - j1) * upper);
-                let s = omega_body0[0].signum();
-                (
-                    Regime::AboutAxis1,
-                    a,
-                    lambda,
-                    m,
-                    s,
-                    s * omega_body0[1] / a[1],
-                    omega_body0[2] / a[2],
-                )
-            };
+        let Circulation {
+            regime,
+            amplitudes,
+            frequency,
+            parameter,
+            sign,
+            phase_sn,
+            phase_cn,
+        } = Circulation::of(inertia, omega_body0, upper, lower, separatrix > 0.0);
         let amplitude0 = phase_sn.atan2(phase_cn);
         let phase = incomplete_elliptic_f(amplitude0, parameter)?;
         let mut top = Self {

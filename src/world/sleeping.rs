@@ -488,25 +488,17 @@ impl FrozenLoads {
             world.bodies.len(),
             world.walls.len(),
         );
-        if let Some((changes, step, bodies, walls)) = self.built_for {
-            let current = changes == state.0
+        let current = self.built_for.is_some_and(|(changes, step, bodies, walls)| {
+            changes == state.0
                 && (step == state.1 || (step + 1 == state.1 && !self.pending))
                 && (bodies, walls) == (state.2, state.3)
-                && !store_changed;
-            if current {
-                self.built_for = Some(state);
-                return false;
-            }
-        }
+                && !store_changed
+        });
         self.built_for = Some(state);
-        self.pending = false;
-        self.bodies.clear();
-        self.wall_forces.clear();
-        self.wall_forces.resize(world.walls.len(), Vector::zeros());
-        self.potential = 0.0;
-        self.contacts = 0;
-        self.max_overlap_ratio = 0.0;
-        self.deep.clear();
+        if current {
+            return false;
+        }
+        self.clear(world.walls.len());
         if world.sleep.sleeping == 0 {
             return true;
         }
@@ -529,33 +521,8 @@ impl FrozenLoads {
                 self.pending = true;
                 continue;
             }
-            let Some(c) = frozen_contact(world, k) else {
-                continue;
-            };
-            match key {
-                ContactKey::Body { a, b } => {
-                    let sa = &mut self.sums[a as usize];
-                    sa.0 -= c.force_on_b;
-                    sa.1 += c.torque_on_a;
-                    sa.2 = true;
-                    let sb = &mut self.sums[b as usize];
-                    sb.0 += c.force_on_b;
-                    sb.1 += c.torque_on_b;
-                    sb.2 = true;
-                }
-                ContactKey::Wall { body, wall } => {
-                    self.wall_forces[wall as usize] -= c.force_on_b;
-                    let s = &mut self.sums[body as usize];
-                    s.0 += c.force_on_b;
-                    s.1 += c.torque_on_b;
-                    s.2 = true;
-                }
-            }
-            self.potential += c.potential;
-            self.contacts += 1;
-            self.max_overlap_ratio = self.max_overlap_ratio.max(c.overlap_ratio);
-            if c.overlap_ratio > warning_fraction {
-                self.deep.push(c);
+            if let Some(c) = frozen_contact(world, k) {
+                self.add(key, c, warning_fraction);
             }
         }
         for (i, &(force, torque, any)) in self.sums.iter().enumerate() {
@@ -564,6 +531,47 @@ impl FrozenLoads {
             }
         }
         true
+    }
+
+    /// Empties the sums, for a world of `walls` walls.
+    fn clear(&mut self, walls: usize) {
+        self.pending = false;
+        self.bodies.clear();
+        self.wall_forces.clear();
+        self.wall_forces.resize(walls, Vector::zeros());
+        self.potential = 0.0;
+        self.contacts = 0;
+        self.max_overlap_ratio = 0.0;
+        self.deep.clear();
+    }
+
+    /// Adds one frozen contact to its bodies' (and wall's) sums and to the totals.
+    fn add(&mut self, key: ContactKey, c: FrozenContact, warning_fraction: Real) {
+        match key {
+            ContactKey::Body { a, b } => {
+                let sa = &mut self.sums[a as usize];
+                sa.0 -= c.force_on_b;
+                sa.1 += c.torque_on_a;
+                sa.2 = true;
+                let sb = &mut self.sums[b as usize];
+                sb.0 += c.force_on_b;
+                sb.1 += c.torque_on_b;
+                sb.2 = true;
+            }
+            ContactKey::Wall { body, wall } => {
+                self.wall_forces[wall as usize] -= c.force_on_b;
+                let s = &mut self.sums[body as usize];
+                s.0 += c.force_on_b;
+                s.1 += c.torque_on_b;
+                s.2 = true;
+            }
+        }
+        self.potential += c.potential;
+        self.contacts += 1;
+        self.max_overlap_ratio = self.max_overlap_ratio.max(c.overlap_ratio);
+        if c.overlap_ratio > warning_fraction {
+            self.deep.push(c);
+        }
     }
 
     /// Adds the per-body sums to `forces` and `torques`.

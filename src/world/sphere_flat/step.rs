@@ -22,7 +22,7 @@
 
 use std::time::Instant;
 
-use crate::math::{Point, Real};
+use crate::math::{Point, Real, Vector};
 
 use super::super::step::{guard, TimeStepCheck};
 use super::super::step::{StepError, StepReport};
@@ -79,18 +79,7 @@ impl SphereSim {
                 walls,
             }) => (found.finish()?, non_finite, walls),
             drifted_or_not_run => {
-                // The fused job drifted and found the lists stale, or it did not run: pass by pass.
-                let moved = match drifted_or_not_run {
-                    Some(Fused::Stale { top, large }) => (top, large),
-                    _ => self.drift(dt, &mut report),
-                };
-                self.lists(moved, &mut report);
-                let t = Instant::now();
-                let found = self.evaluate(dt)?;
-                report.counters.narrow += t.elapsed();
-                let t = Instant::now();
-                let non_finite = self.kick(dt, found.scattered);
-                report.counters.integrate += t.elapsed();
+                let (found, non_finite) = self.by_passes(dt, drifted_or_not_run, &mut report)?;
                 (found, non_finite, None)
             }
         };
@@ -108,8 +97,42 @@ impl SphereSim {
                 quantity,
             });
         }
+        self.finish_step(dt, walls, external_start, &mut report);
+        self.check_time_step(&mut report)?;
+        Ok(report)
+    }
 
-        // 9. Walls, ledger, time.
+    /// Stages 1–8 pass by pass, when the fused job drifted and found the lists stale (`Fused::Stale`) or
+    /// did not run (`None`): the drift unless done, the lists, the pair loop, the kick. Returns what the
+    /// pair loop found and the first sphere the kick left non-finite.
+    fn by_passes(
+        &mut self,
+        dt: Real,
+        drifted_or_not_run: Option<Fused>,
+        report: &mut StepReport,
+    ) -> Result<(Found, Option<(usize, &'static str)>), StepError> {
+        let moved = match drifted_or_not_run {
+            Some(Fused::Stale { top, large }) => (top, large),
+            _ => self.drift(dt, report),
+        };
+        self.lists(moved, report);
+        let t = Instant::now();
+        let found = self.evaluate(dt)?;
+        report.counters.narrow += t.elapsed();
+        let t = Instant::now();
+        let non_finite = self.kick(dt, found.scattered);
+        report.counters.integrate += t.elapsed();
+        Ok((found, non_finite))
+    }
+
+    /// 9. The wall forces and power (the fused job's, else summed here), the ledger, the time.
+    fn finish_step(
+        &mut self,
+        dt: Real,
+        walls: Option<(Vec<Vector>, Real)>,
+        external_start: Real,
+        report: &mut StepReport,
+    ) {
         let t = Instant::now();
         match walls {
             Some((forces, power)) => {
@@ -130,8 +153,6 @@ impl SphereSim {
         self.time += dt;
         self.step_index += 1;
         report.counters.steps = 1;
-        self.check_time_step(&mut report)?;
-        Ok(report)
     }
 
     /// The check of the time step after the step (`super::super::step::guard`; reads the state only).

@@ -67,18 +67,7 @@ pub(super) fn stage(
     scratch.evaluated.resize(n_candidates, Evaluated::default());
     let world_ref: &World = world;
     let candidates = &scratch.candidates;
-    // The sphere path: its per-body inputs, gathered once (see [`super::sphere_kernel`]).
-    let parallel_bodies = world_ref.bodies.len() >= params.parallel.min_bodies;
-    let spheres = (params.skips.sphere_kernel
-        && clock.pool(parallel_bodies, || {
-            sphere_kernel::gather(
-                world_ref,
-                params.skips.isotropic_rotation,
-                parallel_bodies && rayon::current_num_threads() > 1,
-                &mut scratch.spheres,
-            )
-        }))
-    .then_some(scratch.spheres.as_slice());
+    let spheres = gather_spheres(params, world_ref, &mut scratch.spheres, &mut clock);
     let pair = PairInputs {
         world: world_ref,
         isotropic: params.skips.isotropic_rotation,
@@ -106,11 +95,7 @@ pub(super) fn stage(
             },
         )
     });
-    for worker in &mut scratch.workers {
-        counters.query.merge(&worker.query);
-        worker.query = QueryCounters::default();
-        counters.frozen_pairs += worker.tally;
-    }
+    take_worker_counts(&mut scratch.workers, counters);
     world.contacts = contacts;
     evaluated?;
     counters.add(Stage::Narrow, clock.stop());
@@ -119,6 +104,36 @@ pub(super) fn stage(
         parallel,
         store_changed,
     })
+}
+
+/// The sphere path's per-body inputs, gathered once for the pass (see [`super::sphere_kernel`]); `None`
+/// when the scene's skips turn the path off.
+fn gather_spheres<'a>(
+    params: &StepParams,
+    world: &World,
+    spheres: &'a mut Vec<sphere_kernel::SphereBody>,
+    clock: &mut StageClock,
+) -> Option<&'a [sphere_kernel::SphereBody]> {
+    let parallel_bodies = world.bodies.len() >= params.parallel.min_bodies;
+    let gathered = params.skips.sphere_kernel
+        && clock.pool(parallel_bodies, || {
+            sphere_kernel::gather(
+                world,
+                params.skips.isotropic_rotation,
+                parallel_bodies && rayon::current_num_threads() > 1,
+                spheres,
+            )
+        });
+    gathered.then_some(spheres.as_slice())
+}
+
+/// Moves the workers' query counts and frozen-pair tallies into the step's counters.
+fn take_worker_counts(workers: &mut [Worker], counters: &mut StepCounters) {
+    for worker in workers {
+        counters.query.merge(&worker.query);
+        worker.query = QueryCounters::default();
+        counters.frozen_pairs += worker.tally;
+    }
 }
 
 /// Stages 4–5 for one candidate: kept as it was when frozen (both sides asleep or fixed), else the sphere
