@@ -488,12 +488,14 @@ impl FrozenLoads {
             world.bodies.len(),
             world.walls.len(),
         );
-        let current = self.built_for.is_some_and(|(changes, step, bodies, walls)| {
-            changes == state.0
-                && (step == state.1 || (step + 1 == state.1 && !self.pending))
-                && (bodies, walls) == (state.2, state.3)
-                && !store_changed
-        });
+        let current = self
+            .built_for
+            .is_some_and(|(changes, step, bodies, walls)| {
+                changes == state.0
+                    && (step == state.1 || (step + 1 == state.1 && !self.pending))
+                    && (bodies, walls) == (state.2, state.3)
+                    && !store_changed
+            });
         self.built_for = Some(state);
         if current {
             return false;

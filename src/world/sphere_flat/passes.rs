@@ -21,6 +21,9 @@ use super::pair::{
 };
 use super::Spin;
 
+/// The first sphere a kick left with a non-finite state, and which quantity (`None`: all finite).
+pub(super) type NonFinite = Option<(usize, &'static str)>;
+
 /// What the pair loop found, summed over its blocks in pair order.
 #[derive(Default)]
 pub(super) struct Found {

@@ -34,7 +34,7 @@ use super::ledger::OldWalls;
 use super::neighbours::TopTwo;
 use super::pair::{PairContext, PairOut, WallPlane};
 use super::passes::{
-    wall_sums, BlockPart, Drift, Found, Kick, KickPart, LedgerPart, PairBlocks, Rows,
+    wall_sums, BlockPart, Drift, Found, Kick, KickPart, LedgerPart, NonFinite, PairBlocks, Rows,
 };
 use super::team::{for_each_part, split_at_ranges};
 use super::{SphereSim, MIN_PARALLEL_PAIRS};
@@ -110,7 +110,7 @@ impl SphereSim {
         dt: Real,
         drifted_or_not_run: Option<Fused>,
         report: &mut StepReport,
-    ) -> Result<(Found, Option<(usize, &'static str)>), StepError> {
+    ) -> Result<(Found, NonFinite), StepError> {
         let moved = match drifted_or_not_run {
             Some(Fused::Stale { top, large }) => (top, large),
             _ => self.drift(dt, report),

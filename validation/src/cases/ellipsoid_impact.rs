@@ -179,7 +179,11 @@ fn restitution(
         (-bodies[0].velocity.x, SPEED, bodies[0].mass)
     } else {
         let m_star = bodies[0].mass * bodies[1].mass / (bodies[0].mass + bodies[1].mass);
-        (bodies[1].velocity.x - bodies[0].velocity.x, 2.0 * SPEED, m_star)
+        (
+            bodies[1].velocity.x - bodies[0].velocity.x,
+            2.0 * SPEED,
+            m_star,
+        )
     };
     // The scene's time step is set at its characteristic speed for the lightest pair; the bound needs the
     // contact time of this impact.
@@ -247,8 +251,7 @@ impl Case for EllipsoidImpact {
                 ctx.progress().inc(1);
                 let against = if wall { "wall" } else { "ellipsoid" };
                 let tag = format!("{against}_e_{e}");
-                let bound =
-                    restitution_error_bound(EXPONENT, e, dt_over_tc).map_err(case_error)?;
+                let bound = restitution_error_bound(EXPONENT, e, dt_over_tc).map_err(case_error)?;
                 ctx.check(
                     &format!("restitution_error_{tag}"),
                     (measured - e).abs() / e,

@@ -11,12 +11,12 @@ use polydem::law::{ContactModel, DampingLaw, NormalLaw, TangentialLaw};
 use polydem::math::{Point, Real, Rotation, Vector};
 use polydem::shape::{ConvexPolyhedron, Plane, Shape};
 
+use super::restitution_bound::restitution_error_bound;
 use crate::case::{Case, CaseData, Profile, Target};
 use crate::cases::single_contact_energy::{body_of, pose};
 use crate::context::CaseContext;
 use crate::error::SuiteError;
 use crate::plot::{Plot, Series, SeriesStyle};
-use super::restitution_bound::restitution_error_bound;
 use crate::sim::two_body::{impact, sphere_sphere, wall_sphere};
 
 const RADIUS: Real = 0.05;
