@@ -524,7 +524,7 @@ impl FrozenLoads {
                 continue;
             }
             if let Some(c) = frozen_contact(world, k) {
-                self.add(key, c, warning_fraction);
+                self.add(c, warning_fraction);
             }
         }
         for (i, &(force, torque, any)) in self.sums.iter().enumerate() {
@@ -548,8 +548,8 @@ impl FrozenLoads {
     }
 
     /// Adds one frozen contact to its bodies' (and wall's) sums and to the totals.
-    fn add(&mut self, key: ContactKey, c: FrozenContact, warning_fraction: Real) {
-        match key {
+    fn add(&mut self, c: FrozenContact, warning_fraction: Real) {
+        match c.key {
             ContactKey::Body { a, b } => {
                 let sa = &mut self.sums[a as usize];
                 sa.0 -= c.force_on_b;
